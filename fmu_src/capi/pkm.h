@@ -1,0 +1,144 @@
+/*
+ * pkm.h - plain C API of the 4-PUU Schoenflies-motion parallel robot model
+ * (MODEL_SPEC.md). No C++ types; an opaque handle per simulated machine.
+ * SI units throughout: m, kg, s, rad, N, N*m.
+ *
+ * Every function returns a pkm_status; on anything but PKM_OK the handle's
+ * pkm_last_error() says why. A failed call leaves the handle's state as it
+ * was before the call (forward dynamics: at the last point reached).
+ */
+#ifndef PKM_H
+#define PKM_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(_WIN32)
+#define PKM_API __declspec(dllexport)
+#else
+#define PKM_API __attribute__((visibility("default")))
+#endif
+
+typedef enum {
+  PKM_OK = 0,
+  PKM_ERR_INVALID_ARGUMENT = 1,  /* NULL pointer, bad option */
+  PKM_ERR_INVALID_PARAMETER = 2, /* a model parameter out of range */
+  PKM_ERR_NONFINITE = 3,         /* NaN or Inf in an input */
+  PKM_ERR_UNREACHABLE = 4,       /* pose outside a leg's reach (elbow-down) */
+  PKM_ERR_SINGULAR = 5,          /* leg or parallel singularity */
+  PKM_ERR_NOT_CONVERGED = 6,     /* Newton's method failed its stopping rule */
+  PKM_ERR_SOLVER = 7,            /* the integrator gave up */
+  PKM_ERR_NOT_INITIALIZED = 8    /* forward dynamics before pkm_init_pose */
+} pkm_status;
+
+/* Table II/III parameters, leg placement and gravity (MODEL_SPEC). */
+typedef struct {
+  double h, l, h_prime, r_b, r_Q; /* m */
+  double beta[4], gamma[4];       /* rad */
+  double m_slider, m_rod;         /* kg */
+  double I_rod[3];                /* kg*m^2, DH frame 3 axes */
+  double m_platform;              /* kg */
+  double Izz_platform;            /* kg*m^2 */
+  double g;                       /* m/s^2, along -z */
+} pkm_params;
+
+typedef enum { PKM_SOLVER_CVODE = 0, PKM_SOLVER_RK4 = 1 } pkm_solver_kind;
+typedef enum { PKM_CVODE_ADAMS = 0, PKM_CVODE_BDF = 1 } pkm_cvode_method;
+typedef enum {
+  PKM_FORM_AUGMENTED = 0,      /* Eq. 12 */
+  PKM_FORM_NULLSPACE_QR = 1,   /* Eq. 13, B from a QR of C_q */
+  PKM_FORM_LEG_PARTITIONED = 2 /* Eq. 13, B from the leg blocks (default) */
+} pkm_formulation;
+
+typedef struct {
+  int solver;      /* pkm_solver_kind, default CVODE */
+  double rk4_step; /* s, default 1e-3 */
+  double rtol;     /* default 1e-8 */
+  double atol;     /* default 1e-10 */
+  int cvode_method; /* pkm_cvode_method, default Adams */
+  int formulation;  /* pkm_formulation, default leg-partitioned */
+} pkm_solver_settings;
+
+/* Everything the FMU contract lists, at the current time. */
+typedef struct {
+  double t;                       /* s */
+  double pose[4];                 /* x, y, z (m), phi (rad) */
+  double velocity[4];             /* dx, dy, dz (m/s), dphi (rad/s) */
+  double acceleration[4];         /* for the inputs at t */
+  double rho[4], drho[4];         /* m, m/s */
+  double theta1[4], theta2[4];    /* rad; theta1 continuous (unwrapped) */
+  double q[16], qd[16], qdd[16];  /* MODEL_SPEC coordinate order */
+  double lambda[12];              /* Lagrange multipliers of Eq. 1 */
+  double constraint_residual;     /* ||C(q)||, m */
+  double jacobian_condition;      /* actuator Jacobian, phi column / 0.1 m */
+} pkm_outputs;
+
+typedef struct {
+  double F[4];                    /* actuator forces, N */
+  double lambda[12];
+  double q[16], qd[16], qdd[16];
+} pkm_inverse_result;
+
+/* Input callback for pkm_advance_fn: forces F[4] (N) and external wrench
+ * wrench[4] = (Fx, Fy, Fz in N, Mz in N*m) at time t. */
+typedef void (*pkm_input_fn)(void* user, double t, double F[4], double wrench[4]);
+
+typedef struct pkm_model pkm_model;
+
+PKM_API void pkm_default_params(pkm_params* p);
+PKM_API void pkm_default_solver_settings(pkm_solver_settings* s);
+
+/* Creates a model. On failure *out is NULL and, if err is not NULL, a
+ * message naming the offending parameter is written into err[err_len]. */
+PKM_API pkm_status pkm_create(const pkm_params* p, pkm_model** out, char* err, size_t err_len);
+PKM_API void pkm_destroy(pkm_model* m);
+
+PKM_API const char* pkm_last_error(const pkm_model* m);
+PKM_API const char* pkm_status_string(pkm_status s);
+
+PKM_API pkm_status pkm_set_solver(pkm_model* m, const pkm_solver_settings* s);
+
+/* Consistent initial state at time t0 from pose[4] and velocity[4]
+ * (velocity may be NULL: at rest). */
+PKM_API pkm_status pkm_init_pose(pkm_model* m, double t0, const double pose[4],
+                                 const double velocity[4]);
+
+/* Inverse dynamics at a platform pose, velocity, acceleration and
+ * external wrench (wrench may be NULL: none). Independent of the forward
+ * state. */
+PKM_API pkm_status pkm_inverse_dynamics(pkm_model* m, const double pose[4], const double velocity[4],
+                                        const double acceleration[4], const double wrench[4],
+                                        pkm_inverse_result* out);
+
+/* Forward dynamics from the current time to t_end with constant forces F[4]
+ * and wrench[4] (either may be NULL: zero). */
+PKM_API pkm_status pkm_advance(pkm_model* m, double t_end, const double F[4], const double wrench[4]);
+
+/* The same with inputs evaluated by a callback at the integrator's own
+ * times. continuous != 0 says the inputs continue smoothly from the
+ * previous call, so CVODE need not restart. */
+PKM_API pkm_status pkm_advance_fn(pkm_model* m, double t_end, pkm_input_fn inputs, void* user,
+                                  int continuous);
+
+/* Outputs at the current time; F and wrench (may be NULL) are the inputs
+ * at that time, needed for the accelerations and multipliers. */
+PKM_API pkm_status pkm_get_outputs(pkm_model* m, const double F[4], const double wrench[4],
+                                   pkm_outputs* out);
+
+/* Integrated state [x, y, z, phi, dx, dy, dz, dphi] and its time; with the
+ * theta1 unwrapping reference. pkm_set_state restores it exactly. */
+PKM_API pkm_status pkm_get_state(const pkm_model* m, double* t, double y[8], double theta1_ref[4]);
+PKM_API pkm_status pkm_set_state(pkm_model* m, double t, const double y[8], const double theta1_ref[4]);
+
+/* Total mechanical energy T + U (J) at the current state (U with the
+ * spec's gravity, up to a constant). */
+PKM_API pkm_status pkm_energy(pkm_model* m, double* kinetic, double* potential);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PKM_H */

@@ -1,0 +1,267 @@
+// The C API over the core (pkm.h). Converts arrays and status codes; holds
+// no mathematics of its own.
+#include "pkm.h"
+
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <new>
+#include <string>
+
+#include "inverse_dynamics.hpp"
+#include "lagrangian.hpp"
+#include "plant.hpp"
+
+struct pkm_model {
+  explicit pkm_model(const pkm::Model& m) : plant(m) {}
+  pkm::Plant plant;
+  std::string error;
+};
+
+namespace {
+
+using pkm::Status;
+
+pkm_status to_c(Status s) { return static_cast<pkm_status>(static_cast<int>(s)); }
+
+pkm::Params from_c(const pkm_params& c) {
+  pkm::Params p;
+  p.h = c.h;
+  p.l = c.l;
+  p.h_prime = c.h_prime;
+  p.r_b = c.r_b;
+  p.r_Q = c.r_Q;
+  for (int i = 0; i < 4; ++i) {
+    p.beta[i] = c.beta[i];
+    p.gamma[i] = c.gamma[i];
+  }
+  p.m_slider = c.m_slider;
+  p.m_rod = c.m_rod;
+  for (int i = 0; i < 3; ++i) p.I_rod[i] = c.I_rod[i];
+  p.m_platform = c.m_platform;
+  p.Izz_platform = c.Izz_platform;
+  p.g = c.g;
+  return p;
+}
+
+pkm::Vec4 vec4(const double* a) { return a ? pkm::Vec4(a[0], a[1], a[2], a[3]) : pkm::Vec4::Zero(); }
+
+void copy(const pkm::Vec4& v, double* out) { for (int i = 0; i < 4; ++i) out[i] = v[i]; }
+template <int N>
+void copy(const Eigen::Matrix<double, N, 1>& v, double* out) { for (int i = 0; i < N; ++i) out[i] = v[i]; }
+
+pkm_status fail(pkm_model* m, Status s, const std::string& what) {
+  m->error = what + ": " + pkm::status_name(s);
+  if (!m->plant.last_error().empty()) m->error += " (" + m->plant.last_error() + ")";
+  return to_c(s);
+}
+
+struct CallbackInputs {
+  pkm_input_fn fn;
+  void* user;
+  static void eval(void* self, double t, pkm::Vec4& F, pkm::Wrench& we) {
+    auto* c = static_cast<CallbackInputs*>(self);
+    double f[4] = {0, 0, 0, 0}, w[4] = {0, 0, 0, 0};
+    c->fn(c->user, t, f, w);
+    F = vec4(f);
+    we = vec4(w);
+  }
+};
+
+}  // namespace
+
+extern "C" {
+
+void pkm_default_params(pkm_params* c) {
+  if (!c) return;
+  const pkm::Params p;
+  c->h = p.h;
+  c->l = p.l;
+  c->h_prime = p.h_prime;
+  c->r_b = p.r_b;
+  c->r_Q = p.r_Q;
+  for (int i = 0; i < 4; ++i) {
+    c->beta[i] = p.beta[i];
+    c->gamma[i] = p.gamma[i];
+  }
+  c->m_slider = p.m_slider;
+  c->m_rod = p.m_rod;
+  for (int i = 0; i < 3; ++i) c->I_rod[i] = p.I_rod[i];
+  c->m_platform = p.m_platform;
+  c->Izz_platform = p.Izz_platform;
+  c->g = p.g;
+}
+
+void pkm_default_solver_settings(pkm_solver_settings* c) {
+  if (!c) return;
+  const pkm::SolverSettings s;
+  c->solver = static_cast<int>(s.solver);
+  c->rk4_step = s.rk4_step;
+  c->rtol = s.rtol;
+  c->atol = s.atol;
+  c->cvode_method = static_cast<int>(s.cvode_method);
+  c->formulation = static_cast<int>(s.formulation);
+}
+
+pkm_status pkm_create(const pkm_params* p, pkm_model** out, char* err, size_t err_len) {
+  auto message = [&](const std::string& s) {
+    if (err && err_len > 0) std::snprintf(err, err_len, "%s", s.c_str());
+  };
+  if (!out) {
+    message("pkm_create: out is NULL");
+    return PKM_ERR_INVALID_ARGUMENT;
+  }
+  *out = nullptr;
+  if (!p) {
+    message("pkm_create: params is NULL");
+    return PKM_ERR_INVALID_ARGUMENT;
+  }
+  pkm::Model model;
+  std::string why;
+  const Status s = pkm::make_model(from_c(*p), model, &why);
+  if (s != Status::Ok) {
+    message(why);
+    return to_c(s);
+  }
+  *out = new (std::nothrow) pkm_model(model);
+  if (!*out) {
+    message("pkm_create: out of memory");
+    return PKM_ERR_INVALID_ARGUMENT;
+  }
+  message("");
+  return PKM_OK;
+}
+
+void pkm_destroy(pkm_model* m) { delete m; }
+
+const char* pkm_last_error(const pkm_model* m) { return m ? m->error.c_str() : "NULL handle"; }
+
+const char* pkm_status_string(pkm_status s) { return pkm::status_name(static_cast<Status>(s)); }
+
+pkm_status pkm_set_solver(pkm_model* m, const pkm_solver_settings* c) {
+  if (!m || !c) return PKM_ERR_INVALID_ARGUMENT;
+  if (c->cvode_method != 0 && c->cvode_method != 1) {
+    m->error = "cvode_method must be 0 (Adams) or 1 (BDF)";
+    return PKM_ERR_INVALID_ARGUMENT;
+  }
+  if (c->formulation < 0 || c->formulation > 2) {
+    m->error = "formulation must be 0 (Eq. 12), 1 (Eq. 13 QR) or 2 (Eq. 13 leg-partitioned)";
+    return PKM_ERR_INVALID_ARGUMENT;
+  }
+  pkm::SolverSettings s;
+  s.solver = static_cast<pkm::Solver>(c->solver);
+  s.rk4_step = c->rk4_step;
+  s.rtol = c->rtol;
+  s.atol = c->atol;
+  s.cvode_method = static_cast<pkm::CvodeMethod>(c->cvode_method);
+  s.formulation = static_cast<pkm::Formulation>(c->formulation);
+  std::string why;
+  if (m->plant.set_solver(s, &why) != Status::Ok) {
+    m->error = why;
+    return PKM_ERR_INVALID_ARGUMENT;
+  }
+  return PKM_OK;
+}
+
+pkm_status pkm_init_pose(pkm_model* m, double t0, const double pose[4], const double velocity[4]) {
+  if (!m || !pose) return PKM_ERR_INVALID_ARGUMENT;
+  const Status s = m->plant.initialize(t0, vec4(pose), vec4(velocity));
+  if (s != Status::Ok) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "pkm_init_pose(x=%g, y=%g, z=%g, phi=%g)", pose[0], pose[1], pose[2],
+                  pose[3]);
+    return fail(m, s, buf);
+  }
+  return PKM_OK;
+}
+
+pkm_status pkm_inverse_dynamics(pkm_model* m, const double pose[4], const double velocity[4],
+                                const double acceleration[4], const double wrench[4],
+                                pkm_inverse_result* out) {
+  if (!m || !pose || !velocity || !acceleration || !out) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::InverseDynamicsResult r;
+  const Status s = pkm::inverse_dynamics(m->plant.model(), vec4(pose), vec4(velocity), vec4(acceleration),
+                                         vec4(wrench), r);
+  if (s != Status::Ok) return fail(m, s, "pkm_inverse_dynamics");
+  copy(r.F, out->F);
+  copy<12>(r.lambda, out->lambda);
+  copy<16>(r.q, out->q);
+  copy<16>(r.qd, out->qd);
+  copy<16>(r.qdd, out->qdd);
+  return PKM_OK;
+}
+
+pkm_status pkm_advance(pkm_model* m, double t_end, const double F[4], const double wrench[4]) {
+  if (!m) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::LinearInputs in;
+  in.F0 = vec4(F);
+  in.we0 = vec4(wrench);
+  if (!in.F0.allFinite() || !in.we0.allFinite()) return fail(m, Status::NonFinite, "pkm_advance: inputs");
+  const Status s = m->plant.advance(t_end, in.signal(), false);
+  return s == Status::Ok ? PKM_OK : fail(m, s, "pkm_advance");
+}
+
+pkm_status pkm_advance_fn(pkm_model* m, double t_end, pkm_input_fn fn, void* user, int continuous) {
+  if (!m || !fn) return PKM_ERR_INVALID_ARGUMENT;
+  CallbackInputs cb{fn, user};
+  const Status s = m->plant.advance(t_end, {&CallbackInputs::eval, &cb}, continuous != 0);
+  return s == Status::Ok ? PKM_OK : fail(m, s, "pkm_advance_fn");
+}
+
+pkm_status pkm_get_outputs(pkm_model* m, const double F[4], const double wrench[4], pkm_outputs* out) {
+  if (!m || !out) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::LinearInputs in;
+  in.F0 = vec4(F);
+  in.we0 = vec4(wrench);
+  pkm::MechanismState ms;
+  const Status s = m->plant.mechanism(in.signal(), ms);
+  if (s != Status::Ok) return fail(m, s, "pkm_get_outputs");
+  out->t = m->plant.time();
+  copy(m->plant.state().head<4>().eval(), out->pose);
+  copy(m->plant.state().tail<4>().eval(), out->velocity);
+  copy(ms.qdd.segment<4>(pkm::kPlatform).eval(), out->acceleration);
+  for (int i = 0; i < 4; ++i) {
+    const int o = pkm::leg_offset(i);
+    out->rho[i] = ms.q[o];
+    out->drho[i] = ms.qd[o];
+    out->theta1[i] = ms.q[o + 1];
+    out->theta2[i] = ms.q[o + 2];
+  }
+  copy<16>(ms.q, out->q);
+  copy<16>(ms.qd, out->qd);
+  copy<16>(ms.qdd, out->qdd);
+  copy<12>(ms.lambda, out->lambda);
+  out->constraint_residual = m->plant.constraint_residual();
+  out->jacobian_condition = m->plant.jacobian_condition();
+  return PKM_OK;
+}
+
+pkm_status pkm_get_state(const pkm_model* m, double* t, double y[8], double theta1_ref[4]) {
+  if (!m || !t || !y) return PKM_ERR_INVALID_ARGUMENT;
+  if (!m->plant.initialized()) return PKM_ERR_NOT_INITIALIZED;
+  *t = m->plant.time();
+  copy<8>(m->plant.state(), y);
+  if (theta1_ref) copy(m->plant.theta1_ref(), theta1_ref);
+  return PKM_OK;
+}
+
+pkm_status pkm_set_state(pkm_model* m, double t, const double y[8], const double theta1_ref[4]) {
+  if (!m || !y) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::Vec8 v;
+  for (int i = 0; i < 8; ++i) v[i] = y[i];
+  const Status s = m->plant.restore(t, v, theta1_ref ? vec4(theta1_ref) : m->plant.theta1_ref());
+  return s == Status::Ok ? PKM_OK : fail(m, s, "pkm_set_state");
+}
+
+pkm_status pkm_energy(pkm_model* m, double* kinetic, double* potential) {
+  if (!m || !kinetic || !potential) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::MechanismState ms;
+  pkm::LinearInputs none;
+  const Status s = m->plant.mechanism(none.signal(), ms);
+  if (s != Status::Ok) return fail(m, s, "pkm_energy");
+  *kinetic = pkm::kinetic_energy(m->plant.model(), ms.q, ms.qd);
+  *potential = pkm::potential_energy(m->plant.model(), ms.q);
+  return PKM_OK;
+}
+
+}  // extern "C"

@@ -1,0 +1,59 @@
+// The paper's auto-test (section 5.1, MODEL_SPEC "Auto-test"): inverse
+// dynamics along the rest-to-rest path gives F1..F4(t); forward dynamics
+// driven open loop by those forces, evaluated at the integrator's own
+// (stage) times, must reproduce the path.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "inverse_dynamics.hpp"
+#include "plant.hpp"
+#include "trajectory.hpp"
+
+namespace pkm {
+
+struct AutotestOptions {
+  SolverSettings solver;
+  RestToRest path;
+  double sample_dt = 1e-3;  // s, spacing of the recorded samples
+  /// Called now and then with the simulated time (for progress output).
+  void (*progress)(void* user, double t, double t_end) = nullptr;
+  void* progress_user = nullptr;
+};
+
+struct AutotestSample {
+  double t;
+  Pose desired;      // the prescribed path
+  Pose simulated;    // forward dynamics
+  Vec4 F;            // inverse-dynamics actuator forces, N
+  Vec4 rho;          // simulated actuator positions, m
+  double constraint_residual;  // ||C(q)||, m
+  double jacobian_condition;
+};
+
+struct AutotestResult {
+  std::vector<AutotestSample> samples;
+  double max_position_error = 0;  // m, over x, y, z
+  double max_angle_error = 0;     // rad
+  double max_constraint_residual = 0;
+  double max_jacobian_condition = 0;
+  long rhs_evaluations = 0;
+  std::string error;
+};
+
+/// Runs the round trip. Status of the first failure (inverse or forward).
+Status run_autotest(const Model& m, const AutotestOptions& opt, AutotestResult& out);
+
+/// Inverse dynamics along a path as an InputSignal: forces at any time t,
+/// warm-started from the previous call.
+struct PathForces {
+  const Model* model = nullptr;
+  RestToRest path;
+  InverseDynamicsResult id;
+  bool warm = false;
+  Status status = Status::Ok;
+  InputSignal signal();
+};
+
+}  // namespace pkm

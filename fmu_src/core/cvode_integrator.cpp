@@ -1,0 +1,116 @@
+#include "cvode_integrator.hpp"
+
+#include <cvode/cvode.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
+#include <cmath>
+
+namespace pkm {
+namespace {
+
+Eigen::Map<Vec8> as_vec(N_Vector v) { return Eigen::Map<Vec8>(N_VGetArrayPointer(v)); }
+
+}  // namespace
+
+CvodeIntegrator::~CvodeIntegrator() { release(); }
+
+void CvodeIntegrator::release() {
+  if (mem_) CVodeFree(&mem_);
+  if (NLS_) SUNNonlinSolFree(NLS_);
+  if (LS_) SUNLinSolFree(LS_);
+  if (A_) SUNMatDestroy(A_);
+  if (y_) N_VDestroy(y_);
+  if (ctx_) SUNContext_Free(&ctx_);
+  mem_ = nullptr;
+  NLS_ = nullptr;
+  LS_ = nullptr;
+  A_ = nullptr;
+  y_ = nullptr;
+  ctx_ = nullptr;
+}
+
+int CvodeIntegrator::rhs_trampoline(double t, N_Vector y, N_Vector ydot, void* self) {
+  auto* me = static_cast<CvodeIntegrator*>(self);
+  Vec8 out;
+  const int r = me->rhs_(t, as_vec(y), out, me->user_);
+  if (r == 0) as_vec(ydot) = out;
+  return r;
+}
+
+void CvodeIntegrator::error_handler(int code, const char* module, const char* function, char* msg,
+                                    void* self) {
+  // Keep the message for the caller's logger; never print.
+  auto* me = static_cast<CvodeIntegrator*>(self);
+  me->error_ = std::string(module ? module : "CVODE") + "/" + (function ? function : "?") + " (" +
+               std::to_string(code) + "): " + (msg ? msg : "");
+}
+
+Status CvodeIntegrator::init(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user) {
+  release();
+  error_.clear();
+  if (!(rtol > 0.0) || !(atol > 0.0) || !std::isfinite(rtol) || !std::isfinite(atol) || !rhs)
+    return Status::InvalidArgument;
+  rhs_ = rhs;
+  user_ = user;
+  if (SUNContext_Create(nullptr, &ctx_) != 0) return Status::SolverFailure;
+  y_ = N_VNew_Serial(8, ctx_);
+  mem_ = CVodeCreate(method == CvodeMethod::BDF ? CV_BDF : CV_ADAMS, ctx_);
+  if (!y_ || !mem_) return Status::SolverFailure;
+  CVodeSetErrHandlerFn(mem_, &CvodeIntegrator::error_handler, this);
+  N_VConst(0.0, y_);
+  int flag = CVodeInit(mem_, &CvodeIntegrator::rhs_trampoline, 0.0, y_);
+  flag |= CVodeSetUserData(mem_, this);
+  flag |= CVodeSStolerances(mem_, rtol, atol);
+  flag |= CVodeSetMaxNumSteps(mem_, 1000000);
+  if (method == CvodeMethod::BDF) {
+    A_ = SUNDenseMatrix(8, 8, ctx_);
+    LS_ = SUNLinSol_Dense(y_, A_, ctx_);
+    if (!A_ || !LS_) return Status::SolverFailure;
+    flag |= CVodeSetLinearSolver(mem_, LS_, A_);
+  } else {
+    NLS_ = SUNNonlinSol_FixedPoint(y_, 0, ctx_);
+    if (!NLS_) return Status::SolverFailure;
+    flag |= CVodeSetNonlinearSolver(mem_, NLS_);
+  }
+  needs_reset_ = true;
+  return flag == 0 ? Status::Ok : Status::SolverFailure;
+}
+
+Status CvodeIntegrator::reset(double t0, const Vec8& y0) {
+  if (!mem_) return Status::NotInitialized;
+  as_vec(y_) = y0;
+  if (CVodeReInit(mem_, t0, y_) != CV_SUCCESS) return Status::SolverFailure;
+  needs_reset_ = false;
+  return Status::Ok;
+}
+
+Status CvodeIntegrator::advance(double t_out, Vec8& y_out) {
+  if (!mem_ || needs_reset_) return Status::NotInitialized;
+  CVodeSetStopTime(mem_, t_out);
+  double t_reached = 0.0;
+  const int flag = CVode(mem_, t_out, y_, &t_reached, CV_NORMAL);
+  if (flag < 0) {
+    needs_reset_ = true;  // its history is no longer trustworthy
+    return Status::SolverFailure;
+  }
+  y_out = as_vec(y_);
+  return Status::Ok;
+}
+
+long CvodeIntegrator::steps() const {
+  long n = 0;
+  if (mem_) CVodeGetNumSteps(mem_, &n);
+  return n;
+}
+
+long CvodeIntegrator::rhs_evaluations() const {
+  long n = 0;
+  if (mem_) CVodeGetNumRhsEvals(mem_, &n);
+  return n;
+}
+
+}  // namespace pkm

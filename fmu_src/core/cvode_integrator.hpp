@@ -1,0 +1,63 @@
+// SUNDIALS CVODE (variable-order, variable-step Adams or BDF) on the
+// 8-dimensional state of minimal_state.hpp. All SUNDIALS objects are created
+// once in init(); advancing allocates nothing.
+#pragma once
+
+#include <string>
+
+#include "status.hpp"
+#include "types.hpp"
+
+// SUNDIALS handle types, declared here so its headers stay in the .cpp.
+struct _SUNContext;
+struct _generic_N_Vector;
+struct _generic_SUNMatrix;
+struct _generic_SUNLinearSolver;
+struct _generic_SUNNonlinearSolver;
+
+namespace pkm {
+
+enum class CvodeMethod { Adams = 0, BDF = 1 };
+
+class CvodeIntegrator {
+ public:
+  /// ydot = rhs(t, y); returns 0 on success, > 0 for a recoverable failure
+  /// (CVODE retries with a smaller step), < 0 to abort.
+  using Rhs = int (*)(double t, const Vec8& y, Vec8& ydot, void* user);
+
+  CvodeIntegrator() = default;
+  ~CvodeIntegrator();
+  CvodeIntegrator(const CvodeIntegrator&) = delete;
+  CvodeIntegrator& operator=(const CvodeIntegrator&) = delete;
+
+  Status init(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user);
+  /// Restart the history at (t0, y0): needed after any jump in the inputs.
+  Status reset(double t0, const Vec8& y0);
+  /// Integrates to t_out exactly (stop time set, no overshoot).
+  Status advance(double t_out, Vec8& y_out);
+
+  bool ready() const { return mem_ != nullptr; }
+  bool needs_reset() const { return needs_reset_; }
+  const std::string& last_error() const { return error_; }
+  long steps() const;
+  long rhs_evaluations() const;
+
+ private:
+  static int rhs_trampoline(double t, _generic_N_Vector* y, _generic_N_Vector* ydot, void* self);
+  static void error_handler(int code, const char* module, const char* function, char* msg,
+                            void* self);
+  void release();
+
+  _SUNContext* ctx_ = nullptr;
+  void* mem_ = nullptr;  // CVODE memory
+  _generic_N_Vector* y_ = nullptr;
+  _generic_SUNMatrix* A_ = nullptr;                // BDF: dense Jacobian
+  _generic_SUNLinearSolver* LS_ = nullptr;         // BDF: dense LU
+  _generic_SUNNonlinearSolver* NLS_ = nullptr;     // Adams: fixed point
+  Rhs rhs_ = nullptr;
+  void* user_ = nullptr;
+  bool needs_reset_ = true;
+  std::string error_;
+};
+
+}  // namespace pkm

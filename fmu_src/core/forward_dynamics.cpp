@@ -1,0 +1,97 @@
+#include "forward_dynamics.hpp"
+
+#include <cmath>
+
+#include "constraints.hpp"
+#include "lagrangian.hpp"
+#include "reduced_dynamics.hpp"
+
+namespace pkm {
+namespace {
+
+using Mat28 = Eigen::Matrix<double, 28, 28>;
+using Vec28 = Eigen::Matrix<double, 28, 1>;
+
+Status augmented(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f, Vec16& qdd,
+                 Vec12& lambda) {
+  Mat16 M;
+  mass_matrix(m, q, M);
+  Mat12x16 Cq;
+  constraint_jacobian(m, q, Cq);
+  Mat28 A = Mat28::Zero();
+  A.topLeftCorner<16, 16>() = M;
+  A.topRightCorner<16, 12>() = Cq.transpose();
+  A.bottomLeftCorner<12, 16>() = Cq;
+  Vec28 b;
+  b.head<16>() = f - coriolis(m, q, qd) - gravity(m, q);
+  b.tail<12>() = -constraint_gamma(m, q, qd);
+  const Eigen::PartialPivLU<Mat28> lu(A);
+  const Vec28 x = lu.solve(b);
+  qdd = x.head<16>();
+  lambda = x.tail<12>();
+  return x.allFinite() ? Status::Ok : Status::Singular;
+}
+
+Status null_space_qr(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f, Vec16& qdd,
+                     Vec12& lambda) {
+  Mat16 M;
+  mass_matrix(m, q, M);
+  Mat12x16 Cq;
+  constraint_jacobian(m, q, Cq);
+  const Eigen::Matrix<double, 16, 12> CqT = Cq.transpose();
+  const Eigen::HouseholderQR<Eigen::Matrix<double, 16, 12>> qr(CqT);
+  const Mat16 Q = qr.householderQ();
+  const auto R = qr.matrixQR().topLeftCorner<12, 12>().triangularView<Eigen::Upper>();
+  for (int k = 0; k < kM; ++k)  // rank check on R's diagonal
+    if (!(std::fabs(qr.matrixQR()(k, k)) > 1e-12)) return Status::Singular;
+  const Eigen::Matrix<double, 16, 12> Q1 = Q.leftCols<12>();
+  const Eigen::Matrix<double, 16, 4> B = Q.rightCols<4>();
+  // Particular solution of C_q qdd = -gamma: C_q = R^T Q1^T, so qdd_p = Q1 R^{-T} (-gamma).
+  const Vec12 gamma = constraint_gamma(m, q, qd);
+  const Vec16 qdd_p = Q1 * R.transpose().solve(-gamma);
+  const Vec16 rhs = f - coriolis(m, q, qd) - gravity(m, q);
+  // Eq. 13: B^T M B a = B^T (f - V - G - M qdd_p), qdd = qdd_p + B a.
+  const Mat4 Mr = B.transpose() * M * B;
+  const Vec4 a = Mr.llt().solve(B.transpose() * (rhs - M * qdd_p));
+  qdd = qdd_p + B * a;
+  // C_q^T lambda = rhs - M qdd: lambda = R^{-1} Q1^T (rhs - M qdd).
+  lambda = R.solve(Q1.transpose() * (rhs - M * qdd));
+  return (qdd.allFinite() && lambda.allFinite()) ? Status::Ok : Status::Singular;
+}
+
+Status leg_partitioned(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f, Vec16& qdd,
+                       Vec12& lambda) {
+  ReducedDynamics rd;
+  const PlatformConfig pc = platform_config_from_q(q);
+  for (int i = 0; i < kLegs; ++i) {
+    const int o = leg_offset(i);
+    const Status s = rd.prepare_leg(m, i, leg_config_from_q(q, i), pc);
+    if (s != Status::Ok) return s;
+    rd.add_leg(m, i, qd.segment<3>(o), qd[15], f[o]);
+  }
+  return rd.solve(m, f.segment<4>(kPlatform), qdd, lambda);
+}
+
+}  // namespace
+
+const char* formulation_name(Formulation f) {
+  switch (f) {
+    case Formulation::Augmented: return "augmented (Eq. 12)";
+    case Formulation::NullSpaceQR: return "null space, QR (Eq. 13)";
+    case Formulation::LegPartitioned: return "null space, leg-partitioned (Eq. 13)";
+  }
+  return "unknown";
+}
+
+Status forward_dynamics(const Model& m, Formulation form, const Vec16& q, const Vec16& qd,
+                        const Vec16& f, Vec16& qdd, Vec12& lambda) {
+  if (!q.allFinite() || !qd.allFinite() || !f.allFinite()) return Status::NonFinite;
+  switch (form) {
+    case Formulation::Augmented: return augmented(m, q, qd, f, qdd, lambda);
+    case Formulation::NullSpaceQR: return null_space_qr(m, q, qd, f, qdd, lambda);
+    case Formulation::LegPartitioned: return leg_partitioned(m, q, qd, f, qdd, lambda);
+  }
+  return Status::InvalidArgument;
+}
+
+}  // namespace pkm

@@ -1,0 +1,61 @@
+#include "minimal_state.hpp"
+
+#include "constraints.hpp"
+#include "reduced_dynamics.hpp"
+#include "servo_kinematics.hpp"
+
+namespace pkm {
+
+Status expand_state(const Model& m, const Vec8& y, Vec16& q, Vec16& qd) {
+  if (!y.allFinite()) return Status::NonFinite;
+  const Pose pose = y.head<4>();
+  Status s = closed_form_position(m, pose, q);
+  if (s != Status::Ok) return s;
+  ReducedDynamics rd;
+  const PlatformConfig pc = platform_config(pose);
+  for (int i = 0; i < kLegs; ++i) {
+    s = rd.prepare_leg(m, i, leg_config_from_q(q, i), pc);
+    if (s != Status::Ok) return s;
+    qd.segment<3>(leg_offset(i)) = rd.leg_velocity(i, y.tail<4>());
+  }
+  qd.segment<4>(kPlatform) = y.tail<4>();
+  return Status::Ok;
+}
+
+Status state_derivative(const Model& m, Formulation form, const Vec8& y, const Vec16& f, Vec8& ydot,
+                        MechanismState* full) {
+  if (!y.allFinite() || !f.allFinite()) return Status::NonFinite;
+  ydot.head<4>() = y.tail<4>();
+  if (form == Formulation::LegPartitioned && full == nullptr) {
+    // Hot path: no angles, no trigonometry but phi's (the leg's cos/sin
+    // come algebraically from the closed-form inverse kinematics).
+    const Pose pose = y.head<4>();
+    const Pose pd = y.tail<4>();
+    const PlatformConfig pc = platform_config(pose);
+    ReducedDynamics rd;
+    for (int i = 0; i < kLegs; ++i) {
+      LegConfig c;
+      Status s = leg_inverse_kinematics(m, i, pc, c);
+      if (s != Status::Ok) return s;
+      s = rd.prepare_leg(m, i, c, pc);
+      if (s != Status::Ok) return s;
+      rd.add_leg(m, i, rd.leg_velocity(i, pd), pd[3], f[leg_offset(i)]);
+    }
+    Vec16 qdd;
+    Vec12 lambda;
+    const Status s = rd.solve(m, f.segment<4>(kPlatform), qdd, lambda);
+    if (s != Status::Ok) return s;
+    ydot.tail<4>() = qdd.segment<4>(kPlatform);
+    return Status::Ok;
+  }
+  MechanismState local;
+  MechanismState& st = full ? *full : local;
+  Status s = expand_state(m, y, st.q, st.qd);
+  if (s != Status::Ok) return s;
+  s = forward_dynamics(m, form, st.q, st.qd, f, st.qdd, st.lambda);
+  if (s != Status::Ok) return s;
+  ydot.tail<4>() = st.qdd.segment<4>(kPlatform);
+  return Status::Ok;
+}
+
+}  // namespace pkm

@@ -1,0 +1,32 @@
+// The integrators' state and its derivative.
+//
+// The integrated state is the platform's pose and velocity,
+//   y = [x, y, z, phi, xd, yd, zd, phid],
+// the independent coordinates of Eq. 13's leg partitioning. At every
+// evaluation the 12 leg coordinates are recovered from y in closed form
+// (elbow-down leg inverse kinematics) and the leg rates from
+// qd_i = L_i^{-1} P_i pd. This is the projection of q onto C(q) = 0 and of
+// qd onto C_q qd = 0 (along the leg coordinates) done at every stage rather
+// than after every step: the redundant q never drifts, and ||C(q)|| stays
+// at rounding level (~1e-17 m) over any run length.
+#pragma once
+
+#include "forward_dynamics.hpp"
+
+namespace pkm {
+
+struct MechanismState {
+  Vec16 q = Vec16::Zero(), qd = Vec16::Zero(), qdd = Vec16::Zero();
+  Vec12 lambda = Vec12::Zero();
+};
+
+/// q and qd from y (theta1 in atan2's range plus atan2(h', A); unwrap
+/// outside if continuity matters).
+Status expand_state(const Model& m, const Vec8& y, Vec16& q, Vec16& qd);
+
+/// dy/dt for generalised forces f (Eq. 1's right-hand side), with the
+/// chosen formulation. If `full` is given it receives q, qd, qdd, lambda.
+Status state_derivative(const Model& m, Formulation form, const Vec8& y, const Vec16& f, Vec8& ydot,
+                        MechanismState* full = nullptr);
+
+}  // namespace pkm

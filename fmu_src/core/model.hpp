@@ -1,0 +1,41 @@
+// The immutable model: validated parameters plus the leg placement derived
+// from them once (Pinocchio's "model" half; per-call workspaces live with
+// the functions that need them).
+#pragma once
+
+#include <array>
+#include <string>
+
+#include "params.hpp"
+#include "status.hpp"
+#include "types.hpp"
+
+namespace pkm {
+
+struct Model {
+  Params p;
+  // Leg i's base frame 0_i: origin B_i, orientation Rz(beta_i) (spec "Leg placement").
+  std::array<Vec3, kLegs> B;
+  std::array<double, kLegs> cos_beta, sin_beta;
+  // Platform attachment point of leg i in the platform frame, r_Qi.
+  std::array<Vec3, kLegs> r_Q;
+  // Total mass carried by gravity (platform, sliders, rods), kg.
+  double total_mass = 0;
+};
+
+/// Validates `p` and derives the placement. On failure returns
+/// Status::InvalidParameter and, if `error` is given, a message naming the
+/// offending parameter.
+Status make_model(const Params& p, Model& out, std::string* error = nullptr);
+
+/// Rz(beta_i) * v, and its transpose applied to v.
+inline Vec3 rotate_to_base(const Model& m, int leg, const Vec3& v) {
+  const double c = m.cos_beta[leg], s = m.sin_beta[leg];
+  return {c * v.x() - s * v.y(), s * v.x() + c * v.y(), v.z()};
+}
+inline Vec3 rotate_to_leg(const Model& m, int leg, const Vec3& v) {
+  const double c = m.cos_beta[leg], s = m.sin_beta[leg];
+  return {c * v.x() + s * v.y(), -s * v.x() + c * v.y(), v.z()};
+}
+
+}  // namespace pkm

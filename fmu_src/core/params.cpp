@@ -1,0 +1,52 @@
+#include "params.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace pkm {
+namespace {
+
+std::string describe(const char* name, double value, const char* why) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "parameter %s = %.17g %s", name, value, why);
+  return buf;
+}
+
+}  // namespace
+
+std::string validate(const Params& p) {
+  struct Positive { const char* name; double value; };
+  const Positive positive[] = {
+      {"h", p.h},
+      {"l", p.l},
+      {"h_prime", p.h_prime},
+      {"r_b", p.r_b},
+      {"r_Q", p.r_Q},
+      {"m_slider", p.m_slider},
+      {"m_rod", p.m_rod},
+      {"I_rod[1]", p.I_rod[0]},
+      {"I_rod[2]", p.I_rod[1]},
+      {"I_rod[3]", p.I_rod[2]},
+      {"m_platform", p.m_platform},
+      {"Izz_platform", p.Izz_platform},
+  };
+  for (const auto& e : positive) {
+    if (!std::isfinite(e.value)) return describe(e.name, e.value, "is not finite");
+    if (!(e.value > 0.0)) return describe(e.name, e.value, "must be positive");
+  }
+  static const char* beta_names[] = {"beta[1]", "beta[2]", "beta[3]", "beta[4]"};
+  static const char* gamma_names[] = {"gamma[1]", "gamma[2]", "gamma[3]", "gamma[4]"};
+  for (int i = 0; i < 4; ++i) {
+    if (!std::isfinite(p.beta[i])) return describe(beta_names[i], p.beta[i], "is not finite");
+    if (!std::isfinite(p.gamma[i])) return describe(gamma_names[i], p.gamma[i], "is not finite");
+  }
+  if (!std::isfinite(p.g)) return describe("g", p.g, "is not finite");
+  // The rod's inertia about its own axis x3 is the smallest; a rigid body's
+  // principal moments must satisfy the triangle inequalities.
+  const double a = p.I_rod[0], b = p.I_rod[1], c = p.I_rod[2];
+  if (a > b + c || b > a + c || c > a + b)
+    return describe("I_rod[1]", a, "violates the triangle inequality of principal moments with I_rod[2], I_rod[3]");
+  return {};
+}
+
+}  // namespace pkm

@@ -1,0 +1,37 @@
+// Model parameters (MODEL_SPEC: Tables II and III, leg placement, gravity),
+// in SI units. Defaults are the spec's values, converted once here.
+#pragma once
+
+#include <array>
+#include <string>
+
+namespace pkm {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double deg(double d) { return d * kPi / 180.0; }
+
+struct Params {
+  // Geometry (Table II), m.
+  double h = 0.06634;
+  double l = 0.080;
+  double h_prime = 0.075;
+  double r_b = 0.09273;
+  double r_Q = 0.075;
+  // Leg placement (spec "Leg placement"), rad.
+  std::array<double, 4> beta{0.0, kPi / 2, kPi, 3 * kPi / 2};
+  std::array<double, 4> gamma{deg(65), deg(-65), deg(65), deg(-65)};
+  // Bodies (Table III): kg and kg*m^2.
+  double m_slider = 0.09331;
+  double m_rod = 0.06371;
+  std::array<double, 3> I_rod{3.83e-6, 49.86e-6, 52.64e-6};  // DH frame 3 axes
+  double m_platform = 0.45474;
+  double Izz_platform = 2874.21e-6;
+  // Gravity along -z_G, m/s^2. Zero is allowed (the comparison test).
+  double g = 9.81;
+};
+
+/// Checks every parameter. Returns an empty string when they are valid,
+/// otherwise a message that names the offending parameter and its value.
+std::string validate(const Params& p);
+
+}  // namespace pkm

@@ -1,0 +1,51 @@
+// Eq. 13 with the null-space basis taken from the leg blocks (coordinate
+// partitioning, platform pose independent), built leg by leg.
+//
+// Leg i's closure C_i = 0 differentiated once and twice:
+//   L_i qd_i = P_i pd,                  L_i = Rz(beta_i) J_i, P_i = [I3, e_z x Rz(phi) r_Qi]
+//   L_i qdd_i = P_i pdd - gamma_i,      gamma_i = Rz(beta_i) (J_i qd_i)_q qd_i + Rz(phi) r_Qi phid^2
+// so qd_i = A_i pd and qdd_i = A_i pdd + b_i with A_i = L_i^{-1} P_i and
+// b_i = -L_i^{-1} gamma_i. Projecting Eq. 1 on B = [A_1; ...; A_4; I4]:
+//   (M_p + sum A_i^T M_i A_i) pdd = f_p - G_p + sum A_i^T (f_i - V_i - G_i - M_i b_i)
+// and each leg's rows give its multipliers: lambda_i = L_i^{-T} (f_i - M_i qdd_i - V_i - G_i).
+#pragma once
+
+#include <array>
+
+#include "leg_kinematics.hpp"
+
+namespace pkm {
+
+class ReducedDynamics {
+ public:
+  /// Leg i's configuration-dependent terms. Status::Singular at a leg
+  /// singularity.
+  Status prepare_leg(const Model& m, int leg, const LegConfig& c, const PlatformConfig& pc);
+
+  /// qd_i = A_i pd (valid after prepare_leg).
+  Vec3 leg_velocity(int leg, const Pose& pd) const { return legs_[leg].A * pd; }
+
+  /// Adds leg i's contribution, with its rates qd_leg, the platform's
+  /// angular rate phid and the actuator force F on rho_i.
+  void add_leg(const Model& m, int leg, const Vec3& qd_leg, double phid, double F);
+
+  /// Solves the reduced 4x4 system (with the external wrench on the
+  /// platform) and recovers the full qdd and lambda.
+  Status solve(const Model& m, const Wrench& we, Vec16& qdd, Vec12& lambda);
+
+ private:
+  struct Leg {
+    LegConfig c;
+    Vec3 attach;  // Rz(phi) r_Qi
+    Mat3 Linv;    // L_i^{-1}
+    Mat34 A;      // L_i^{-1} P_i
+    Mat3 M;       // leg mass matrix
+    Vec3 b;       // -L_i^{-1} gamma_i
+    Vec3 r;       // f_i - V_i - G_i - M_i b_i
+  };
+  std::array<Leg, kLegs> legs_;
+  Mat4 Mr_ = Mat4::Zero();
+  Vec4 rhs_ = Vec4::Zero();
+};
+
+}  // namespace pkm
