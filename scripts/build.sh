@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Installs what is missing (scripts/setup.sh), then configures and builds
+# everything in build/ (Ninja, Release).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+./scripts/setup.sh
+# A build/ configured earlier with another generator would make cmake fail: reset it.
+if [ -f build/CMakeCache.txt ] && ! grep -q '^CMAKE_GENERATOR:INTERNAL=Ninja$' build/CMakeCache.txt; then
+  echo "build: build/ was not configured with Ninja, reconfiguring" >&2
+  rm -rf build/CMakeCache.txt build/CMakeFiles
+fi
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake --build build -j2

@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Installs what building and testing need, and only what is missing:
+# Debian packages (apt-get) and the Python virtualenv .venv with
+# python_checks/requirements.txt. Idempotent and non-interactive (CI-safe).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+log() { echo "setup: $*" >&2; }
+
+# 1. Debian packages.
+packages=(build-essential cmake ninja-build libeigen3-dev libsundials-dev libgtest-dev
+          python3 python3-venv python3-pip)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
+done
+if [ "${#missing[@]}" -eq 0 ]; then
+  log "all Debian packages present, nothing missing"
+else
+  log "installing missing Debian packages: ${missing[*]}"
+  if [ "$(id -u)" -eq 0 ]; then
+    sudo=()
+  elif command -v sudo >/dev/null 2>&1; then
+    sudo=(sudo -n)
+  else
+    log "ERROR: not root and no sudo; install these packages by hand: ${missing[*]}"
+    exit 1
+  fi
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo[@]}" apt-get update -q
+  "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+# 2. Python virtualenv, on Debian's python3 (the one installed above) when present.
+py=/usr/bin/python3
+[ -x "$py" ] || py=python3
+if [ ! -x .venv/bin/python ]; then
+  log "creating .venv with $py"
+  "$py" -m venv .venv
+fi
+req=python_checks/requirements.txt
+stamp=.venv/.requirements.stamp
+if [ ! -f "$stamp" ] || [ "$req" -nt "$stamp" ]; then
+  log "installing Python requirements from $req"
+  .venv/bin/pip install --disable-pip-version-check -q -r "$req"
+  touch "$stamp"
+else
+  log "Python requirements up to date"
+fi
+log "done"

@@ -1,0 +1,148 @@
+// The plain C API (pkm.h): creation and parameter errors, pose errors,
+// forward and inverse dynamics through it, state save/restore, and that a
+// failed call loses nothing.
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "pkm.h"
+
+namespace {
+
+struct Handle {
+  pkm_model* m = nullptr;
+  explicit Handle(const pkm_params* p = nullptr) {
+    pkm_params d;
+    pkm_default_params(&d);
+    char err[256];
+    EXPECT_EQ(pkm_create(p ? p : &d, &m, err, sizeof err), PKM_OK) << err;
+  }
+  ~Handle() { pkm_destroy(m); }
+};
+
+const double kHome[4] = {0.0, 0.0, 0.05, 0.0};
+
+}  // namespace
+
+TEST(CApi, CreateRejectsBadParametersWithAMessage) {
+  pkm_params p;
+  pkm_default_params(&p);
+  p.r_b = -1.0;
+  pkm_model* m = reinterpret_cast<pkm_model*>(0x1);
+  char err[256] = "";
+  EXPECT_EQ(pkm_create(&p, &m, err, sizeof err), PKM_ERR_INVALID_PARAMETER);
+  EXPECT_EQ(m, nullptr);
+  EXPECT_NE(std::string(err).find("r_b"), std::string::npos) << err;
+  EXPECT_EQ(pkm_create(nullptr, &m, err, sizeof err), PKM_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(pkm_create(&p, nullptr, nullptr, 0), PKM_ERR_INVALID_ARGUMENT);
+}
+
+TEST(CApi, UnreachablePoseIsAnErrorWithAMessage) {
+  Handle h;
+  const double far[4] = {0.2, 0.0, 0.05, 0.0};
+  EXPECT_EQ(pkm_init_pose(h.m, 0.0, far, nullptr), PKM_ERR_UNREACHABLE);
+  EXPECT_NE(std::string(pkm_last_error(h.m)).find("unreachable"), std::string::npos) << pkm_last_error(h.m);
+  double F[4] = {0, 0, 0, 0};
+  EXPECT_EQ(pkm_advance(h.m, 0.01, F, nullptr), PKM_ERR_NOT_INITIALIZED);
+}
+
+TEST(CApi, NonFiniteForceIsRejectedAndTheStateKept) {
+  Handle h;
+  ASSERT_EQ(pkm_init_pose(h.m, 0.0, kHome, nullptr), PKM_OK);
+  double t0, y0[8];
+  ASSERT_EQ(pkm_get_state(h.m, &t0, y0, nullptr), PKM_OK);
+  const double bad[4] = {1.0, NAN, 1.0, 1.0};
+  EXPECT_EQ(pkm_advance(h.m, 0.01, bad, nullptr), PKM_ERR_NONFINITE);
+  double t1, y1[8];
+  ASSERT_EQ(pkm_get_state(h.m, &t1, y1, nullptr), PKM_OK);
+  EXPECT_EQ(t0, t1);
+  EXPECT_EQ(std::memcmp(y0, y1, sizeof y0), 0);
+}
+
+TEST(CApi, StaticForcesHoldTheHomePose) {
+  // Inverse dynamics at rest, fed forward for 0.5 s, keeps the platform put.
+  Handle h;
+  const double zero[4] = {0, 0, 0, 0};
+  pkm_inverse_result inv;
+  ASSERT_EQ(pkm_inverse_dynamics(h.m, kHome, zero, zero, nullptr, &inv), PKM_OK);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(inv.F[i], 2.655616050, 1e-9);
+  for (int solver : {PKM_SOLVER_CVODE, PKM_SOLVER_RK4}) {
+    pkm_solver_settings s;
+    pkm_default_solver_settings(&s);
+    s.solver = solver;
+    ASSERT_EQ(pkm_set_solver(h.m, &s), PKM_OK);
+    ASSERT_EQ(pkm_init_pose(h.m, 0.0, kHome, nullptr), PKM_OK);
+    ASSERT_EQ(pkm_advance(h.m, 0.5, inv.F, nullptr), PKM_OK) << pkm_last_error(h.m);
+    pkm_outputs out;
+    ASSERT_EQ(pkm_get_outputs(h.m, inv.F, nullptr, &out), PKM_OK);
+    EXPECT_DOUBLE_EQ(out.t, 0.5);
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(out.pose[k], kHome[k], 1e-12) << "solver " << solver;
+    for (int k = 0; k < 12; ++k) EXPECT_NEAR(out.lambda[k], inv.lambda[k], 1e-9);
+    EXPECT_LT(out.constraint_residual, 1e-15);
+    EXPECT_GT(out.jacobian_condition, 1.0);
+    EXPECT_LT(out.jacobian_condition, 26.0);
+  }
+}
+
+TEST(CApi, SavedStateRestoresABitIdenticalContinuation) {
+  Handle h;
+  pkm_solver_settings s;
+  pkm_default_solver_settings(&s);
+  s.solver = PKM_SOLVER_RK4;
+  ASSERT_EQ(pkm_set_solver(h.m, &s), PKM_OK);
+  const double v0[4] = {0.01, 0.0, 0.0, 0.05};
+  ASSERT_EQ(pkm_init_pose(h.m, 0.0, kHome, v0), PKM_OK);
+  const double F[4] = {2.7, 2.6, 2.65, 2.66};
+  ASSERT_EQ(pkm_advance(h.m, 0.2, F, nullptr), PKM_OK);
+  double t, y[8], th[4];
+  ASSERT_EQ(pkm_get_state(h.m, &t, y, th), PKM_OK);
+  ASSERT_EQ(pkm_advance(h.m, 0.4, F, nullptr), PKM_OK);
+  pkm_outputs a, b;
+  ASSERT_EQ(pkm_get_outputs(h.m, F, nullptr, &a), PKM_OK);
+  ASSERT_EQ(pkm_set_state(h.m, t, y, th), PKM_OK);
+  ASSERT_EQ(pkm_advance(h.m, 0.4, F, nullptr), PKM_OK);
+  ASSERT_EQ(pkm_get_outputs(h.m, F, nullptr, &b), PKM_OK);
+  EXPECT_EQ(std::memcmp(&a, &b, sizeof a), 0);
+  EXPECT_NE(a.pose[0], kHome[0]);  // it did move
+}
+
+TEST(CApi, CallbackInputsMatchConstantInputs) {
+  Handle h1, h2;
+  const double F[4] = {2.7, 2.6, 2.65, 2.66};
+  ASSERT_EQ(pkm_init_pose(h1.m, 0.0, kHome, nullptr), PKM_OK);
+  ASSERT_EQ(pkm_init_pose(h2.m, 0.0, kHome, nullptr), PKM_OK);
+  ASSERT_EQ(pkm_advance(h1.m, 0.3, F, nullptr), PKM_OK);
+  auto cb = [](void* user, double, double f[4], double w[4]) {
+    std::memcpy(f, user, 4 * sizeof(double));
+    for (int i = 0; i < 4; ++i) w[i] = 0.0;
+  };
+  ASSERT_EQ(pkm_advance_fn(h2.m, 0.3, cb, const_cast<double*>(F), 0), PKM_OK);
+  double t1, y1[8], t2, y2[8];
+  pkm_get_state(h1.m, &t1, y1, nullptr);
+  pkm_get_state(h2.m, &t2, y2, nullptr);
+  EXPECT_EQ(std::memcmp(y1, y2, sizeof y1), 0);
+}
+
+TEST(CApi, BadSolverSettingsAreRejected) {
+  Handle h;
+  pkm_solver_settings s;
+  pkm_default_solver_settings(&s);
+  s.rk4_step = -1e-3;
+  EXPECT_EQ(pkm_set_solver(h.m, &s), PKM_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(pkm_last_error(h.m)).find("rk4_step"), std::string::npos);
+  pkm_default_solver_settings(&s);
+  s.solver = 7;
+  EXPECT_EQ(pkm_set_solver(h.m, &s), PKM_ERR_INVALID_ARGUMENT);
+}
+
+TEST(CApi, EnergyIsAvailable) {
+  Handle h;
+  const double v0[4] = {0.0, 0.0, 0.1, 0.0};
+  ASSERT_EQ(pkm_init_pose(h.m, 0.0, kHome, v0), PKM_OK);
+  double T, U;
+  ASSERT_EQ(pkm_energy(h.m, &T, &U), PKM_OK);
+  // Pure vertical motion: every body moves at 0.1 m/s, nothing rotates.
+  EXPECT_NEAR(T, 0.5 * (0.45474 + 4 * (0.09331 + 0.06371)) * 0.01, 1e-15);
+}

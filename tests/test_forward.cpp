@@ -1,0 +1,166 @@
+// Forward dynamics: the three formulations agree (Eq. 12, Eq. 13 with a QR
+// basis, Eq. 13 with the leg-partitioned basis), they invert the inverse
+// dynamics, and energy is conserved when nothing does work.
+#include <cmath>
+
+#include "inverse_dynamics.hpp"
+#include "lagrangian.hpp"
+#include "plant.hpp"
+#include "test_support.hpp"
+
+using namespace pkm_test;
+
+TEST(ForwardDynamics, AllFormulationsGiveTheSameAccelerationsAndMultipliers) {
+  const Model m = default_model();
+  for (unsigned seed = 1; seed <= 12; ++seed) {
+    const RandomState s = random_state(m, seed);
+    const Vec16 f = generalized_forces(Vec4::Constant(2.65) + random_vec<4>(200 + seed, 1.0),
+                                       random_vec<4>(300 + seed, 0.5));
+    Vec16 qdd[3];
+    Vec12 lam[3];
+    for (int k = 0; k < 3; ++k)
+      ASSERT_EQ(forward_dynamics(m, static_cast<Formulation>(k), s.q, s.qd, f, qdd[k], lam[k]), Status::Ok);
+    for (int k = 1; k < 3; ++k) {
+      EXPECT_LT(rel_diff(qdd[k], qdd[0]), 1e-10) << formulation_name(static_cast<Formulation>(k)) << " seed " << seed;
+      EXPECT_LT(rel_diff(lam[k], lam[0]), 1e-10) << formulation_name(static_cast<Formulation>(k)) << " seed " << seed;
+    }
+    // The accelerations keep the state on the manifold: C_q qdd + gamma = 0.
+    Mat12x16 Cq;
+    constraint_jacobian(m, s.q, Cq);
+    EXPECT_LT((Cq * qdd[0] + constraint_gamma(m, s.q, s.qd)).lpNorm<Eigen::Infinity>(), 1e-12);
+  }
+}
+
+TEST(ForwardDynamics, InvertsInverseDynamics) {
+  // Forces from Eqs. 10-11 for a chosen platform acceleration, fed forward,
+  // give that acceleration and the same multipliers back.
+  const Model m = default_model();
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    const RandomState s = random_state(m, seed);
+    const Pose acc = random_vec<4>(400 + seed, 3.0);
+    const Wrench we = random_vec<4>(500 + seed, 0.3);
+    InverseDynamicsResult r;
+    ASSERT_EQ(inverse_dynamics(m, s.pose, s.vel, acc, we, r), Status::Ok);
+    for (int k = 0; k < 3; ++k) {
+      Vec16 qdd;
+      Vec12 lam;
+      ASSERT_EQ(forward_dynamics(m, static_cast<Formulation>(k), r.q, r.qd, generalized_forces(r.F, we), qdd, lam),
+                Status::Ok);
+      EXPECT_LT((qdd.segment<4>(kPlatform) - acc).lpNorm<Eigen::Infinity>(), 1e-10 * acc.lpNorm<Eigen::Infinity>());
+      EXPECT_LT(rel_diff(lam, r.lambda), 1e-10);
+    }
+  }
+}
+
+TEST(ForwardDynamics, StateDerivativeHotPathEqualsFullEvaluation) {
+  const Model m = default_model();
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const RandomState s = random_state(m, seed);
+    Vec8 y;
+    y << s.pose, s.vel;
+    const Vec16 f = generalized_forces(random_vec<4>(600 + seed, 3.0), Wrench::Zero());
+    Vec8 fast, full;
+    MechanismState ms;
+    ASSERT_EQ(state_derivative(m, Formulation::LegPartitioned, y, f, fast), Status::Ok);
+    ASSERT_EQ(state_derivative(m, Formulation::Augmented, y, f, full, &ms), Status::Ok);
+    EXPECT_LT(rel_diff(fast, full), 1e-12);
+    EXPECT_LT((ms.q - s.q).lpNorm<Eigen::Infinity>(), 1e-15);
+    EXPECT_LT((ms.qd - s.qd).lpNorm<Eigen::Infinity>(), 1e-13);
+  }
+}
+
+namespace {
+
+struct EnergyRun {
+  double max_rel_drift = 0;
+  double scale = 0;
+};
+
+// Integrates with CVODE (tight) from a random state near home with no
+// actuator force and records the drift of T + U against the energy scale
+// max(T) that the motion reaches.
+EnergyRun run_energy(double g, pkm::CvodeMethod method, double duration = 2.0) {
+  const Model m = default_model(g);
+  Plant plant(m);
+  SolverSettings st;
+  st.solver = Solver::Cvode;
+  st.cvode_method = method;
+  st.rtol = 1e-12;
+  st.atol = 1e-14;
+  EXPECT_EQ(plant.set_solver(st), Status::Ok);
+  // A slow drift away from home: stays inside the workspace for 2 s.
+  EXPECT_EQ(plant.initialize(0.0, Pose(0.0, 0.0, 0.05, 0.0), Pose(0.001, -0.0015, 0.002, 0.01)), Status::Ok);
+  LinearInputs none;
+  MechanismState ms;
+  auto energy = [&](double& T) {
+    EXPECT_EQ(plant.mechanism(none.signal(), ms), Status::Ok);
+    T = kinetic_energy(m, ms.q, ms.qd);
+    return T + potential_energy(m, ms.q);
+  };
+  double T0;
+  const double E0 = energy(T0);
+  EnergyRun r;
+  r.scale = T0;
+  std::vector<double> drift;
+  for (int k = 1; k <= 200; ++k) {
+    EXPECT_EQ(plant.advance(duration * k / 200.0, none.signal(), true), Status::Ok);
+    double T;
+    const double E = energy(T);
+    r.scale = std::max(r.scale, T);
+    drift.push_back(std::fabs(E - E0));
+  }
+  for (double d : drift) r.max_rel_drift = std::max(r.max_rel_drift, d / r.scale);
+  return r;
+}
+
+}  // namespace
+
+TEST(ForwardDynamics, KineticEnergyConservedWithoutForcesOrGravity) {
+  const EnergyRun r = run_energy(0.0, CvodeMethod::Adams);
+  EXPECT_GT(r.scale, 1e-7);
+  EXPECT_LE(r.max_rel_drift, 1e-9) << "scale " << r.scale << " J";
+  std::printf("  zero gravity, Adams: relative drift of T over 2 s = %.2e (T = %.3e J)\n", r.max_rel_drift, r.scale);
+}
+
+TEST(ForwardDynamics, TotalEnergyConservedInFreeFall) {
+  // Gravity on, no actuator force: the mechanism falls as a whole while its
+  // parts move relative to each other; T + U is conserved.
+  for (CvodeMethod method : {CvodeMethod::Adams, CvodeMethod::BDF}) {
+    const EnergyRun r = run_energy(9.81, method);
+    EXPECT_GT(r.scale, 1.0);
+    EXPECT_LE(r.max_rel_drift, 1e-9) << "method " << static_cast<int>(method);
+    std::printf("  gravity, %s: relative drift of T + U over 2 s = %.2e (max T = %.3e J)\n",
+                method == CvodeMethod::Adams ? "Adams" : "BDF", r.max_rel_drift, r.scale);
+  }
+}
+
+TEST(ForwardDynamics, WorkOfHeldForcesBalancesTheEnergy) {
+  // Constant actuator forces are conservative: T + U - sum F_i rho_i is
+  // constant. Near home the held static forces give a bounded oscillation.
+  const Model m = default_model();
+  InverseDynamicsResult st;
+  ASSERT_EQ(inverse_dynamics(m, Pose(0, 0, 0.05, 0), Pose::Zero(), Pose::Zero(), Wrench::Zero(), st), Status::Ok);
+  Plant plant(m);
+  SolverSettings s;
+  s.rtol = 1e-12;
+  s.atol = 1e-14;
+  ASSERT_EQ(plant.set_solver(s), Status::Ok);
+  ASSERT_EQ(plant.initialize(0.0, Pose(0.001, 0.0, 0.05, 0.0), Pose(0.0, 0.002, 0.0, 0.02)), Status::Ok);
+  LinearInputs held;
+  held.F0 = st.F;
+  MechanismState ms;
+  auto energy = [&](double& T) {
+    EXPECT_EQ(plant.mechanism(held.signal(), ms), Status::Ok);
+    T = kinetic_energy(m, ms.q, ms.qd);
+    return T + potential_energy(m, ms.q) - st.F.dot(Vec4(ms.q[0], ms.q[3], ms.q[6], ms.q[9]));
+  };
+  double T;
+  const double E0 = energy(T);
+  double scale = T, drift = 0;
+  for (int k = 1; k <= 200; ++k) {
+    ASSERT_EQ(plant.advance(0.01 * k, held.signal(), true), Status::Ok);
+    drift = std::max(drift, std::fabs(energy(T) - E0));
+    scale = std::max(scale, T);
+  }
+  EXPECT_LE(drift / scale, 1e-9) << "scale " << scale;
+}

@@ -1,0 +1,66 @@
+// Parameters: the spec's defaults in SI, and validation messages that name
+// the offending parameter.
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "model.hpp"
+
+using namespace pkm;
+
+TEST(Params, DefaultsAreTheSpecTablesInSI) {
+  const Params p;
+  EXPECT_DOUBLE_EQ(p.h, 66.34e-3);
+  EXPECT_DOUBLE_EQ(p.l, 80e-3);
+  EXPECT_DOUBLE_EQ(p.h_prime, 75e-3);
+  EXPECT_DOUBLE_EQ(p.r_b, 92.73e-3);
+  EXPECT_DOUBLE_EQ(p.r_Q, 75e-3);
+  EXPECT_DOUBLE_EQ(p.m_slider, 93.31e-3);
+  EXPECT_DOUBLE_EQ(p.m_rod, 63.71e-3);
+  EXPECT_DOUBLE_EQ(p.m_platform, 454.74e-3);
+  EXPECT_DOUBLE_EQ(p.Izz_platform, 2874.21 * 1e-6);  // kg mm^2 -> kg m^2
+  EXPECT_DOUBLE_EQ(p.I_rod[1], 49.86e-6);
+  EXPECT_DOUBLE_EQ(p.gamma[0], 65.0 * kPi / 180.0);
+  EXPECT_DOUBLE_EQ(p.gamma[1], -65.0 * kPi / 180.0);
+  EXPECT_DOUBLE_EQ(p.beta[3], 1.5 * kPi);
+  EXPECT_TRUE(validate(p).empty());
+}
+
+TEST(Params, PlacementFollowsTheSpec) {
+  Model m;
+  ASSERT_EQ(make_model(Params{}, m), Status::Ok);
+  EXPECT_NEAR(m.B[1].x(), 0.0, 1e-17);
+  EXPECT_NEAR(m.B[1].y(), 0.09273, 1e-17);
+  // r_Q1 at angle beta_1 + gamma_1 = 65 deg.
+  EXPECT_NEAR(std::atan2(m.r_Q[0].y(), m.r_Q[0].x()), 65.0 * kPi / 180.0, 1e-15);
+  EXPECT_NEAR(m.r_Q[3].norm(), 0.075, 1e-17);
+}
+
+TEST(Params, ValidationNamesTheOffendingParameter) {
+  struct Case { const char* name; void (*spoil)(Params&); };
+  const Case cases[] = {
+      {"parameter l ", [](Params& p) { p.l = -0.08; }},
+      {"parameter h_prime ", [](Params& p) { p.h_prime = 0.0; }},
+      {"parameter r_Q ", [](Params& p) { p.r_Q = NAN; }},
+      {"parameter m_rod ", [](Params& p) { p.m_rod = -1; }},
+      {"parameter I_rod[2] ", [](Params& p) { p.I_rod[1] = INFINITY; }},
+      {"parameter Izz_platform ", [](Params& p) { p.Izz_platform = 0; }},
+      {"parameter gamma[3] ", [](Params& p) { p.gamma[2] = NAN; }},
+      {"parameter g ", [](Params& p) { p.g = INFINITY; }},
+  };
+  for (const Case& c : cases) {
+    Params p;
+    c.spoil(p);
+    Model m;
+    std::string why;
+    EXPECT_EQ(make_model(p, m, &why), Status::InvalidParameter) << c.name;
+    EXPECT_NE(why.find(c.name), std::string::npos) << "message: " << why;
+  }
+}
+
+TEST(Params, ZeroGravityIsAllowed) {
+  Params p;
+  p.g = 0.0;
+  EXPECT_TRUE(validate(p).empty());
+}

@@ -1,0 +1,66 @@
+// Shared helpers of the unit tests: random reachable states and finite
+// differences (all derived from the spec, never from the code's outputs).
+#pragma once
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "constraints.hpp"
+#include "model.hpp"
+#include "servo_kinematics.hpp"
+
+namespace pkm_test {
+
+using namespace pkm;
+
+inline Model default_model(double g = 9.81) {
+  Params p;
+  p.g = g;
+  Model m;
+  EXPECT_EQ(make_model(p, m), Status::Ok);
+  return m;
+}
+
+/// A random pose inside the auto-test's neighbourhood of the workspace,
+/// with a random velocity; q and qd on the constraint manifold.
+struct RandomState {
+  Pose pose, vel;
+  Vec16 q, qd;
+};
+
+inline RandomState random_state(const Model& m, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  RandomState s;
+  s.pose = Pose(0.008 * u(gen), 0.008 * u(gen), 0.06 + 0.012 * u(gen), 0.08 * u(gen));
+  s.vel = Pose(0.2 * u(gen), 0.2 * u(gen), 0.2 * u(gen), 1.5 * u(gen));
+  EXPECT_EQ(closed_form_position(m, s.pose, s.q), Status::Ok);
+  EXPECT_EQ(solve_velocity(m, s.q, s.vel, s.qd), Status::Ok);
+  return s;
+}
+
+/// A random vector with entries in [-scale, scale].
+template <int N>
+Eigen::Matrix<double, N, 1> random_vec(unsigned seed, double scale) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(-scale, scale);
+  Eigen::Matrix<double, N, 1> v;
+  for (int i = 0; i < N; ++i) v[i] = u(gen);
+  return v;
+}
+
+/// Fourth-order central difference of s -> f(s) at s = 0.
+template <class F>
+auto d_ds(F f, double h) -> decltype(f(0.0)) {
+  return (f(-2 * h) - 8 * f(-h) + 8 * f(h) - f(2 * h)) / (12 * h);
+}
+
+/// Relative difference with a floor on the scale.
+template <class A, class B>
+double rel_diff(const A& a, const B& b, double floor = 1e-300) {
+  const double scale = std::max({a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff(), floor});
+  return (a - b).cwiseAbs().maxCoeff() / scale;
+}
+
+}  // namespace pkm_test
