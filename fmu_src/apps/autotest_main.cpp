@@ -33,12 +33,13 @@ bool write_csv(const std::string& path, const pkm::AutotestResult& r) {
   if (!f) return false;
   std::fprintf(f,
                "t_s,x_ref_m,y_ref_m,z_ref_m,phi_ref_rad,x_m,y_m,z_m,phi_rad,"
-               "F1_N,F2_N,F3_N,F4_N,rho1_m,rho2_m,rho3_m,rho4_m,constraint_residual_m,jacobian_condition\n");
+               "F1_N,F2_N,F3_N,F4_N,F1_static_N,F2_static_N,F3_static_N,F4_static_N,rho1_m,rho2_m,rho3_m,rho4_m,constraint_residual_m,jacobian_condition\n");
   for (const auto& s : r.samples) {
     std::fprintf(f, "%.6f", s.t);
     for (int k = 0; k < 4; ++k) std::fprintf(f, ",%.17g", s.desired[k]);
     for (int k = 0; k < 4; ++k) std::fprintf(f, ",%.17g", s.simulated[k]);
     for (int k = 0; k < 4; ++k) std::fprintf(f, ",%.17g", s.F[k]);
+    for (int k = 0; k < 4; ++k) std::fprintf(f, ",%.17g", s.F_static[k]);
     for (int k = 0; k < 4; ++k) std::fprintf(f, ",%.17g", s.rho[k]);
     std::fprintf(f, ",%.6e,%.6f\n", s.constraint_residual, s.jacobian_condition);
   }
@@ -116,9 +117,9 @@ int main(int argc, char** argv) {
     else
       std::printf("  CVODE Adams, rtol = %g, atol = %g:", opt.solver.rtol, opt.solver.atol);
     std::printf(" max |position error| = %.3e m, max |phi error| = %.3e rad, max ||C(q)|| = %.1e m, "
-                "max cond(J) = %.2f, %ld derivative evaluations (with inverse dynamics at each), %.2f s wall -> %s\n",
+                "max cond(J) = %.2f, max |F - F_static| = %.4f N, %ld derivative evaluations (with inverse dynamics at each), %.2f s wall -> %s\n",
                 r.max_position_error, r.max_angle_error, r.max_constraint_residual, r.max_jacobian_condition,
-                r.rhs_evaluations, wall, csv.c_str());
+                r.max_dynamic_force, r.rhs_evaluations, wall, csv.c_str());
   }
   return failures == 0 ? 0 : 1;
 }

@@ -69,6 +69,10 @@ Status run_autotest(const Model& m, const AutotestOptions& opt, AutotestResult& 
     opt.path.eval(t, smp.desired, pd, pdd);
     smp.simulated = plant.state().head<4>();
     smp.F = forces.id.F;
+    InverseDynamicsResult at_rest;
+    s = inverse_dynamics(m, smp.desired, Pose::Zero(), Pose::Zero(), Wrench::Zero(), at_rest);
+    if (s != Status::Ok) return s;
+    smp.F_static = at_rest.F;
     for (int i = 0; i < kLegs; ++i) smp.rho[i] = ms.q[leg_offset(i)];
     smp.constraint_residual = plant.constraint_residual();
     smp.jacobian_condition = plant.jacobian_condition();
@@ -77,6 +81,7 @@ Status run_autotest(const Model& m, const AutotestOptions& opt, AutotestResult& 
     out.max_angle_error = std::max(out.max_angle_error, std::fabs(e[3]));
     out.max_constraint_residual = std::max(out.max_constraint_residual, smp.constraint_residual);
     out.max_jacobian_condition = std::max(out.max_jacobian_condition, smp.jacobian_condition);
+    out.max_dynamic_force = std::max(out.max_dynamic_force, (smp.F - smp.F_static).lpNorm<Eigen::Infinity>());
     out.samples.push_back(smp);
     if (opt.progress && (k % std::max(1L, n / 10) == 0 || k == n)) opt.progress(opt.progress_user, t, t_end);
   }

@@ -27,6 +27,7 @@ struct AutotestSample {
   Pose desired;      // the prescribed path
   Pose simulated;    // forward dynamics
   Vec4 F;            // inverse-dynamics actuator forces, N
+  Vec4 F_static;     // the forces that would hold the same pose at rest, N
   Vec4 rho;          // simulated actuator positions, m
   double constraint_residual;  // ||C(q)||, m
   double jacobian_condition;
@@ -38,6 +39,7 @@ struct AutotestResult {
   double max_angle_error = 0;     // rad
   double max_constraint_residual = 0;
   double max_jacobian_condition = 0;
+  double max_dynamic_force = 0;   // max |F - F_static|, N
   long rhs_evaluations = 0;
   std::string error;
 };
