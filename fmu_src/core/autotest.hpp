@@ -47,13 +47,11 @@ struct AutotestResult {
 /// Runs the round trip. Status of the first failure (inverse or forward).
 Status run_autotest(const Model& m, const AutotestOptions& opt, AutotestResult& out);
 
-/// Inverse dynamics along a path as an InputSignal: forces at any time t,
-/// warm-started from the previous call.
+/// Inverse dynamics along a path as an InputSignal: forces at any time t.
 struct PathForces {
   const Model* model = nullptr;
   RestToRest path;
   InverseDynamicsResult id;
-  bool warm = false;
   Status status = Status::Ok;
   InputSignal signal();
 };
