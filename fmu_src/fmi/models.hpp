@@ -1,0 +1,13 @@
+// The two FMUs of the project (MODEL_SPEC "FMU interface contract").
+#pragma once
+
+#include "fmi2_cs.hpp"
+
+namespace pkm_fmi {
+
+/// PKM4PUU: forward dynamics, the plant.
+const ModelDefinition& pkm4puu_definition();
+/// PKM4PUU_Inverse: algebraic inverse dynamics (computed-force feed-forward).
+const ModelDefinition& pkm4puu_inverse_definition();
+
+}  // namespace pkm_fmi

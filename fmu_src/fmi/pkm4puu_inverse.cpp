@@ -1,0 +1,204 @@
+// PKM4PUU_Inverse.fmu: inverse dynamics of the 4-PUU robot (computed-force
+// feed-forward), over pkm::inverse_dynamics. An algebraic FMU: its outputs
+// are functions of the inputs at the communication point (direct
+// feedthrough), computed lazily on the first get after an input changed.
+//
+// Immutable: the table and ModelDefinition (shared), and pkm::Model built
+// once per instance at the end of initialisation. Per instance
+// (InverseData): parameter and input values and the output cache.
+//
+// The position problem starts from the closed-form elbow-down inverse
+// kinematics every time (inverse_dynamics with warm_start = false), not
+// from the previous solution: the closed form is already exact (Newton
+// stops after 0 iterations), so this is faster than a warm start (about
+// 3 us against 6 us per evaluation), cannot leave the elbow-down branch
+// after a jump of the inputs, and makes the outputs a pure function of the
+// current inputs and parameters (bit for bit, whatever was computed
+// before; nothing to carry in FMU states).
+#include <cmath>
+#include <iterator>
+#include <memory>
+
+#include "inverse_dynamics.hpp"
+#include "mechanism_parameters.hpp"
+#include "models.hpp"
+
+#ifndef PKM4PUU_INVERSE_GUID
+#error "PKM4PUU_INVERSE_GUID must be defined (the build computes it from modelDescription/PKM4PUU_Inverse.xml)"
+#endif
+
+namespace pkm_fmi {
+namespace {
+
+struct InverseData final : MechanismData {
+  // Inputs.
+  double pose[4] = {0.0, 0.0, 0.05, 0.0};  // x, y, z, phi
+  double vel[4] = {}, acc[4] = {};
+  double wrench[4] = {};  // Fe1..Fe3, Me_z
+  // Outputs.
+  double F[4] = {}, rho[4] = {}, drho[4] = {}, lambda[12] = {};
+  // Built at the end of initialisation.
+  std::unique_ptr<pkm::Model> model;
+
+  void reset() override { model.reset(); }
+  fmi2Status exit_initialization(Context& ctx) override;
+  fmi2Status do_step(Context&, double t, double h, double& t_reached) override {
+    t_reached = t + h;  // no dynamics: the outputs follow the inputs
+    return fmi2OK;
+  }
+  fmi2Status update_outputs(Context& ctx) override;
+  void save(StateWriter& w) const override;
+  bool load(StateReader& r, Context& ctx) override;
+
+  fmi2Status make(Context& ctx, const char* function, pkm::Model& out) const;
+};
+
+fmi2Status InverseData::make(Context& ctx, const char* function, pkm::Model& out) const {
+  std::string why;
+  if (pkm::make_model(params, out, &why) != pkm::Status::Ok) {
+    ctx.log.error("%s: %s", function, why.c_str());
+    return fmi2Error;
+  }
+  return fmi2OK;
+}
+
+fmi2Status InverseData::exit_initialization(Context& ctx) {
+  auto m = std::make_unique<pkm::Model>();
+  const fmi2Status st = make(ctx, "fmi2ExitInitializationMode", *m);
+  if (st != fmi2OK) return st;
+  model = std::move(m);
+  return fmi2OK;
+}
+
+fmi2Status InverseData::update_outputs(Context& ctx) {
+  pkm::Model temporary;
+  const pkm::Model* m = model.get();
+  if (ctx.mode == kInitializationMode) {
+    const fmi2Status st = make(ctx, "fmi2GetReal (initialization mode)", temporary);
+    if (st != fmi2OK) return st;
+    m = &temporary;
+  }
+  if (!m) {
+    ctx.log.error("fmi2GetReal: outputs not available (initialisation did not succeed)");
+    return fmi2Error;
+  }
+  const pkm::Pose p(pose[0], pose[1], pose[2], pose[3]);
+  const pkm::Pose pd(vel[0], vel[1], vel[2], vel[3]);
+  const pkm::Pose pdd(acc[0], acc[1], acc[2], acc[3]);
+  const pkm::Wrench we(wrench[0], wrench[1], wrench[2], wrench[3]);
+  pkm::InverseDynamicsResult r;
+  const pkm::Status s = pkm::inverse_dynamics(*m, p, pd, pdd, we, r, /*warm_start=*/false);
+  if (s != pkm::Status::Ok) {
+    ctx.log.error("fmi2GetReal: inverse dynamics at x = %g m, y = %g m, z = %g m, phi = %g rad failed: %s "
+                  "(outputs not written)",
+                  pose[0], pose[1], pose[2], pose[3], pkm::status_name(s));
+    return fmi2Error;
+  }
+  for (int i = 0; i < 4; ++i) {
+    const int o = pkm::leg_offset(i);
+    F[i] = r.F[i];
+    rho[i] = r.q[o];
+    drho[i] = r.qd[o];
+  }
+  for (int k = 0; k < 12; ++k) lambda[k] = r.lambda[k];
+  return fmi2OK;
+}
+
+void InverseData::save(StateWriter& w) const { w.u8(model ? 1 : 0); }
+
+bool InverseData::load(StateReader& r, Context& ctx) {
+  const bool has_model = r.u8() != 0;
+  if (!r.ok()) return false;
+  model.reset();
+  if (has_model) {
+    auto m = std::make_unique<pkm::Model>();
+    if (make(ctx, "fmi2SetFMUstate", *m) != fmi2OK) return false;
+    model = std::move(m);
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------- the table
+
+#define INV(member) \
+  [](ModelData& d, int i) -> void* { return &static_cast<InverseData&>(d).member[i]; }
+
+// clang-format off
+constexpr Variable kVariables[] = {
+  // Inputs: 1..16.
+  real_input(1, "x", 0.0, "m", "Platform reference point P (centre of mass), x in the base frame", INV(pose), 0, nullptr),
+  real_input(2, "y", 0.0, "m", "Platform reference point P (centre of mass), y in the base frame", INV(pose), 1, nullptr),
+  real_input(3, "z", 0.05, "m", "Platform reference point P (centre of mass), z in the base frame (home pose: 0.05 m)", INV(pose), 2, nullptr),
+  real_input(4, "phi", 0.0, "rad", "Platform rotation about z of the base frame", INV(pose), 3, nullptr),
+  real_input(5, "dx", 0.0, "m/s", "Velocity of P, x component", INV(vel), 0, nullptr),
+  real_input(6, "dy", 0.0, "m/s", "Velocity of P, y component", INV(vel), 1, nullptr),
+  real_input(7, "dz", 0.0, "m/s", "Velocity of P, z component", INV(vel), 2, nullptr),
+  real_input(8, "dphi", 0.0, "rad/s", "Platform angular velocity about z", INV(vel), 3, nullptr),
+  real_input(9, "ddx", 0.0, "m/s2", "Acceleration of P, x component", INV(acc), 0, nullptr),
+  real_input(10, "ddy", 0.0, "m/s2", "Acceleration of P, y component", INV(acc), 1, nullptr),
+  real_input(11, "ddz", 0.0, "m/s2", "Acceleration of P, z component", INV(acc), 2, nullptr),
+  real_input(12, "ddphi", 0.0, "rad/s2", "Platform angular acceleration about z", INV(acc), 3, nullptr),
+  real_input(13, "Fe[1]", 0.0, "N", "External force on the platform at P, x component (base frame)", INV(wrench), 0, nullptr),
+  real_input(14, "Fe[2]", 0.0, "N", "External force on the platform at P, y component (base frame)", INV(wrench), 1, nullptr),
+  real_input(15, "Fe[3]", 0.0, "N", "External force on the platform at P, z component (base frame)", INV(wrench), 2, nullptr),
+  real_input(16, "Me_z", 0.0, "N.m", "External moment on the platform about z", INV(wrench), 3, nullptr),
+  // Outputs: 20..51.
+  real_output(20, "F[1]", "N", "Actuator force on the slider of leg 1, along +z (Eq. 11)", INV(F), 0),
+  real_output(21, "F[2]", "N", "Actuator force on the slider of leg 2, along +z (Eq. 11)", INV(F), 1),
+  real_output(22, "F[3]", "N", "Actuator force on the slider of leg 3, along +z (Eq. 11)", INV(F), 2),
+  real_output(23, "F[4]", "N", "Actuator force on the slider of leg 4, along +z (Eq. 11)", INV(F), 3),
+  real_output(24, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", INV(rho), 0),
+  real_output(25, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", INV(rho), 1),
+  real_output(26, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", INV(rho), 2),
+  real_output(27, "rho[4]", "m", "Actuated prismatic joint of leg 4 (slider position)", INV(rho), 3),
+  real_output(28, "drho[1]", "m/s", "Slider velocity of leg 1", INV(drho), 0),
+  real_output(29, "drho[2]", "m/s", "Slider velocity of leg 2", INV(drho), 1),
+  real_output(30, "drho[3]", "m/s", "Slider velocity of leg 3", INV(drho), 2),
+  real_output(31, "drho[4]", "m/s", "Slider velocity of leg 4", INV(drho), 3),
+  real_output(40, "lambda[1]", "N", "Lagrange multiplier of leg 1's loop closure, x row (Eq. 10)", INV(lambda), 0),
+  real_output(41, "lambda[2]", "N", "Lagrange multiplier of leg 1's loop closure, y row (Eq. 10)", INV(lambda), 1),
+  real_output(42, "lambda[3]", "N", "Lagrange multiplier of leg 1's loop closure, z row (Eq. 10)", INV(lambda), 2),
+  real_output(43, "lambda[4]", "N", "Lagrange multiplier of leg 2's loop closure, x row (Eq. 10)", INV(lambda), 3),
+  real_output(44, "lambda[5]", "N", "Lagrange multiplier of leg 2's loop closure, y row (Eq. 10)", INV(lambda), 4),
+  real_output(45, "lambda[6]", "N", "Lagrange multiplier of leg 2's loop closure, z row (Eq. 10)", INV(lambda), 5),
+  real_output(46, "lambda[7]", "N", "Lagrange multiplier of leg 3's loop closure, x row (Eq. 10)", INV(lambda), 6),
+  real_output(47, "lambda[8]", "N", "Lagrange multiplier of leg 3's loop closure, y row (Eq. 10)", INV(lambda), 7),
+  real_output(48, "lambda[9]", "N", "Lagrange multiplier of leg 3's loop closure, z row (Eq. 10)", INV(lambda), 8),
+  real_output(49, "lambda[10]", "N", "Lagrange multiplier of leg 4's loop closure, x row (Eq. 10)", INV(lambda), 9),
+  real_output(50, "lambda[11]", "N", "Lagrange multiplier of leg 4's loop closure, y row (Eq. 10)", INV(lambda), 10),
+  real_output(51, "lambda[12]", "N", "Lagrange multiplier of leg 4's loop closure, z row (Eq. 10)", INV(lambda), 11),
+  // Parameters: the mechanism (100..120).
+  PKM_FMI_MECHANISM_PARAMETERS,
+};
+// clang-format on
+
+#undef INV
+
+static_assert(sorted_by_vr(kVariables, std::size(kVariables)), "the table must be sorted by value reference");
+
+std::unique_ptr<ModelData> create() { return std::make_unique<InverseData>(); }
+
+const ModelDefinition kDefinition{
+    "PKM4PUU_Inverse",
+    PKM4PUU_INVERSE_GUID,
+    "4-PUU Schoenflies-motion parallel robot: inverse dynamics (computed-force feed-forward)",
+    "<p>Inverse dynamics of the 4-PUU parallel kinematics machine with three translations and one rotation "
+    "(3T1R) of M. Ruggiu, P. Rea and E. Ottaviano, <i>Dynamic model of a 3T1R parallel kinematics machine</i>. "
+    "Given the platform pose, velocity and acceleration and an external wrench, it solves the position, "
+    "velocity and acceleration problems of the legs (Eqs. 2-9, elbow-down) and then Eqs. 10-11 for the "
+    "Lagrange multipliers and the four actuator forces. The outputs are algebraic functions of the inputs at "
+    "the communication point (direct feedthrough); fmi2DoStep only advances time.</p>"
+    "<p>An unreachable or singular pose makes fmi2GetReal return fmi2Error with a message; no output is "
+    "written then. At rest at the home pose (0, 0, 0.05 m, 0) with g = 9.81 m/s2 each actuator carries "
+    "2.655616050 N.</p>",
+    kVariables,
+    std::size(kVariables),
+    /*can_interpolate_inputs=*/false,
+    &create,
+};
+
+}  // namespace
+
+const ModelDefinition& pkm4puu_inverse_definition() { return kDefinition; }
+
+}  // namespace pkm_fmi

@@ -1,0 +1,90 @@
+// Build tool: writes an FMU's documentation/index.html from its variable
+// table, so that the page always lists the variables the binary has.
+//   pkm_fmu_doc <modelIdentifier> <output.html>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <string>
+
+#include "models.hpp"
+
+namespace {
+
+std::string escape(const char* s) {
+  std::string out;
+  for (; *s; ++s) {
+    switch (*s) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += *s;
+    }
+  }
+  return out;
+}
+
+std::string start_text(const pkm_fmi::Variable& v) {
+  if (!v.has_start()) return "";
+  char buf[40];
+  if (v.type == pkm_fmi::VarType::Real) {
+    for (int digits = 1; digits <= 17; ++digits) {  // the shortest text that reads back exactly
+      std::snprintf(buf, sizeof buf, "%.*g", digits, v.start);
+      if (std::strtod(buf, nullptr) == v.start) break;
+    }
+  } else {
+    std::snprintf(buf, sizeof buf, "%d", static_cast<int>(v.start));
+  }
+  return buf;
+}
+
+void section(std::ofstream& out, const pkm_fmi::ModelDefinition& def, pkm_fmi::Causality c, const char* title) {
+  out << "<h2>" << title << "</h2>\n<table>\n<tr><th>name</th><th>type</th><th>unit</th><th>start</th>"
+         "<th>value reference</th><th>description</th></tr>\n";
+  for (std::size_t i = 0; i < def.n_variables; ++i) {
+    const pkm_fmi::Variable& v = def.variables[i];
+    if (v.causality != c) continue;
+    out << "<tr><td><code>" << escape(v.name) << "</code></td><td>" << pkm_fmi::xml_name(v.type) << "</td><td>"
+        << escape(v.unit) << "</td><td>" << start_text(v) << "</td><td>" << v.vr << "</td><td>"
+        << escape(v.description) << "</td></tr>\n";
+  }
+  out << "</table>\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: %s <modelIdentifier> <output.html>\n", argv[0]);
+    return 2;
+  }
+  const pkm_fmi::ModelDefinition* defs[] = {&pkm_fmi::pkm4puu_definition(), &pkm_fmi::pkm4puu_inverse_definition()};
+  const pkm_fmi::ModelDefinition* def = nullptr;
+  for (const auto* d : defs)
+    if (std::strcmp(d->identifier, argv[1]) == 0) def = d;
+  if (!def) {
+    std::fprintf(stderr, "%s: unknown model %s\n", argv[0], argv[1]);
+    return 2;
+  }
+  std::ofstream out(argv[2]);
+  out << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" << def->identifier
+      << "</title>\n<style>body{font-family:sans-serif;max-width:60em;margin:auto}"
+         "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 6px;text-align:left}</style>\n"
+         "</head>\n<body>\n<h1>"
+      << def->identifier << "</h1>\n<p><b>" << escape(def->title) << "</b></p>\n"
+      << def->summary
+      << "\n<p>FMI 2.0 Co-Simulation, binaries for linux64. SI units on every variable (m, kg, s, rad, N, N.m). "
+         "Parameters are fixed: they can be set before fmi2ExitInitializationMode only. Arrays follow the "
+         "<code>name[i]</code> convention, 1-based; leg i = 1..4.</p>\n";
+  section(out, *def, pkm_fmi::Causality::Input, "Inputs");
+  section(out, *def, pkm_fmi::Causality::Output, "Outputs");
+  section(out, *def, pkm_fmi::Causality::Parameter, "Parameters");
+  out << "</body>\n</html>\n";
+  out.close();
+  if (!out) {
+    std::fprintf(stderr, "%s: cannot write %s\n", argv[0], argv[2]);
+    return 1;
+  }
+  return 0;
+}
