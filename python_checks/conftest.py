@@ -1,0 +1,45 @@
+"""Shared fixtures: where the FMUs are and where results go.
+
+The FMUs are taken from $PKM_BUILD_DIR (default <repo>/build). A missing FMU
+is a failure, not a skip: these checks exist to test the built FMUs.
+"""
+import os
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+def build_dir() -> Path:
+    return Path(os.environ.get("PKM_BUILD_DIR", REPO / "build")).resolve()
+
+
+def _require_fmu(name: str) -> Path:
+    path = build_dir() / name
+    if not path.is_file():
+        pytest.fail(
+            f"{path} does not exist: build the FMUs first with ./run_tests.sh "
+            f"(or point PKM_BUILD_DIR at the build directory that holds {name})",
+            pytrace=False,
+        )
+    return path
+
+
+@pytest.fixture(scope="session")
+def plant_fmu() -> Path:
+    """PKM4PUU.fmu, the forward-dynamics plant."""
+    return _require_fmu("PKM4PUU.fmu")
+
+
+@pytest.fixture(scope="session")
+def inverse_fmu() -> Path:
+    """PKM4PUU_Inverse.fmu, the algebraic inverse dynamics."""
+    return _require_fmu("PKM4PUU_Inverse.fmu")
+
+
+@pytest.fixture(scope="session")
+def results_dir() -> Path:
+    path = REPO / "results"
+    path.mkdir(parents=True, exist_ok=True)
+    return path
