@@ -146,3 +146,20 @@ TEST(CApi, EnergyIsAvailable) {
   // Pure vertical motion: every body moves at 0.1 m/s, nothing rotates.
   EXPECT_NEAR(T, 0.5 * (0.45474 + 4 * (0.09331 + 0.06371)) * 0.01, 1e-15);
 }
+
+TEST(CApi, ReadingOutputsChangesNothing) {
+  // An FMU state saved after reading outputs equals one saved without.
+  Handle h;
+  const double v0[4] = {0.01, -0.01, 0.0, 0.1};
+  ASSERT_EQ(pkm_init_pose(h.m, 0.0, kHome, v0), PKM_OK);
+  const double F[4] = {2.7, 2.6, 2.65, 2.66};
+  ASSERT_EQ(pkm_advance(h.m, 0.1, F, nullptr), PKM_OK);
+  double t1, y1[8], th1[4], t2, y2[8], th2[4];
+  ASSERT_EQ(pkm_get_state(h.m, &t1, y1, th1), PKM_OK);
+  pkm_outputs out;
+  ASSERT_EQ(pkm_get_outputs(h.m, F, nullptr, &out), PKM_OK);
+  ASSERT_EQ(pkm_get_state(h.m, &t2, y2, th2), PKM_OK);
+  EXPECT_EQ(std::memcmp(th1, th2, sizeof th1), 0);
+  EXPECT_EQ(std::memcmp(y1, y2, sizeof y1), 0);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(out.theta1[i], th1[i]);
+}

@@ -65,7 +65,9 @@ Status CvodeIntegrator::init(CvodeMethod method, double rtol, double atol, Rhs r
   int flag = CVodeInit(mem_, &CvodeIntegrator::rhs_trampoline, 0.0, y_);
   flag |= CVodeSetUserData(mem_, this);
   flag |= CVodeSStolerances(mem_, rtol, atol);
-  flag |= CVodeSetMaxNumSteps(mem_, 1000000);
+  // Enough for a long communication interval at the natural step (~1 ms),
+  // few enough that a run into a singularity fails in a fraction of a second.
+  flag |= CVodeSetMaxNumSteps(mem_, 100000);
   if (method == CvodeMethod::BDF) {
     A_ = SUNDenseMatrix(8, 8, ctx_);
     LS_ = SUNLinSol_Dense(y_, A_, ctx_);

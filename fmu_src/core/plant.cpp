@@ -51,6 +51,11 @@ std::string validate(const SolverSettings& s) {
     std::snprintf(buf, sizeof buf, "atol = %.17g must be positive and finite", s.atol);
     return buf;
   }
+  if (s.cvode_method != CvodeMethod::Adams && s.cvode_method != CvodeMethod::BDF)
+    return "cvode_method must be 0 (Adams) or 1 (BDF)";
+  if (s.formulation != Formulation::Augmented && s.formulation != Formulation::NullSpaceQR &&
+      s.formulation != Formulation::LegPartitioned)
+    return "formulation must be 0 (Eq. 12), 1 (Eq. 13, QR) or 2 (Eq. 13, leg-partitioned)";
   return {};
 }
 
@@ -86,7 +91,7 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
 }
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
-  if (!std::isfinite(t) || !y.allFinite()) return Status::NonFinite;
+  if (!std::isfinite(t) || !y.allFinite() || !theta1_ref.allFinite()) return Status::NonFinite;
   Vec16 q, qd;
   const Status s = expand_state(model_, y, q, qd);
   if (s != Status::Ok) return s;
@@ -165,12 +170,20 @@ Status Plant::advance(double t_end, const InputSignal& inputs, bool continuous) 
   if (!(t_end > t_)) return t_end == t_ ? Status::Ok : Status::InvalidArgument;
   error_.clear();
   inputs_ = inputs;
+  const double t_start = t_;
   const Status s = settings_.solver == Solver::Rk4 ? advance_rk4(t_end) : advance_cvode(t_end, continuous);
   inputs_ = InputSignal{};
+  if (t_ != t_start) update_theta1_ref();
   return s;
 }
 
-Status Plant::mechanism(const InputSignal& inputs, MechanismState& out) {
+void Plant::update_theta1_ref() {
+  Vec16 q;
+  if (closed_form_position(model_, y_.head<4>(), q) != Status::Ok) return;
+  for (int i = 0; i < kLegs; ++i) theta1_ref_[i] = unwrap_near(q[leg_offset(i) + 1], theta1_ref_[i]);
+}
+
+Status Plant::mechanism(const InputSignal& inputs, MechanismState& out) const {
   if (!initialized_) return Status::NotInitialized;
   Vec4 F;
   Wrench we;
@@ -181,7 +194,6 @@ Status Plant::mechanism(const InputSignal& inputs, MechanismState& out) {
   for (int i = 0; i < kLegs; ++i) {
     double& th1 = out.q[leg_offset(i) + 1];
     th1 = unwrap_near(th1, theta1_ref_[i]);
-    theta1_ref_[i] = th1;
   }
   return Status::Ok;
 }

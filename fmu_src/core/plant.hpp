@@ -70,9 +70,10 @@ class Plant {
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref);
 
   /// q, qd, qdd and lambda at the current time, for the inputs at that time
-  /// (evaluated on demand after each advance; theta1 unwrapped continuously).
-  Status mechanism(const InputSignal& inputs, MechanismState& out);
-  /// theta1 of each leg as last reported (the reference for unwrapping).
+  /// (evaluated on demand; theta1 continuous in time). Reading changes nothing.
+  Status mechanism(const InputSignal& inputs, MechanismState& out) const;
+  /// theta1 of each leg at the current time, unwrapped continuously since
+  /// initialisation (updated at the end of every advance).
   const Vec4& theta1_ref() const { return theta1_ref_; }
 
   /// ||C(q)|| at the current state (m).
@@ -88,6 +89,7 @@ class Plant {
   Status derivative(double t, const Vec8& y, Vec8& ydot);
   Status advance_rk4(double t_end);
   Status advance_cvode(double t_end, bool continuous);
+  void update_theta1_ref();
 
   Model model_;
   SolverSettings settings_;
