@@ -41,12 +41,10 @@ Status state_derivative(const Model& m, Formulation form, const Vec8& y, const V
       if (s != Status::Ok) return s;
       rd.add_leg(m, i, rd.leg_velocity(i, pd), pd[3], f[leg_offset(i)]);
     }
-    Vec16 qdd;
-    Vec12 lambda;
-    const Status s = rd.solve(m, f.segment<4>(kPlatform), qdd, lambda);
-    if (s != Status::Ok) return s;
-    ydot.tail<4>() = qdd.segment<4>(kPlatform);
-    return Status::Ok;
+    Pose pdd;
+    const Status s = rd.solve_platform(m, f.segment<4>(kPlatform), pdd);
+    if (s == Status::Ok) ydot.tail<4>() = pdd;
+    return s;
   }
   MechanismState local;
   MechanismState& st = full ? *full : local;

@@ -35,15 +35,22 @@ void ReducedDynamics::add_leg(const Model& m, int leg, const Vec3& qd_leg, doubl
   rhs_.noalias() += L.A.transpose() * L.r;
 }
 
-Status ReducedDynamics::solve(const Model& m, const Wrench& we, Vec16& qdd, Vec12& lambda) {
+Status ReducedDynamics::solve_platform(const Model& m, const Wrench& we, Pose& a) const {
   const Params& p = m.p;
   Mat4 Mr = Mr_;
   Mr.diagonal() += Vec4(p.m_platform, p.m_platform, p.m_platform, p.Izz_platform);
   Vec4 rhs = rhs_ + we;
-  rhs[2] -= p.m_platform * p.g;
+  rhs[2] -= p.m_platform * p.g;  // G_p
   const Eigen::LLT<Mat4> llt(Mr);
   if (llt.info() != Eigen::Success) return Status::Singular;
-  const Vec4 a = llt.solve(rhs);
+  a = llt.solve(rhs);
+  return a.allFinite() ? Status::Ok : Status::Singular;
+}
+
+Status ReducedDynamics::solve(const Model& m, const Wrench& we, Vec16& qdd, Vec12& lambda) {
+  Pose a;
+  const Status s = solve_platform(m, we, a);
+  if (s != Status::Ok) return s;
   for (int i = 0; i < kLegs; ++i) {
     const Leg& L = legs_[i];
     const Vec3 qdd_i = L.A * a + L.b;
@@ -51,7 +58,7 @@ Status ReducedDynamics::solve(const Model& m, const Wrench& we, Vec16& qdd, Vec1
     lambda.segment<3>(3 * i) = L.Linv.transpose() * (L.r - L.M * (L.A * a));
   }
   qdd.segment<4>(kPlatform) = a;
-  return (a.allFinite() && lambda.allFinite()) ? Status::Ok : Status::Singular;
+  return lambda.allFinite() ? Status::Ok : Status::Singular;
 }
 
 }  // namespace pkm

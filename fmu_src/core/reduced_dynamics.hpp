@@ -33,6 +33,9 @@ class ReducedDynamics {
   /// platform) and recovers the full qdd and lambda.
   Status solve(const Model& m, const Wrench& we, Vec16& qdd, Vec12& lambda);
 
+  /// Only the platform's accelerations (the integrators' hot path).
+  Status solve_platform(const Model& m, const Wrench& we, Pose& pdd) const;
+
  private:
   struct Leg {
     LegConfig c;
