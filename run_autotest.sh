@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
 # The main job: builds everything, runs the paper's auto-test into results/,
-# then plots the results.
+# then plots the results; then runs the auto-test (section 5.1) and the
+# comparison test (section 5.2) through the FMUs built in build/, which print
+# their tables of max errors and write their CSV and PNG files to results/.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")"
 ./scripts/build.sh
 build/fmu_src/pkm_autotest --out results
 .venv/bin/python scripts/plot_autotest.py results
+.venv/bin/python python_checks/fmu_autotest.py --build build --out results
+.venv/bin/python python_checks/fmu_comparison.py --build build --out results
