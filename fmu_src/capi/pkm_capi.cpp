@@ -8,6 +8,7 @@
 #include <new>
 #include <string>
 
+#include "constraints.hpp"
 #include "inverse_dynamics.hpp"
 #include "lagrangian.hpp"
 #include "plant.hpp"
@@ -231,8 +232,8 @@ pkm_status pkm_get_outputs(pkm_model* m, const double F[4], const double wrench[
   copy<16>(ms.qd, out->qd);
   copy<16>(ms.qdd, out->qdd);
   copy<12>(ms.lambda, out->lambda);
-  out->constraint_residual = m->plant.constraint_residual();
-  out->jacobian_condition = m->plant.jacobian_condition();
+  out->constraint_residual = pkm::constraints(m->plant.model(), ms.q).norm();
+  out->jacobian_condition = pkm::actuator_jacobian_condition(m->plant.model(), ms.q);
   return PKM_OK;
 }
 

@@ -75,4 +75,10 @@ double actuator_jacobian_condition(const Mat4& J) {
   return s[0] / s[3];
 }
 
+double actuator_jacobian_condition(const Model& m, const Vec16& q) {
+  Mat4 J;
+  if (actuator_jacobian(m, q, J) != Status::Ok) return std::numeric_limits<double>::infinity();
+  return actuator_jacobian_condition(J);
+}
+
 }  // namespace pkm

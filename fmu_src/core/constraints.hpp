@@ -33,6 +33,9 @@ Status actuator_jacobian(const Model& m, const Vec16& q, Mat4& J);
 /// a singularity.
 double actuator_jacobian_condition(const Mat4& J);
 
+/// The same at a configuration q on the manifold (+inf at a singularity).
+double actuator_jacobian_condition(const Model& m, const Vec16& q);
+
 /// Characteristic length that makes the phi column commensurate, m.
 constexpr double kConditionLength = 0.1;
 

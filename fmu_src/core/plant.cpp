@@ -85,6 +85,7 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
   y_.tail<4>() = velocity;
   t_ = t0;
   for (int i = 0; i < kLegs; ++i) theta1_ref_[i] = q[leg_offset(i) + 1];
+  theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, y_);
   initialized_ = true;
   return Status::Ok;
@@ -98,6 +99,7 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
   t_ = t;
   y_ = y;
   theta1_ref_ = theta1_ref;
+  theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, y_);
   initialized_ = true;
   return Status::Ok;
@@ -173,14 +175,20 @@ Status Plant::advance(double t_end, const InputSignal& inputs, bool continuous) 
   const double t_start = t_;
   const Status s = settings_.solver == Solver::Rk4 ? advance_rk4(t_end) : advance_cvode(t_end, continuous);
   inputs_ = InputSignal{};
-  if (t_ != t_start) update_theta1_ref();
+  if (t_ != t_start) theta1_stale_ = true;
   return s;
 }
 
-void Plant::update_theta1_ref() {
+const Vec4& Plant::theta1_ref() const {
+  if (theta1_stale_) update_theta1_ref();
+  return theta1_ref_;
+}
+
+void Plant::update_theta1_ref() const {
   Vec16 q;
   if (closed_form_position(model_, y_.head<4>(), q) != Status::Ok) return;
   for (int i = 0; i < kLegs; ++i) theta1_ref_[i] = unwrap_near(q[leg_offset(i) + 1], theta1_ref_[i]);
+  theta1_stale_ = false;
 }
 
 Status Plant::mechanism(const InputSignal& inputs, MechanismState& out) const {
@@ -193,7 +201,7 @@ Status Plant::mechanism(const InputSignal& inputs, MechanismState& out) const {
   if (s != Status::Ok) return s;
   for (int i = 0; i < kLegs; ++i) {
     double& th1 = out.q[leg_offset(i) + 1];
-    th1 = unwrap_near(th1, theta1_ref_[i]);
+    th1 = unwrap_near(th1, theta1_ref()[i]);
   }
   return Status::Ok;
 }
@@ -206,10 +214,8 @@ double Plant::constraint_residual() const {
 
 double Plant::jacobian_condition() const {
   Vec16 q, qd;
-  Mat4 J;
-  if (expand_state(model_, y_, q, qd) != Status::Ok || actuator_jacobian(model_, q, J) != Status::Ok)
-    return std::numeric_limits<double>::infinity();
-  return actuator_jacobian_condition(J);
+  if (expand_state(model_, y_, q, qd) != Status::Ok) return std::numeric_limits<double>::infinity();
+  return actuator_jacobian_condition(model_, q);
 }
 
 }  // namespace pkm

@@ -73,8 +73,10 @@ class Plant {
   /// (evaluated on demand; theta1 continuous in time). Reading changes nothing.
   Status mechanism(const InputSignal& inputs, MechanismState& out) const;
   /// theta1 of each leg at the current time, unwrapped continuously since
-  /// initialisation (updated at the end of every advance).
-  const Vec4& theta1_ref() const { return theta1_ref_; }
+  /// initialisation. Brought up to date when read (not in every advance:
+  /// that would cost four atan2 per step); continuity holds as long as theta1
+  /// moves less than pi between reads, which the workspace guarantees.
+  const Vec4& theta1_ref() const;
 
   /// ||C(q)|| at the current state (m).
   double constraint_residual() const;
@@ -89,7 +91,7 @@ class Plant {
   Status derivative(double t, const Vec8& y, Vec8& ydot);
   Status advance_rk4(double t_end);
   Status advance_cvode(double t_end, bool continuous);
-  void update_theta1_ref();
+  void update_theta1_ref() const;
 
   Model model_;
   SolverSettings settings_;
@@ -99,7 +101,8 @@ class Plant {
   bool initialized_ = false;
   double t_ = 0;
   Vec8 y_ = Vec8::Zero();
-  Vec4 theta1_ref_ = Vec4::Zero();
+  mutable Vec4 theta1_ref_ = Vec4::Zero();
+  mutable bool theta1_stale_ = false;
   long rhs_count_ = 0;
   Status rhs_status_ = Status::Ok;
   std::string error_;

@@ -205,8 +205,9 @@ fmi2Status PlantData::update_outputs(Context& ctx) {
     theta2[i] = ms.q[o + 2];
   }
   for (int k = 0; k < 12; ++k) lambda[k] = ms.lambda[k];
-  residual = plant->constraint_residual();
-  condition = plant->jacobian_condition();  // +inf at a parallel singularity, never NaN
+  // From the q just evaluated: one closed-form expansion serves every output.
+  residual = pkm::constraints(plant->model(), ms.q).norm();
+  condition = pkm::actuator_jacobian_condition(plant->model(), ms.q);  // +inf at a singularity, never NaN
   bool finite = std::isfinite(residual) && !std::isnan(condition);
   for (const double* block : {pose, vel, rho, drho, theta1, theta2})
     for (int i = 0; i < 4; ++i) finite = finite && std::isfinite(block[i]);
