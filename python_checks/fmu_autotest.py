@@ -30,7 +30,6 @@ usage: fmu_autotest.py [--build DIR] [--out DIR]
 """
 import argparse
 import csv
-import math
 import sys
 import time
 from pathlib import Path
@@ -38,6 +37,7 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 
+import autotest_plots
 from fmu_helpers import ACC, F, P0, POSE, T_MOVE, VEL, Fmu, inverse_forces, p, run
 
 matplotlib.use("Agg")
@@ -249,48 +249,20 @@ def plot_errors(runs, path):
 
 
 def plot_pose(runs, path, case=POSE_PLOT_CASE):
-    """Prescribed vs FMU-simulated x, y, z, phi (the style of
-    scripts/plot_autotest.py's autotest_pose.png)."""
+    """Prescribed vs FMU-simulated x, y, z, phi for one case."""
     r = runs[case]
-    fig, axes = plt.subplots(2, 2, figsize=(9, 6.5), sharex=True)
-    specs = [(0, 1e3, "x (mm)"), (1, 1e3, "y (mm)"), (2, 1e3, "z (mm)"), (3, 180 / math.pi, "phi (deg)")]
-    for ax, (j, scale, label) in zip(axes.flat, specs):
-        ax.plot(r.t, scale * r.ref[:, j], "k-", lw=3, alpha=0.35, label="prescribed p'(t)")
-        ax.plot(r.t, scale * r.pose[:, j], "C3--", lw=1.2, label="plant FMU p(t)")
-        ax.set_ylabel(label)
-        ax.grid(True, alpha=0.3)
-    axes[0, 0].legend(loc="best", fontsize=8)
-    for ax in axes[1]:
-        ax.set_xlabel("time (s)")
     m, s = case
-    fig.suptitle("Auto-test through the FMUs: prescribed motion and the plant FMU driven open loop\n"
-                 f"by the inverse FMU's forces ({m} input, {s}, {H * 1e3:g} ms step; max error "
-                 f"{r.pos_err.max():.1e} m, {r.phi_err.max():.1e} rad)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    autotest_plots.plot_pose(
+        r.t, r.ref, r.pose, "plant FMU p(t)",
+        "Auto-test through the FMUs: prescribed motion and the plant FMU driven open loop\n"
+        f"by the inverse FMU's forces ({m} input, {s}, {H * 1e3:g} ms step; max error "
+        f"{r.pos_err.max():.1e} m, {r.phi_err.max():.1e} rad)", path)
 
 
 def plot_forces(Fh, F_static, path):
-    """F1..F4 from the inverse FMU at the half-step times and, below, their
-    dynamic part (minus the forces that hold the same pose at rest)."""
-    t = half_step_times()
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
-    for i in range(4):
-        axes[0].plot(t, Fh[:, i], label=f"$F_{i + 1}$")
-        axes[1].plot(t, 1e3 * (Fh[:, i] - F_static[:, i]), label=f"$F_{i + 1} - F_{{{i + 1},static}}$")
-    axes[0].set_ylabel("actuator force (N)")
-    axes[0].set_title("Auto-test: actuator forces from the inverse FMU (PKM4PUU_Inverse)")
-    axes[1].set_ylabel("dynamic part (mN)")
-    axes[1].set_title("minus the forces that hold the same pose at rest (inverse FMU, zero velocity "
-                      "and acceleration)", fontsize=9)
-    axes[1].set_xlabel("time (s)")
-    for ax in axes:
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="best", ncol=4, fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    """F1..F4 from the inverse FMU at the half-step times, and their dynamic part."""
+    autotest_plots.plot_forces(half_step_times(), Fh, F_static,
+                               "Auto-test: actuator forces from the inverse FMU (PKM4PUU_Inverse)", path)
 
 
 def write_results(runs, Fh, inverse_fmu, out_dir):

@@ -14,48 +14,20 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from autotest_plots import plot_forces, plot_pose  # noqa: E402
+
 
 def load(path):
     data = np.genfromtxt(path, delimiter=",", names=True)
     return {name: data[name] for name in data.dtype.names}
 
 
-def plot_forces(d, out):
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
-    t = d["t_s"]
-    for i in range(1, 5):
-        axes[0].plot(t, d[f"F{i}_N"], label=f"$F_{i}$")
-        axes[1].plot(t, 1e3 * (d[f"F{i}_N"] - d[f"F{i}_static_N"]), label=f"$F_{i} - F_{{{i},static}}$")
-    axes[0].set_ylabel("actuator force (N)")
-    axes[0].set_title("Auto-test: actuator forces from inverse dynamics (Eqs. 10-11)")
-    axes[1].set_ylabel("dynamic part (mN)")
-    axes[1].set_title("minus the forces that hold the same pose at rest", fontsize=9)
-    axes[1].set_xlabel("time (s)")
-    for ax in axes:
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="best", ncol=4, fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+def unit(name):
+    return "rad" if name == "phi" else "m"
 
 
-def plot_pose(d, out):
-    fig, axes = plt.subplots(2, 2, figsize=(9, 6.5), sharex=True)
-    t = d["t_s"]
-    specs = [("x", 1e3, "x (mm)"), ("y", 1e3, "y (mm)"), ("z", 1e3, "z (mm)"), ("phi", 180 / np.pi, "phi (deg)")]
-    unit = {"x": "m", "y": "m", "z": "m", "phi": "rad"}
-    for ax, (name, scale, label) in zip(axes.flat, specs):
-        ax.plot(t, scale * d[f"{name}_ref_{unit[name]}"], "k-", lw=3, alpha=0.35, label="prescribed p'(t)")
-        ax.plot(t, scale * d[f"{name}_{unit[name]}"], "C3--", lw=1.2, label="forward dynamics p(t)")
-        ax.set_ylabel(label)
-        ax.grid(True, alpha=0.3)
-    axes[0, 0].legend(loc="best", fontsize=8)
-    for ax in axes[1]:
-        ax.set_xlabel("time (s)")
-    fig.suptitle("Auto-test: prescribed motion and forward dynamics driven by the computed forces")
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+def pose_columns(d, suffix):
+    return np.stack([d[f"{n}{suffix}_{unit(n)}"] for n in ("x", "y", "z", "phi")], axis=1)
 
 
 def plot_errors(runs, out):
@@ -93,8 +65,14 @@ def main():
         print(f"plot_autotest: no autotest_*.csv in {res}", file=sys.stderr)
         return 1
     first = runs[0][1]
-    plot_forces(first, res / "autotest_forces.png")
-    plot_pose(first, res / "autotest_pose.png")
+    t = first["t_s"]
+    F = np.stack([first[f"F{i}_N"] for i in range(1, 5)], axis=1)
+    F_static = np.stack([first[f"F{i}_static_N"] for i in range(1, 5)], axis=1)
+    plot_forces(t, F, F_static, "Auto-test: actuator forces from inverse dynamics (Eqs. 10-11)",
+                res / "autotest_forces.png")
+    plot_pose(t, pose_columns(first, "_ref"), pose_columns(first, ""), "forward dynamics p(t)",
+              "Auto-test: prescribed motion and forward dynamics driven by the computed forces",
+              res / "autotest_pose.png")
     plot_errors(runs, res / "autotest_errors.png")
     for f in ("autotest_forces.png", "autotest_pose.png", "autotest_errors.png"):
         print(f"wrote {res / f}")
