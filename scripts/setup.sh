@@ -8,7 +8,8 @@ log() { echo "setup: $*" >&2; }
 
 # 1. Debian packages.
 packages=(build-essential cmake ninja-build libeigen3-dev libsundials-dev libgtest-dev
-          python3 python3-venv python3-pip)
+          python3 python3-venv python3-pip
+          clang libclang-rt-14-dev valgrind)  # hardening: libFuzzer + sanitizers (fuzz/), memcheck
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

@@ -60,6 +60,12 @@ typedef struct {
   double atol;     /* default 1e-10 */
   int cvode_method; /* pkm_cvode_method, default Adams */
   int formulation;  /* pkm_formulation, default leg-partitioned */
+  /* Singularity guards, checked at the end of every integration step (RK4:
+   * every step; CVODE: every pkm_advance*): a step ending beyond either is
+   * undone and PKM_ERR_SINGULAR returned (pkm_last_error names the leg or
+   * the condition number); the state stays at the last good point. */
+  double max_jacobian_condition; /* actuator Jacobian (phi column / 0.1 m), > 1, default 1e3 */
+  double min_leg_measure;        /* |cos(theta2) sin(theta2)| of every leg, in [0, 0.5), default 1e-2 */
 } pkm_solver_settings;
 
 /* Everything the FMU contract lists, at the current time. */
@@ -102,7 +108,9 @@ PKM_API const char* pkm_status_string(pkm_status s);
 PKM_API pkm_status pkm_set_solver(pkm_model* m, const pkm_solver_settings* s);
 
 /* Consistent initial state at time t0 from pose[4] and velocity[4]
- * (velocity may be NULL: at rest). */
+ * (velocity may be NULL: at rest). PKM_ERR_UNREACHABLE if a leg cannot
+ * reach elbow-down, PKM_ERR_SINGULAR beyond the singularity guards of the
+ * solver settings; pkm_last_error says which leg and why. */
 PKM_API pkm_status pkm_init_pose(pkm_model* m, double t0, const double pose[4],
                                  const double velocity[4]);
 

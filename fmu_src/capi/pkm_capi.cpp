@@ -102,6 +102,8 @@ void pkm_default_solver_settings(pkm_solver_settings* c) {
   c->atol = s.atol;
   c->cvode_method = static_cast<int>(s.cvode_method);
   c->formulation = static_cast<int>(s.formulation);
+  c->max_jacobian_condition = s.max_jacobian_condition;
+  c->min_leg_measure = s.min_leg_measure;
 }
 
 pkm_status pkm_create(const pkm_params* p, pkm_model** out, char* err, size_t err_len) {
@@ -156,6 +158,8 @@ pkm_status pkm_set_solver(pkm_model* m, const pkm_solver_settings* c) {
   s.atol = c->atol;
   s.cvode_method = static_cast<pkm::CvodeMethod>(c->cvode_method);
   s.formulation = static_cast<pkm::Formulation>(c->formulation);
+  s.max_jacobian_condition = c->max_jacobian_condition;
+  s.min_leg_measure = c->min_leg_measure;
   std::string why;
   if (m->plant.set_solver(s, &why) != Status::Ok) {
     m->error = why;

@@ -58,7 +58,7 @@ Status actuator_jacobian(const Model& m, const Vec16& q, Mat4& J) {
   const PlatformConfig pc = platform_config_from_q(q);
   for (int i = 0; i < kLegs; ++i) {
     const LegConfig c = leg_config_from_q(q, i);
-    if (leg_singularity_measure(m.p, c) < 1e-12) return Status::Singular;
+    if (leg_singularity_measure(m.p, c) < kLegSingularFloor) return Status::Singular;
     // C_i = 0 => L_i dq_i = P_i dpose; rho_i is the first row of L_i^{-1} P_i.
     const Mat3 Linv = leg_block(m, i, c).inverse();
     J.row(i) = Linv.row(0) * platform_point_jacobian(m, i, pc);

@@ -8,6 +8,7 @@
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 #include <cmath>
+#include <cstdio>
 
 namespace pkm {
 namespace {
@@ -68,6 +69,15 @@ Status CvodeIntegrator::init(CvodeMethod method, double rtol, double atol, Rhs r
   // Enough for a long communication interval at the natural step (~1 ms),
   // few enough that a run into a singularity fails in a fraction of a second.
   flag |= CVodeSetMaxNumSteps(mem_, 100000);
+  // No step below 1 ps: the mechanism's fastest motions take milliseconds;
+  // steps this small only occur when the trajectory runs into the edge of the
+  // workspace (a leg singularity) or the inputs are absurd. Without a floor
+  // CVODE creeps towards the edge in ever smaller steps until it has spent
+  // its 100000 (about 0.2 s per failing call, 5 s under the sanitizers);
+  // with it, such a call fails after a few hundred evaluations, at the same
+  // point. The floor is never reached by a step that succeeds otherwise, so
+  // regular results are unchanged, bit for bit.
+  flag |= CVodeSetMinStep(mem_, kMinStep);
   if (method == CvodeMethod::BDF) {
     A_ = SUNDenseMatrix(8, 8, ctx_);
     LS_ = SUNLinSol_Dense(y_, A_, ctx_);
@@ -97,6 +107,23 @@ Status CvodeIntegrator::advance(double t_out, Vec8& y_out) {
   const int flag = CVode(mem_, t_out, y_, &t_reached, CV_NORMAL);
   if (flag < 0) {
     needs_reset_ = true;  // its history is no longer trustworthy
+    return Status::SolverFailure;
+  }
+  // CVODE (6.4) can report success without having integrated: when the
+  // state derivative is so large that the initial step underflows to 0 it
+  // warns "t + h = t", takes zero-length steps up to the stop time, fails to
+  // interpolate there (ignored) and returns CV_SUCCESS with y unchanged.
+  // Accept only an interval that CVODE's own time really reached.
+  double t_cur = 0.0;
+  CVodeGetCurrentTime(mem_, &t_cur);
+  if (!(t_cur >= t_out - 1e-12 * (1.0 + std::fabs(t_out))) || !as_vec(y_).allFinite()) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "CVODE returned at t = %.17g without integrating past t = %.17g (step size underflow: "
+                  "the state derivative is too large)",
+                  t_out, t_cur);
+    error_ = buf;
+    needs_reset_ = true;
     return Status::SolverFailure;
   }
   y_out = as_vec(y_);

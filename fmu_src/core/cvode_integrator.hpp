@@ -19,6 +19,9 @@ namespace pkm {
 
 enum class CvodeMethod { Adams = 0, BDF = 1 };
 
+/// CVODE's smallest step, s (see cvode_integrator.cpp).
+constexpr double kMinStep = 1e-12;
+
 class CvodeIntegrator {
  public:
   /// ydot = rhs(t, y); returns 0 on success, > 0 for a recoverable failure

@@ -53,4 +53,9 @@ Status leg_inverse_kinematics(const Model& m, int leg, const PlatformConfig& pc,
 /// dimensionless measure of a leg singularity (link vertical or horizontal).
 double leg_singularity_measure(const Params& p, const LegConfig& c);
 
+/// Below this leg_singularity_measure a leg block is treated as singular
+/// whatever the user's limits say (workspace_guard.hpp): the state
+/// derivative, the servo Jacobian and the actuator Jacobian refuse it.
+constexpr double kLegSingularFloor = 1e-12;
+
 }  // namespace pkm

@@ -34,8 +34,8 @@ std::string validate(const Params& p) {
     if (!std::isfinite(e.value)) return describe(e.name, e.value, "is not finite");
     if (!(e.value > 0.0)) return describe(e.name, e.value, "must be positive");
   }
-  static const char* beta_names[] = {"beta[1]", "beta[2]", "beta[3]", "beta[4]"};
-  static const char* gamma_names[] = {"gamma[1]", "gamma[2]", "gamma[3]", "gamma[4]"};
+  static const char* const beta_names[] = {"beta[1]", "beta[2]", "beta[3]", "beta[4]"};
+  static const char* const gamma_names[] = {"gamma[1]", "gamma[2]", "gamma[3]", "gamma[4]"};
   for (int i = 0; i < 4; ++i) {
     if (!std::isfinite(p.beta[i])) return describe(beta_names[i], p.beta[i], "is not finite");
     if (!std::isfinite(p.gamma[i])) return describe(gamma_names[i], p.gamma[i], "is not finite");

@@ -1,7 +1,9 @@
 #include "plant.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "constraints.hpp"
 #include "lagrangian.hpp"
@@ -56,7 +58,7 @@ std::string validate(const SolverSettings& s) {
   if (s.formulation != Formulation::Augmented && s.formulation != Formulation::NullSpaceQR &&
       s.formulation != Formulation::LegPartitioned)
     return "formulation must be 0 (Eq. 12), 1 (Eq. 13, QR) or 2 (Eq. 13, leg-partitioned)";
-  return {};
+  return validate(s.limits());
 }
 
 Plant::Plant(const Model& model) : model_(model) {}
@@ -73,16 +75,35 @@ Status Plant::set_solver(const SolverSettings& s, std::string* error) {
 }
 
 Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
-  if (!std::isfinite(t0) || !pose.allFinite() || !velocity.allFinite()) return Status::NonFinite;
+  error_.clear();
+  if (!std::isfinite(t0) || !pose.allFinite() || !velocity.allFinite()) {
+    error_ = "the initial time, pose or velocity is not finite";
+    return Status::NonFinite;
+  }
+  Vec8 y;
+  y.head<4>() = pose;
+  y.tail<4>() = velocity;
+  Status s = guard(y, t0);  // reachable elbow-down, within the singularity limits
+  if (s != Status::Ok) return s;
   Vec16 q, qd;
-  Status s = closed_form_position(model_, pose, q);
+  s = closed_form_position(model_, pose, q);
   if (s != Status::Ok) return s;
   s = solve_position(model_, pose, q);  // Eqs. 2-4 (a polish: the closed form is exact)
-  if (s != Status::Ok) return s;
+  if (s != Status::Ok) {
+    error_ = "the position problem at the initial pose did not converge";
+    return s;
+  }
   s = solve_velocity(model_, q, velocity, qd);
   if (s != Status::Ok) return s;
-  y_.head<4>() = pose;
-  y_.tail<4>() = velocity;
+  // The state derivative must exist there (with no inputs): a velocity so
+  // large that the Coriolis terms overflow is refused here, not at the first step.
+  Vec8 ydot;
+  s = state_derivative(model_, settings_.formulation, y, Vec16::Zero(), ydot);
+  if (s != Status::Ok || !ydot.allFinite()) {
+    error_ = "the state derivative at the initial state is not finite (initial velocity too large?)";
+    return Status::NonFinite;
+  }
+  y_ = y;
   t_ = t0;
   for (int i = 0; i < kLegs; ++i) theta1_ref_[i] = q[leg_offset(i) + 1];
   theta1_stale_ = false;
@@ -93,8 +114,10 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
   if (!std::isfinite(t) || !y.allFinite() || !theta1_ref.allFinite()) return Status::NonFinite;
+  Status s = guard(y, t);
+  if (s != Status::Ok) return s;
   Vec16 q, qd;
-  const Status s = expand_state(model_, y, q, qd);
+  s = expand_state(model_, y, q, qd);
   if (s != Status::Ok) return s;
   t_ = t;
   y_ = y;
@@ -108,32 +131,72 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
 Status Plant::derivative(double t, const Vec8& y, Vec8& ydot) {
   Vec4 F;
   Wrench we;
-  read_inputs(inputs_, t, F, we);
   ++rhs_count_;
-  return state_derivative(model_, settings_.formulation, y, generalized_forces(F, we), ydot);
+  // A non-finite trial time or state is the integrator's (a step size
+  // computed from absurd accelerations), not the inputs': the step fails,
+  // the state is kept.
+  if (!std::isfinite(t)) return Status::SolverFailure;
+  read_inputs(inputs_, t, F, we);
+  if (!F.allFinite() || !we.allFinite()) return Status::NonFinite;  // the inputs' fault
+  const Status s = state_derivative(model_, settings_.formulation, y, generalized_forces(F, we), ydot);
+  return s == Status::NonFinite ? Status::SolverFailure : s;  // finite inputs: the trial state was not
 }
 
 int Plant::cvode_rhs(double t, const Vec8& y, Vec8& ydot, void* self) {
   auto* me = static_cast<Plant*>(self);
   const Status s = me->derivative(t, y, ydot);
   me->rhs_status_ = s;
-  // A trial state off the workspace may be CVODE's overshoot: let it retry
-  // with a smaller step (recoverable); anything else aborts.
+  // A trial state off the workspace (or not finite) may be CVODE's
+  // overshoot: let it retry with a smaller step (recoverable); non-finite
+  // inputs abort.
   if (s == Status::Ok) return 0;
-  return (s == Status::Unreachable || s == Status::Singular) ? 1 : -1;
+  return (s == Status::Unreachable || s == Status::Singular || s == Status::SolverFailure) ? 1 : -1;
+}
+
+Status Plant::guard(const Vec8& y, double t) {
+  GuardReport report;
+  const Status s = check_configuration(model_, y.head<4>(), settings_.limits(), &report);
+  if (s == Status::Ok) return s;
+  char at[64];
+  std::snprintf(at, sizeof at, "at t = %.17g s: ", t);
+  error_ = at + describe_configuration_failure(model_, y.head<4>(), settings_.limits(), report);
+  return s;
 }
 
 Status Plant::advance_rk4(double t_end) {
   const double span = t_end - t_;
-  const long n = std::max(1L, static_cast<long>(std::ceil(span / settings_.rk4_step - 1e-9)));
+  const double steps = std::ceil(span / settings_.rk4_step - 1e-9);
+  if (!(steps <= kMaxRk4StepsPerAdvance)) {  // also NaN
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "an interval of %.6g s needs %.3g RK4 steps of rk4_step = %.6g s, more than %.0e: "
+                  "use shorter intervals or a larger rk4_step",
+                  span, steps, settings_.rk4_step, kMaxRk4StepsPerAdvance);
+    error_ = buf;
+    return Status::InvalidArgument;
+  }
+  const long n = std::max(1L, static_cast<long>(steps));
   const double h = span / static_cast<double>(n);
   auto f = [this](double t, const Vec8& y, Vec8& ydot) { return derivative(t, y, ydot); };
   const double t0 = t_;
   for (long k = 0; k < n; ++k) {
     const double tk = (k == 0) ? t0 : t0 + static_cast<double>(k) * h;
-    const Status s = rk4_step(f, tk, h, y_);
-    if (s != Status::Ok) return s;
-    t_ = (k + 1 == n) ? t_end : t0 + static_cast<double>(k + 1) * h;
+    const Vec8 before = y_;
+    Status s = rk4_step(f, tk, h, y_);
+    if (s != Status::Ok) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "the RK4 step from t = %.17g s could not be evaluated: %s", tk,
+                    status_name(s));
+      error_ = buf;
+      return s;
+    }
+    const double t_next = (k + 1 == n) ? t_end : t0 + static_cast<double>(k + 1) * h;
+    s = guard(y_, t_next);  // every step ends within the limits, or is undone
+    if (s != Status::Ok) {
+      y_ = before;
+      return s;
+    }
+    t_ = t_next;
   }
   return Status::Ok;
 }
@@ -155,11 +218,16 @@ Status Plant::advance_cvode(double t_end, bool continuous) {
   }
   Vec8 y = y_;
   rhs_status_ = Status::Ok;
-  const Status s = cvode_.advance(t_end, y);
+  Status s = cvode_.advance(t_end, y);
   if (s != Status::Ok) {
     error_ = cvode_.last_error();
     cvode_.reset(t_, y_);
     return rhs_status_ != Status::Ok ? rhs_status_ : s;
+  }
+  s = guard(y, t_end);  // the interval ends within the limits, or is undone
+  if (s != Status::Ok) {
+    cvode_.reset(t_, y_);
+    return s;
   }
   y_ = y;
   t_ = t_end;

@@ -7,6 +7,7 @@
 
 #include "cvode_integrator.hpp"
 #include "minimal_state.hpp"
+#include "workspace_guard.hpp"
 
 namespace pkm {
 
@@ -19,7 +20,18 @@ struct SolverSettings {
   double atol = 1e-10;     // CVODE
   CvodeMethod cvode_method = CvodeMethod::Adams;
   Formulation formulation = Formulation::LegPartitioned;
+  // Singularity guards (workspace_guard.hpp), checked at the end of every
+  // step: a step ending beyond either is undone and reported (Status::Singular).
+  double max_jacobian_condition = GuardLimits{}.max_jacobian_condition;
+  double min_leg_measure = GuardLimits{}.min_leg_measure;
+
+  GuardLimits limits() const { return {max_jacobian_condition, min_leg_measure}; }
 };
+
+/// At most this many RK4 steps in one advance (a longer interval or a
+/// smaller rk4_step is refused with Status::InvalidArgument before any
+/// work: about 25 s of computing at 2.5 us per step).
+constexpr double kMaxRk4StepsPerAdvance = 1e7;
 
 /// Returns "" if the settings are usable, otherwise a message naming the
 /// offending setting.
@@ -51,22 +63,29 @@ class Plant {
   const SolverSettings& solver() const { return settings_; }
 
   /// Consistent initial state at time t0 from a pose and a velocity
-  /// (position and velocity problems). Status::Unreachable or ::Singular
-  /// if the pose cannot be assembled elbow-down.
+  /// (position and velocity problems). Status::Unreachable if the pose
+  /// cannot be assembled elbow-down, ::Singular if it lies beyond the
+  /// singularity limits of the solver settings, ::NonFinite if the state
+  /// derivative there is not finite (velocity far too large); last_error()
+  /// says which leg and why. On failure nothing changes.
   Status initialize(double t0, const Pose& pose, const Pose& velocity);
 
   /// Integrates to t_end with the given inputs. `continuous` tells that the
   /// inputs continue smoothly those of the previous call (CVODE keeps its
   /// history); otherwise CVODE restarts at the current time. On failure the
   /// state stays at the last point reached successfully (RK4: the last
-  /// whole step; CVODE: the start of the call).
+  /// whole step; CVODE: the start of the call). Every step's end state is
+  /// checked against the singularity limits (check_configuration): a step
+  /// ending beyond them is undone and Status::Singular (or ::Unreachable)
+  /// returned, with last_error() naming the leg or the condition number.
   Status advance(double t_end, const InputSignal& inputs, bool continuous = false);
 
   bool initialized() const { return initialized_; }
   double time() const { return t_; }
   /// The integrated state [pose; velocity].
   const Vec8& state() const { return y_; }
-  /// Restores a state saved earlier (time, y, theta1 continuity).
+  /// Restores a state saved earlier (time, y, theta1 continuity); refused
+  /// (nothing changes) if y lies beyond the singularity limits.
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref);
 
   /// q, qd, qdd and lambda at the current time, for the inputs at that time
@@ -91,6 +110,9 @@ class Plant {
   Status derivative(double t, const Vec8& y, Vec8& ydot);
   Status advance_rk4(double t_end);
   Status advance_cvode(double t_end, bool continuous);
+  /// check_configuration of y's pose against the settings' limits; on
+  /// failure error_ describes it.
+  Status guard(const Vec8& y, double t);
   void update_theta1_ref() const;
 
   Model model_;

@@ -9,7 +9,7 @@ Status ServoJacobian::factor(const Model& m, const Vec16& q) {
   if (!q.allFinite()) return Status::NonFinite;
   // det Phi_q is the product of the four leg blocks' determinants.
   for (int i = 0; i < kLegs; ++i)
-    if (leg_singularity_measure(m.p, leg_config_from_q(q, i)) < 1e-12) return Status::Singular;
+    if (leg_singularity_measure(m.p, leg_config_from_q(q, i)) < kLegSingularFloor) return Status::Singular;
   Mat16 A = Mat16::Zero();
   Mat12x16 Cq;
   constraint_jacobian(m, q, Cq);

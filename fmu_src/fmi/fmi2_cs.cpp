@@ -77,12 +77,18 @@ void write_le64(unsigned char* p, std::uint64_t v) {
   for (int i = 0; i < 8; ++i) p[i] = static_cast<unsigned char>(v >> (8 * i));
 }
 
+}  // namespace
+
 // The in-memory FMU state: its serialised form (so that get/set and
-// serialise/deserialise share one code path and one format).
+// serialise/deserialise share one code path and one format), and the
+// instance that created it (fmi2FreeInstance frees the states it created).
 struct SavedState {
   std::uint64_t tag = kStateTag;
   std::vector<unsigned char> bytes;
+  Instance* owner = nullptr;
 };
+
+namespace {
 
 SavedState* as_state(fmi2FMUstate s) {
   auto* p = static_cast<SavedState*>(s);
@@ -314,7 +320,20 @@ Instance::Instance(const ModelDefinition& def, Logger log)
     : tag_(kInstanceTag), def_(def), log_(std::move(log)) {}
 
 Instance::~Instance() {
+  // FMI 2.0: fmi2FreeInstance frees everything the instance allocated,
+  // including FMU states the importer did not free.
+  for (SavedState* s : states_) {
+    *static_cast<volatile std::uint64_t*>(&s->tag) = 0;
+    delete s;
+  }
   *static_cast<volatile std::uint64_t*>(&tag_) = 0;  // a dangling handle is no longer taken for an instance
+}
+
+SavedState* Instance::new_state() {
+  auto owned = std::make_unique<SavedState>();
+  owned->owner = this;
+  states_.insert(owned.get());  // may throw: then nothing leaks
+  return owned.release();
 }
 
 Instance* Instance::from(fmi2Component c) {
@@ -322,7 +341,7 @@ Instance* Instance::from(fmi2Component c) {
   return (i && i->tag_ == kInstanceTag) ? i : nullptr;
 }
 
-Instance* Instance::instantiate(const ModelDefinition& def, fmi2String instance_name, fmi2Type type,
+Instance* Instance::instantiate(const ModelDefinition& def, fmi2String instance_name, int type,
                                 fmi2String guid, fmi2String resource_location,
                                 const fmi2CallbackFunctions* functions, fmi2Boolean visible,
                                 fmi2Boolean logging_on) {
@@ -469,6 +488,7 @@ fmi2Status Instance::reset() {
   if (!allowed(kMaskReset, "fmi2Reset")) return fmi2Error;
   apply_start_values();
   data_->reset();
+  input_derivatives_set_ = false;
   mode_ = kInstantiated;
   start_time_ = stop_time_ = time_ = last_successful_time_ = 0.0;
   stop_time_defined_ = false;
@@ -740,6 +760,7 @@ bool Instance::load(const std::vector<unsigned char>& bytes, const char* functio
     const Variable& v = def_.variables[i];
     if (v.derivative) *static_cast<double*>(v.derivative(*data_, v.index)) = values[k++];
   }
+  input_derivatives_set_ = true;  // the restored state may carry derivatives
   mode_ = mode;
   stop_time_defined_ = stop_defined;
   terminated_ = terminated;
@@ -771,7 +792,7 @@ fmi2Status Instance::get_fmu_state(fmi2FMUstate* state) {
       return fmi2Error;
     }
   } else {
-    s = new SavedState();
+    s = new_state();
     *state = s;
   }
   save(s->bytes);
@@ -799,6 +820,7 @@ fmi2Status Instance::free_fmu_state(fmi2FMUstate* state) {
     log_.error("fmi2FreeFMUstate: not an FMU state of this FMU");
     return fmi2Error;
   }
+  if (s->owner) s->owner->forget_state(s);  // freed through another instance of this FMU: its creator forgets it
   *static_cast<volatile std::uint64_t*>(&s->tag) = 0;
   delete s;
   *state = nullptr;
@@ -840,8 +862,9 @@ fmi2Status Instance::deserialize_fmu_state(const fmi2Byte bytes[], std::size_t s
   }
   const auto* p = reinterpret_cast<const unsigned char*>(bytes);
   if (!check_header(p, size, "fmi2DeSerializeFMUstate")) return fmi2Error;
-  auto* s = new SavedState();
-  s->bytes.assign(p, p + size);
+  std::vector<unsigned char> copy(p, p + size);
+  SavedState* s = new_state();
+  s->bytes.swap(copy);
   *state = s;
   return fmi2OK;
 }
@@ -858,7 +881,7 @@ fmi2Status Instance::get_directional_derivative(const fmi2ValueReference[], std:
 
 fmi2Status Instance::set_real_input_derivatives(const fmi2ValueReference vr[], std::size_t n,
                                                 const fmi2Integer order[], const fmi2Real value[]) {
-  static const char* fn = "fmi2SetRealInputDerivatives";
+  static const char* const fn = "fmi2SetRealInputDerivatives";
   if (!allowed(kMaskInputDerivatives, fn)) return fmi2Error;
   if (!def_.can_interpolate_inputs) {
     log_.error("%s: %s does not interpolate inputs (canInterpolateInputs = false)", fn, def_.identifier);
@@ -891,6 +914,7 @@ fmi2Status Instance::set_real_input_derivatives(const fmi2ValueReference vr[], s
     if (order[k] != 1) continue;
     const Variable* v = def_.find(vr[k]);
     *static_cast<double*>(v->derivative(*data_, v->index)) = value[k];
+    input_derivatives_set_ = true;
     if (log_.enabled(LogCategory::All)) log_.trace("%s: d%s/dt = %.17g", fn, v->name, value[k]);
   }
   if (higher) {
@@ -912,12 +936,41 @@ fmi2Status Instance::do_step(fmi2Real t, fmi2Real h, fmi2Boolean no_set_fmu_stat
   (void)no_set_fmu_state_prior;
   if (log_.enabled(LogCategory::All)) log_.trace("fmi2DoStep(%.17g, %.17g)", t, h);
   if (!std::isfinite(h) || !(h > 0.0)) {
-    log_.error("fmi2DoStep: communicationStepSize = %g must be positive and finite", h);
+    log_.error("fmi2DoStep: communicationStepSize = %g must be positive and finite; the call has no effect", h);
     return fmi2Error;
   }
   const double tolerance = 1e-9 * std::max(1.0, std::abs(time_));
   if (!std::isfinite(t) || std::abs(t - time_) > tolerance) {
-    log_.error("fmi2DoStep: currentCommunicationPoint = %.17g differs from the FMU's time %.17g", t, time_);
+    log_.error("fmi2DoStep: currentCommunicationPoint = %.17g differs from the FMU's time %.17g; the call has no "
+               "effect",
+               t, time_);
+    return fmi2Error;
+  }
+  if (!std::isfinite(t + h)) {
+    log_.error("fmi2DoStep: currentCommunicationPoint + communicationStepSize = %g is not finite; the call has no "
+               "effect",
+               t + h);
+    return fmi2Error;
+  }
+  // Inputs interpolated with their derivatives must stay finite over the step
+  // (only once a derivative was ever set: the loop is not free).
+  for (std::size_t i = 0; input_derivatives_set_ && i < def_.n_variables; ++i) {
+    const Variable& v = def_.variables[i];
+    if (!v.derivative) continue;
+    const double u = *static_cast<double*>(v.value(*data_, v.index));
+    const double du = *static_cast<double*>(v.derivative(*data_, v.index));
+    if (!std::isfinite(u + du * h)) {
+      log_.error("fmi2DoStep: input %s extrapolated with its derivative %g to t = %.17g is not finite; the call has "
+                 "no effect",
+                 v.name, du, t + h);
+      return fmi2Error;
+    }
+  }
+  // FMI 2.0, fmi2SetupExperiment: computing past a defined stopTime is an error.
+  if (stop_time_defined_ && t + h > stop_time_ + 1e-9 * std::max(1.0, std::abs(stop_time_))) {
+    log_.error("fmi2DoStep: the step to t = %.17g would pass stopTime = %.17g (fmi2SetupExperiment); the call has "
+               "no effect",
+               t + h, stop_time_);
     return fmi2Error;
   }
   Context ctx = context();
@@ -949,7 +1002,7 @@ fmi2Status Instance::cancel_step() {
   return fmi2Error;  // unreachable: fmi2DoStep never returns fmi2Pending
 }
 
-fmi2Status Instance::get_status(fmi2StatusKind kind, fmi2Status* value) {
+fmi2Status Instance::get_status(int kind, fmi2Status* value) {
   if (!allowed(kMaskStatus, "fmi2GetStatus")) return fmi2Error;
   if (!value) {
     log_.error("fmi2GetStatus: value is NULL");
@@ -962,7 +1015,7 @@ fmi2Status Instance::get_status(fmi2StatusKind kind, fmi2Status* value) {
   return fmi2Discard;
 }
 
-fmi2Status Instance::get_real_status(fmi2StatusKind kind, fmi2Real* value) {
+fmi2Status Instance::get_real_status(int kind, fmi2Real* value) {
   if (!allowed(kMaskStatus, "fmi2GetRealStatus")) return fmi2Error;
   if (!value) {
     log_.error("fmi2GetRealStatus: value is NULL");
@@ -975,13 +1028,13 @@ fmi2Status Instance::get_real_status(fmi2StatusKind kind, fmi2Real* value) {
   return fmi2Discard;
 }
 
-fmi2Status Instance::get_integer_status(fmi2StatusKind, fmi2Integer* value) {
+fmi2Status Instance::get_integer_status(int, fmi2Integer* value) {
   if (!allowed(kMaskStatus, "fmi2GetIntegerStatus")) return fmi2Error;
   (void)value;
   return fmi2Discard;  // no integer status is defined for FMI 2.0 co-simulation
 }
 
-fmi2Status Instance::get_boolean_status(fmi2StatusKind kind, fmi2Boolean* value) {
+fmi2Status Instance::get_boolean_status(int kind, fmi2Boolean* value) {
   if (!allowed(kMaskStatus, "fmi2GetBooleanStatus")) return fmi2Error;
   if (!value) {
     log_.error("fmi2GetBooleanStatus: value is NULL");
@@ -994,7 +1047,7 @@ fmi2Status Instance::get_boolean_status(fmi2StatusKind kind, fmi2Boolean* value)
   return fmi2Discard;
 }
 
-fmi2Status Instance::get_string_status(fmi2StatusKind, fmi2String* value) {
+fmi2Status Instance::get_string_status(int, fmi2String* value) {
   if (!allowed(kMaskStatus, "fmi2GetStringStatus")) return fmi2Error;
   (void)value;
   return fmi2Discard;  // fmi2PendingStatus: never pending

@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "fmi2Functions.h"
@@ -38,6 +39,8 @@ const char* xml_name(Variability v);
 const char* xml_name(Initial i);
 
 class ModelData;
+class Instance;
+struct SavedState;  // an FMU state (fmi2_cs.cpp)
 
 /// Where a variable lives in an instance's data: returns a pointer to a
 /// double (Real), fmi2Integer (Integer) or fmi2Boolean (Boolean). `index`
@@ -287,7 +290,10 @@ constexpr bool sorted_by_vr(const Variable* v, std::size_t n) {
 class Instance {
  public:
   /// nullptr on failure (logged through functions->logger if there is one).
-  static Instance* instantiate(const ModelDefinition& def, fmi2String instance_name, fmi2Type type,
+  /// `type` and the status kinds below are the C enums' values as int: an
+  /// importer written in C may pass any int, which a C++ enum parameter
+  /// must not hold (fmi2_functions.cpp reads them as int at the boundary).
+  static Instance* instantiate(const ModelDefinition& def, fmi2String instance_name, int type,
                                fmi2String guid, fmi2String resource_location,
                                const fmi2CallbackFunctions* functions, fmi2Boolean visible,
                                fmi2Boolean logging_on);
@@ -332,11 +338,11 @@ class Instance {
   fmi2Status do_step(fmi2Real current_communication_point, fmi2Real step_size,
                      fmi2Boolean no_set_fmu_state_prior);
   fmi2Status cancel_step();
-  fmi2Status get_status(fmi2StatusKind kind, fmi2Status* value);
-  fmi2Status get_real_status(fmi2StatusKind kind, fmi2Real* value);
-  fmi2Status get_integer_status(fmi2StatusKind kind, fmi2Integer* value);
-  fmi2Status get_boolean_status(fmi2StatusKind kind, fmi2Boolean* value);
-  fmi2Status get_string_status(fmi2StatusKind kind, fmi2String* value);
+  fmi2Status get_status(int kind, fmi2Status* value);
+  fmi2Status get_real_status(int kind, fmi2Real* value);
+  fmi2Status get_integer_status(int kind, fmi2Integer* value);
+  fmi2Status get_boolean_status(int kind, fmi2Boolean* value);
+  fmi2Status get_string_status(int kind, fmi2String* value);
 
   /// Turns an exception escaping a method into fmi2Error (never across the C ABI).
   fmi2Status internal_error(const char* function, const char* what);
@@ -361,6 +367,9 @@ class Instance {
                         std::size_t n, const T value[]);
   const Variable* lookup(const char* function, VarType type, fmi2ValueReference vr);
 
+  /// A new FMU state owned by this instance (freed with it if the importer does not).
+  SavedState* new_state();
+
   void save(std::vector<unsigned char>& out) const;
   bool check_header(const unsigned char* bytes, std::size_t size, const char* function);
   bool load(const std::vector<unsigned char>& bytes, const char* function);
@@ -377,6 +386,12 @@ class Instance {
   double last_successful_time_ = 0.0;   // fmi2LastSuccessfulTime
   bool terminated_ = false;             // fmi2Terminated (set after a discarded step)
   bool outputs_valid_ = false;          // computed variables up to date
+  bool input_derivatives_set_ = false;  // fmi2SetRealInputDerivatives was used (or a state restored)
+  std::unordered_set<SavedState*> states_;  // FMU states this instance created and nobody freed yet
+
+ public:
+  /// Forgets a state freed through any instance (fmi2FreeFMUstate).
+  void forget_state(SavedState* s) { states_.erase(s); }
 };
 
 }  // namespace pkm_fmi

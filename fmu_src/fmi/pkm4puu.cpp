@@ -45,6 +45,8 @@ struct PlantData final : MechanismData {
   double atol = kDefaultSolver.atol;
   fmi2Integer cvode_method = static_cast<fmi2Integer>(kDefaultSolver.cvode_method);
   fmi2Integer formulation = static_cast<fmi2Integer>(kDefaultSolver.formulation);
+  double max_jacobian_condition = kDefaultSolver.max_jacobian_condition;
+  double min_leg_measure = kDefaultSolver.min_leg_measure;
   // Inputs u = [F1..F4, Fe1..Fe3, Me_z] at the current time, and du/dt.
   double u[8] = {};
   double du[8] = {};
@@ -98,6 +100,8 @@ fmi2Status PlantData::make_plant(Context& ctx, const char* function, std::unique
   s.atol = atol;
   s.cvode_method = static_cast<pkm::CvodeMethod>(cvode_method);
   s.formulation = static_cast<pkm::Formulation>(formulation);
+  s.max_jacobian_condition = max_jacobian_condition;
+  s.min_leg_measure = min_leg_measure;
   auto plant_new = std::make_unique<pkm::Plant>(model);
   if (plant_new->set_solver(s, &why) != pkm::Status::Ok) {
     ctx.log.error("%s: parameter %s", function, why.c_str());
@@ -115,10 +119,13 @@ fmi2Status PlantData::build(Context& ctx, const char* function) {
   const pkm::Pose vel_0(vel0[0], vel0[1], vel0[2], vel0[3]);
   const pkm::Status s = p->initialize(ctx.start_time, pose_0, vel_0);
   if (s != pkm::Status::Ok) {
-    ctx.log.error("%s: the initial pose x0 = %g m, y0 = %g m, z0 = %g m, phi0 = %g rad (velocity dx0 = %g, dy0 = %g, "
-                  "dz0 = %g m/s, dphi0 = %g rad/s) cannot be assembled elbow-down: %s",
-                  function, pose0[0], pose0[1], pose0[2], pose0[3], vel0[0], vel0[1], vel0[2], vel0[3],
-                  pkm::status_name(s));
+    const char* what = s == pkm::Status::Unreachable ? "cannot be assembled elbow-down"
+                       : s == pkm::Status::Singular  ? "lies beyond the singularity limits"
+                                                     : "cannot be used";
+    ctx.log.error("%s: the initial state x0 = %.9g m, y0 = %.9g m, z0 = %.9g m, phi0 = %.9g rad (velocity dx0 = %g, "
+                  "dy0 = %g, dz0 = %g m/s, dphi0 = %g rad/s) %s: %s: %s",
+                  function, pose0[0], pose0[1], pose0[2], pose0[3], vel0[0], vel0[1], vel0[2], vel0[3], what,
+                  pkm::status_name(s), p->last_error().c_str());
     return fmi2Error;
   }
   plant = std::move(p);
@@ -164,15 +171,18 @@ fmi2Status PlantData::do_step(Context& ctx, double t, double h, double& t_reache
     case pkm::Status::Unreachable:
     case pkm::Status::Singular:
     case pkm::Status::NotConverged:
-      // The plant kept its last good state (RK4: last whole step; CVODE: the step start).
+      // The plant kept its last good state (RK4: last whole step; CVODE: the
+      // step start), within the singularity limits. fmi2Terminated is set by
+      // the generic layer: a master stops at fmi2LastSuccessfulTime instead
+      // of retrying the same step.
       ctx.log.discard("fmi2DoStep: integration from t = %.17g to %.17g failed (%s%s%s); the state is kept at "
-                      "t = %.17g",
+                      "t = %.17g (fmi2LastSuccessfulTime), fmi2Terminated = true",
                       t_start, t_end, pkm::status_name(s), plant->last_error().empty() ? "" : ": ",
                       plant->last_error().c_str(), t_reached);
       return fmi2Discard;
     default:
-      ctx.log.error("fmi2DoStep: integration from t = %.17g to %.17g failed: %s", t_start, t_end,
-                    pkm::status_name(s));
+      ctx.log.error("fmi2DoStep: integration from t = %.17g to %.17g failed: %s%s%s", t_start, t_end,
+                    pkm::status_name(s), plant->last_error().empty() ? "" : ": ", plant->last_error().c_str());
       return fmi2Error;
   }
 }
@@ -328,6 +338,14 @@ constexpr Variable kVariables[] = {
                     "Forward dynamics: 0 = augmented saddle-point system (Eq. 12), 1 = null-space projection with a QR "
                     "(Eq. 13), 2 = null space from the leg blocks (Eq. 13, leg-partitioned)",
                     PLANT_SCALAR(formulation)),
+  real_parameter(146, "max_jacobian_condition", kDefaultSolver.max_jacobian_condition, "",
+                 "Parallel-singularity guard: a step whose end state has an actuator Jacobian condition number "
+                 "(phi column divided by 0.1 m) above this is discarded (fmi2Discard, state kept); > 1",
+                 PLANT_SCALAR(max_jacobian_condition), 0),
+  real_parameter(147, "min_leg_measure", kDefaultSolver.min_leg_measure, "",
+                 "Leg-singularity guard: a step whose end state has |cos(theta2) sin(theta2)| of a leg below this "
+                 "(rod nearly horizontal or vertical) is discarded (fmi2Discard, state kept); in [0, 0.5)",
+                 PLANT_SCALAR(min_leg_measure), 0),
 };
 // clang-format on
 
@@ -351,8 +369,10 @@ const ModelDefinition kDefinition{
     "work elbow-down (the platform hangs below the rods).</p>"
     "<p>Each communication step is integrated by CVODE (default; restarted at every step, so results depend only "
     "on the state and inputs at the step start) or by fixed-step RK4. The inputs can be interpolated linearly "
-    "within a step (fmi2SetRealInputDerivatives, order 1). A step that cannot be completed returns fmi2Discard "
-    "with the state kept at fmi2LastSuccessfulTime. FMU states can be saved, restored and serialised.</p>",
+    "within a step (fmi2SetRealInputDerivatives, order 1). A step that cannot be completed, or that ends near a "
+    "leg singularity (min_leg_measure) or a parallel singularity (max_jacobian_condition), returns fmi2Discard "
+    "with the last good state kept at fmi2LastSuccessfulTime and fmi2Terminated = true. FMU states can be saved, "
+    "restored and serialised.</p>",
     kVariables,
     std::size(kVariables),
     /*can_interpolate_inputs=*/true,

@@ -1,0 +1,666 @@
+// Coverage-guided fuzzing (libFuzzer, under AddressSanitizer and
+// UndefinedBehaviorSanitizer) of the FMI 2.0 layer: random sequences of FMI
+// calls with random arguments on up to three instances of the two FMUs,
+// linked in-process (the same sources as PKM4PUU.so and PKM4PUU_Inverse.so;
+// the exported functions are compiled twice, once per model, with the
+// prefixes PKM4PUU_ and PKM4PUU_Inverse_).
+//
+// Each input is decoded (FuzzedDataProvider) into at most kMaxOps operations:
+// any FMI function, in any state, with value references from the model's
+// table or arbitrary ones, values from a list of awkward numbers (NaN, +-Inf,
+// 0, -0, denormals, 1e300, DBL_MAX, ...) or raw bytes, NULL pointers,
+// foreign pointers, FMU states (saved, freed, serialised, corrupted, taken
+// to another instance), and two macro operations that bring an instance
+// into its stepping state and run it, so that deep states are reached fast.
+//
+// Besides the sanitizers, the harness checks the FMU's promises (a
+// violation aborts, i.e. is a finding):
+//   - no fmi2GetReal that returns fmi2OK or fmi2Warning hands out NaN or Inf;
+//   - nothing is written outside the buffers the FMU was given (guard zones);
+//   - after fmi2Discard: fmi2GetBooleanStatus(fmi2Terminated) is fmi2True and
+//     fmi2GetRealStatus(fmi2LastSuccessfulTime) lies in [t, t + h];
+//   - the logger receives a message that is safe as a printf format.
+// At exit it prints how many FMI calls were made (PKM_FUZZ_CALLS=...).
+#include <chrono>
+#include <cmath>
+#include <cstdarg>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <fuzzer/FuzzedDataProvider.h>
+
+#include "fmi2FunctionTypes.h"
+#include "models.hpp"
+
+// The two in-process FMUs' exported functions.
+#define PKM_FUZZ_FMI2_FUNCTIONS(X)                                                                             \
+  X(fmi2GetTypesPlatform) X(fmi2GetVersion) X(fmi2SetDebugLogging) X(fmi2Instantiate) X(fmi2FreeInstance)      \
+  X(fmi2SetupExperiment) X(fmi2EnterInitializationMode) X(fmi2ExitInitializationMode) X(fmi2Terminate)         \
+  X(fmi2Reset) X(fmi2GetReal) X(fmi2GetInteger) X(fmi2GetBoolean) X(fmi2GetString) X(fmi2SetReal)              \
+  X(fmi2SetInteger) X(fmi2SetBoolean) X(fmi2SetString) X(fmi2GetFMUstate) X(fmi2SetFMUstate)                   \
+  X(fmi2FreeFMUstate) X(fmi2SerializedFMUstateSize) X(fmi2SerializeFMUstate) X(fmi2DeSerializeFMUstate)        \
+  X(fmi2GetDirectionalDerivative) X(fmi2SetRealInputDerivatives) X(fmi2GetRealOutputDerivatives) X(fmi2DoStep) \
+  X(fmi2CancelStep) X(fmi2GetStatus) X(fmi2GetRealStatus) X(fmi2GetIntegerStatus) X(fmi2GetBooleanStatus)      \
+  X(fmi2GetStringStatus)
+
+extern "C" {
+#define PKM_FUZZ_DECLARE(name) name##TYPE PKM4PUU_##name; name##TYPE PKM4PUU_Inverse_##name;
+PKM_FUZZ_FMI2_FUNCTIONS(PKM_FUZZ_DECLARE)
+#undef PKM_FUZZ_DECLARE
+}
+
+namespace {
+
+struct Api {
+#define PKM_FUZZ_MEMBER(name) name##TYPE* name;
+  PKM_FUZZ_FMI2_FUNCTIONS(PKM_FUZZ_MEMBER)
+#undef PKM_FUZZ_MEMBER
+  const pkm_fmi::ModelDefinition* def;
+};
+
+const Api kApis[2] = {
+    {
+#define PKM_FUZZ_PLANT(name) &PKM4PUU_##name,
+        PKM_FUZZ_FMI2_FUNCTIONS(PKM_FUZZ_PLANT)
+#undef PKM_FUZZ_PLANT
+            &pkm_fmi::pkm4puu_definition(),
+    },
+    {
+#define PKM_FUZZ_INVERSE(name) &PKM4PUU_Inverse_##name,
+        PKM_FUZZ_FMI2_FUNCTIONS(PKM_FUZZ_INVERSE)
+#undef PKM_FUZZ_INVERSE
+            &pkm_fmi::pkm4puu_inverse_definition(),
+    },
+};
+
+// ---------------------------------------------------------------- checks
+
+unsigned long long g_calls = 0;  // FMI calls made (harness bookkeeping, not FMU state)
+unsigned long long g_inputs = 0;
+
+[[noreturn]] void violation(const char* what) {
+  std::fprintf(stderr, "PKM_FUZZ VIOLATION: %s\n", what);
+  std::abort();
+}
+
+void require(bool ok, const char* what) {
+  if (!ok) violation(what);
+}
+
+void print_calls() {
+  std::fprintf(stderr, "PKM_FUZZ_CALLS=%llu PKM_FUZZ_INPUTS=%llu\n", g_calls, g_inputs);
+}
+
+// The importer's logger: treats the message as a printf format with no
+// arguments (as many masters do): the FMU must have escaped every '%'.
+void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category, fmi2String message,
+            ...) {
+  (void)env;
+  (void)status;
+  require(message != nullptr && category != nullptr && name != nullptr, "logger called with NULL strings");
+  for (const char* p = message; *p; ++p) {
+    if (*p == '%') {
+      require(p[1] == '%', "log message with an unescaped '%'");
+      ++p;
+    }
+  }
+  char buf[256];
+  va_list args;
+  va_start(args, message);
+  std::vsnprintf(buf, sizeof buf, message, args);
+  va_end(args);
+}
+
+void* fuzz_calloc(size_t n, size_t size) { return std::calloc(n, size); }
+void fuzz_free(void* p) { std::free(p); }
+
+const fmi2CallbackFunctions kCallbacks{&logger, &fuzz_calloc, &fuzz_free, nullptr, nullptr};
+const fmi2CallbackFunctions kNoLogger{nullptr, &fuzz_calloc, &fuzz_free, nullptr, nullptr};
+
+alignas(64) unsigned char g_foreign[512];  // never an instance nor a state (all zero)
+
+// ---------------------------------------------------------------- values
+
+double awkward(FuzzedDataProvider& in) {
+  static const double values[] = {0.0,
+                                  -0.0,
+                                  1.0,
+                                  -1.0,
+                                  std::numeric_limits<double>::quiet_NaN(),
+                                  std::numeric_limits<double>::infinity(),
+                                  -std::numeric_limits<double>::infinity(),
+                                  1e300,
+                                  -1e300,
+                                  1e-300,
+                                  std::numeric_limits<double>::denorm_min(),
+                                  std::numeric_limits<double>::max(),
+                                  -std::numeric_limits<double>::max(),
+                                  std::numeric_limits<double>::min(),
+                                  2.655616050,
+                                  2.7,
+                                  0.05,
+                                  0.08,
+                                  0.075,
+                                  1e-3,
+                                  1e-4,
+                                  0.02,
+                                  0.5,
+                                  3.0,
+                                  1.1344640137963142,
+                                  1e3,
+                                  1e-2,
+                                  0.4999,
+                                  2147483648.0,
+                                  -2147483649.0};
+  switch (in.ConsumeIntegralInRange<int>(0, 3)) {
+    case 0:
+    case 1: return values[in.ConsumeIntegralInRange<std::size_t>(0, std::size(values) - 1)];
+    case 2: return in.ConsumeFloatingPoint<double>();
+    default: return in.ConsumeFloatingPointInRange<double>(-0.05, 0.05);
+  }
+}
+
+/// A perturbation of a variable's start value (parameters: mostly valid).
+double near_start(FuzzedDataProvider& in, const pkm_fmi::Variable& v) {
+  const double s = v.has_start() ? v.start : 0.0;
+  const double f = in.ConsumeFloatingPointInRange<double>(-0.3, 0.3);
+  return s != 0.0 ? s * (1.0 + f) : f * 0.01;
+}
+
+fmi2ValueReference pick_vr(FuzzedDataProvider& in, const pkm_fmi::ModelDefinition& d) {
+  if (in.ConsumeIntegralInRange<int>(0, 9) < 8)
+    return d.variables[in.ConsumeIntegralInRange<std::size_t>(0, d.n_variables - 1)].vr;
+  return in.ConsumeIntegral<fmi2ValueReference>();
+}
+
+const pkm_fmi::Variable* pick_var(FuzzedDataProvider& in, const pkm_fmi::ModelDefinition& d) {
+  return &d.variables[in.ConsumeIntegralInRange<std::size_t>(0, d.n_variables - 1)];
+}
+
+double step_size(FuzzedDataProvider& in) {
+  static const double common[] = {1e-3, 1e-3, 1e-3, 2e-3, 1e-4, 5e-3, 1e-2, 0.05};
+  static const double odd[] = {0.0, -1e-3, std::numeric_limits<double>::quiet_NaN(),
+                               std::numeric_limits<double>::infinity(), 1e-12, 0.3, 1.0, 1e-300};
+  if (in.ConsumeIntegralInRange<int>(0, 15) != 0)
+    return common[in.ConsumeIntegralInRange<std::size_t>(0, std::size(common) - 1)];
+  return odd[in.ConsumeIntegralInRange<std::size_t>(0, std::size(odd) - 1)];
+}
+
+// ---------------------------------------------------------------- the world of one input
+
+struct State {
+  fmi2FMUstate s = nullptr;
+  int owner = -1;  // slot that created it
+};
+
+struct Slot {
+  int kind = 0;  // 0 plant, 1 inverse
+  fmi2Component c = nullptr;
+  double time = 0.0;  // what the harness believes the current time is
+};
+
+constexpr int kSlots = 3;
+constexpr int kMaxOps = 48;
+
+struct World {
+  Slot slots[kSlots];
+  std::vector<State> states;
+  std::vector<std::vector<fmi2Byte>> blobs;
+
+  const Api& api(int i) const { return kApis[slots[i].kind]; }
+
+  void free_slot(int i) {
+    if (!slots[i].c) return;
+    ++g_calls;
+    api(i).fmi2FreeInstance(slots[i].c);  // frees the states it created
+    slots[i].c = nullptr;
+    for (auto it = states.begin(); it != states.end();)
+      it = (it->owner == i) ? states.erase(it) : it + 1;
+  }
+  ~World() {
+    // Free every other state explicitly, leave the rest to fmi2FreeInstance.
+    for (std::size_t k = 0; k < states.size(); k += 2) {
+      State& st = states[k];
+      if (slots[st.owner].c) {
+        ++g_calls;
+        api(st.owner).fmi2FreeFMUstate(slots[st.owner].c, &st.s);
+      }
+    }
+    for (int i = 0; i < kSlots; ++i) free_slot(i);
+  }
+};
+
+fmi2Component component(FuzzedDataProvider& in, World& w, int i) {
+  switch (in.ConsumeIntegralInRange<int>(0, 31)) {
+    case 0: return nullptr;
+    case 1: return g_foreign;
+    default: return w.slots[i].c;
+  }
+}
+
+void check_reals(fmi2Status s, const double* v, std::size_t n) {
+  if (s != fmi2OK && s != fmi2Warning) return;
+  for (std::size_t k = 0; k < n; ++k) require(std::isfinite(v[k]), "fmi2GetReal returned fmi2OK with NaN or Inf");
+}
+
+constexpr double kGuard = -8.125e77;
+
+void get_reals(const Api& a, fmi2Component c, const fmi2ValueReference* vr, std::size_t n, bool null_value) {
+  std::vector<double> buf(n + 2, kGuard);
+  ++g_calls;
+  const fmi2Status s = a.fmi2GetReal(c, vr, n, null_value ? nullptr : buf.data() + 1);
+  require(buf.front() == kGuard && buf.back() == kGuard, "fmi2GetReal wrote outside its buffer");
+  if (s != fmi2OK && s != fmi2Warning) {
+    for (double x : buf) require(x == kGuard, "fmi2GetReal failed but wrote values");
+  } else if (!null_value) {
+    check_reals(s, buf.data() + 1, n);
+  }
+}
+
+/// All Real outputs of a slot (after a step).
+void get_all_outputs(World& w, int i) {
+  const Api& a = w.api(i);
+  std::vector<fmi2ValueReference> vrs;
+  for (std::size_t k = 0; k < a.def->n_variables; ++k)
+    if (a.def->variables[k].causality == pkm_fmi::Causality::Output) vrs.push_back(a.def->variables[k].vr);
+  get_reals(a, w.slots[i].c, vrs.data(), vrs.size(), false);
+}
+
+void do_step(FuzzedDataProvider& in, World& w, int i, double h) {
+  Slot& sl = w.slots[i];
+  if (!sl.c) return;
+  const Api& a = w.api(i);
+  // Keep RK4 runs short: a step of more than 2e4 RK4 steps (but fewer than
+  // the 1e7 the FMU refuses outright) costs seconds under the sanitizers.
+  if (sl.kind == 0) {
+    const fmi2ValueReference solver_vr = 140, rk4_vr = 141;
+    fmi2Integer solver = 0;
+    double rk4 = 1e-3;
+    g_calls += 2;
+    if (a.fmi2GetInteger(sl.c, &solver_vr, 1, &solver) == fmi2OK && solver == 1 &&
+        a.fmi2GetReal(sl.c, &rk4_vr, 1, &rk4) == fmi2OK && h / rk4 > 2e4 && h / rk4 <= 1.1e7)
+      h = 2e4 * rk4;
+  }
+  double t = sl.time;
+  if (in.ConsumeIntegralInRange<int>(0, 31) == 0) t = awkward(in);
+  ++g_calls;
+  static const bool trace = std::getenv("PKM_FUZZ_TRACE") != nullptr;
+  const auto t0 = std::chrono::steady_clock::now();
+  const fmi2Status s = a.fmi2DoStep(component(in, w, i), t, h, in.ConsumeBool() ? fmi2True : fmi2False);
+  if (trace) {
+    std::fprintf(stderr, "  fmi2DoStep(slot %d, kind %d, t %.17g, h %g) = %d in %.3f s\n", i, sl.kind, t, h,
+                 static_cast<int>(s), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    for (std::size_t k = 0; k < a.def->n_variables; ++k) {  // the parameters that differ from their start values
+      const pkm_fmi::Variable& v = a.def->variables[k];
+      if ((v.causality != pkm_fmi::Causality::Parameter && v.causality != pkm_fmi::Causality::Input) || v.type != pkm_fmi::VarType::Real) continue;
+      double x = 0.0;
+      if (a.fmi2GetReal(sl.c, &v.vr, 1, &x) == fmi2OK && x != v.start)
+        std::fprintf(stderr, "    %s = %.17g (start %g)\n", v.name, x, v.start);
+    }
+  }
+  if (s == fmi2OK || s == fmi2Warning) {
+    sl.time = t + h;
+    if (in.ConsumeBool()) get_all_outputs(w, i);
+  } else if (s == fmi2Discard) {
+    fmi2Boolean terminated = fmi2False;
+    double last = std::numeric_limits<double>::quiet_NaN();
+    g_calls += 2;
+    require(a.fmi2GetBooleanStatus(sl.c, fmi2Terminated, &terminated) == fmi2OK && terminated == fmi2True,
+            "fmi2Discard without fmi2Terminated");
+    require(a.fmi2GetRealStatus(sl.c, fmi2LastSuccessfulTime, &last) == fmi2OK, "no fmi2LastSuccessfulTime");
+    require(last >= t - 1e-9 * std::fmax(1.0, std::fabs(t)) && last <= t + h, "fmi2LastSuccessfulTime out of range");
+    sl.time = last;
+    get_all_outputs(w, i);
+  }
+}
+
+void set_some(FuzzedDataProvider& in, World& w, int i, bool plausible) {
+  const Api& a = w.api(i);
+  const std::size_t n = in.ConsumeIntegralInRange<std::size_t>(0, 5);
+  std::vector<fmi2ValueReference> vr(n);
+  std::vector<double> v(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const pkm_fmi::Variable* var = pick_var(in, *a.def);
+    vr[k] = plausible ? var->vr : pick_vr(in, *a.def);
+    v[k] = plausible && in.ConsumeBool() ? near_start(in, *var) : awkward(in);
+  }
+  ++g_calls;
+  a.fmi2SetReal(component(in, w, i), n ? vr.data() : nullptr, n, (n || in.ConsumeBool()) ? v.data() : nullptr);
+}
+
+void boot(FuzzedDataProvider& in, World& w, int i) {
+  w.free_slot(i);
+  Slot& sl = w.slots[i];
+  sl.kind = in.ConsumeIntegralInRange<int>(0, 3) == 0 ? 1 : 0;
+  const Api& a = w.api(i);
+  ++g_calls;
+  sl.c = a.fmi2Instantiate("fuzz", fmi2CoSimulation, a.def->guid, "", &kCallbacks, fmi2False,
+                           in.ConsumeBool() ? fmi2True : fmi2False);
+  if (!sl.c) violation("fmi2Instantiate failed with valid arguments");
+  sl.time = in.ConsumeBool() ? 0.0 : in.ConsumeFloatingPointInRange<double>(-10.0, 10.0);
+  g_calls += 4;
+  a.fmi2SetupExperiment(sl.c, fmi2False, 0.0, sl.time, fmi2False, 0.0);
+  const int n = in.ConsumeIntegralInRange<int>(0, 3);
+  for (int k = 0; k < n; ++k) set_some(in, w, i, true);
+  if (sl.kind == 0 && in.ConsumeBool()) {
+    const fmi2ValueReference solver = 140;
+    const fmi2Integer one = 1;
+    ++g_calls;
+    a.fmi2SetInteger(sl.c, &solver, 1, &one);
+  }
+  a.fmi2EnterInitializationMode(sl.c);
+  a.fmi2ExitInitializationMode(sl.c);
+}
+
+void run(FuzzedDataProvider& in, World& w, int i) {
+  const Slot& sl = w.slots[i];
+  if (!sl.c) return;
+  const Api& a = w.api(i);
+  const int n = in.ConsumeIntegralInRange<int>(1, 12);
+  const double h = step_size(in);
+  for (int k = 0; k < n; ++k) {
+    if (sl.kind == 0 && in.ConsumeBool()) {
+      const fmi2ValueReference f[4] = {1, 2, 3, 4};
+      double v[4];
+      const double amp = in.ConsumeBool() ? 0.01 : in.ConsumeFloatingPointInRange<double>(-5.0, 5.0);
+      for (int j = 0; j < 4; ++j) v[j] = 2.655616050 + amp * std::sin(3.0 * sl.time + j);
+      ++g_calls;
+      a.fmi2SetReal(sl.c, f, 4, v);
+    }
+    do_step(in, w, i, h);
+  }
+}
+
+void one_op(FuzzedDataProvider& in, World& w) {
+  const int i = in.ConsumeIntegralInRange<int>(0, kSlots - 1);
+  Slot& sl = w.slots[i];
+  const Api& a = w.api(i);
+  const pkm_fmi::ModelDefinition& d = *a.def;
+  switch (in.ConsumeIntegralInRange<int>(0, 29)) {
+    case 0:
+    case 1: boot(in, w, i); break;
+    case 2:
+    case 3:
+    case 4: run(in, w, i); break;
+    case 5: {  // fmi2Instantiate with arbitrary arguments
+      w.free_slot(i);
+      sl.kind = in.ConsumeBool() ? 1 : 0;
+      const Api& b = w.api(i);
+      const std::string name = in.ConsumeRandomLengthString(16);
+      const int guid_kind = in.ConsumeIntegralInRange<int>(0, 3);
+      const std::string junk_guid = in.ConsumeRandomLengthString(40);
+      const char* guid = guid_kind == 0 ? nullptr : guid_kind == 1 ? junk_guid.c_str() : b.def->guid;
+      int type_bits = in.ConsumeBool() ? 1 : in.ConsumeIntegral<int>();
+      fmi2Type type;
+      std::memcpy(&type, &type_bits, sizeof type);  // a C importer may pass any int
+      const int cb = in.ConsumeIntegralInRange<int>(0, 2);
+      ++g_calls;
+      sl.c = b.fmi2Instantiate(in.ConsumeBool() ? name.c_str() : nullptr, type, guid,
+                               in.ConsumeBool() ? "file:///tmp" : nullptr,
+                               cb == 0 ? nullptr : cb == 1 ? &kNoLogger : &kCallbacks, fmi2False,
+                               in.ConsumeBool() ? fmi2True : fmi2False);
+      sl.time = 0.0;
+      break;
+    }
+    case 6:
+      w.free_slot(i);
+      break;
+    case 7: {
+      const double start = in.ConsumeBool() ? 0.0 : awkward(in);
+      const double stop = in.ConsumeBool() ? start + 0.05 : awkward(in);
+      ++g_calls;
+      if (a.fmi2SetupExperiment(component(in, w, i), in.ConsumeBool(), awkward(in), start, in.ConsumeBool(), stop) ==
+          fmi2OK)
+        sl.time = start;
+      break;
+    }
+    case 8: ++g_calls; a.fmi2EnterInitializationMode(component(in, w, i)); break;
+    case 9: ++g_calls; a.fmi2ExitInitializationMode(component(in, w, i)); break;
+    case 10: ++g_calls; a.fmi2Terminate(component(in, w, i)); break;
+    case 11:
+      ++g_calls;
+      if (a.fmi2Reset(component(in, w, i)) == fmi2OK) sl.time = 0.0;
+      break;
+    case 12:
+    case 13: set_some(in, w, i, in.ConsumeBool()); break;
+    case 14: {
+      const std::size_t n = in.ConsumeIntegralInRange<std::size_t>(0, 6);
+      std::vector<fmi2ValueReference> vr(n);
+      for (auto& r : vr) r = pick_vr(in, d);
+      get_reals(a, component(in, w, i), n ? vr.data() : nullptr, n, in.ConsumeIntegralInRange<int>(0, 15) == 0);
+      break;
+    }
+    case 15: {  // Integer
+      const std::size_t n = in.ConsumeIntegralInRange<std::size_t>(0, 3);
+      std::vector<fmi2ValueReference> vr(n);
+      std::vector<fmi2Integer> v(n + 2, -123456);
+      for (auto& r : vr) r = in.ConsumeBool() ? static_cast<fmi2ValueReference>(in.ConsumeIntegralInRange(140, 145))
+                                              : pick_vr(in, d);
+      if (in.ConsumeBool()) {
+        for (std::size_t k = 0; k < n; ++k) v[k + 1] = in.ConsumeIntegralInRange<int>(-2, 3);
+        if (in.ConsumeIntegralInRange<int>(0, 7) == 0 && n) v[1] = in.ConsumeIntegral<int>();
+        ++g_calls;
+        a.fmi2SetInteger(component(in, w, i), n ? vr.data() : nullptr, n, v.data() + 1);
+      } else {
+        ++g_calls;
+        a.fmi2GetInteger(component(in, w, i), n ? vr.data() : nullptr, n, v.data() + 1);
+        require(v.front() == -123456 && v.back() == -123456, "fmi2GetInteger wrote outside its buffer");
+      }
+      break;
+    }
+    case 16: {  // Boolean and String: this FMU has none
+      const fmi2ValueReference vr = pick_vr(in, d);
+      fmi2Boolean b[3] = {7, 7, 7};
+      fmi2String s[3] = {"g", "g", "g"};
+      g_calls += 4;
+      a.fmi2GetBoolean(component(in, w, i), &vr, 1, &b[1]);
+      a.fmi2SetBoolean(component(in, w, i), &vr, 1, &b[1]);
+      a.fmi2GetString(component(in, w, i), &vr, 1, &s[1]);
+      a.fmi2SetString(component(in, w, i), &vr, 1, &s[1]);
+      require(b[0] == 7 && b[2] == 7 && s[0][0] == 'g' && s[2][0] == 'g', "Boolean/String wrote outside");
+      break;
+    }
+    case 17: {  // input derivatives
+      const std::size_t n = in.ConsumeIntegralInRange<std::size_t>(0, 4);
+      std::vector<fmi2ValueReference> vr(n);
+      std::vector<fmi2Integer> order(n);
+      std::vector<double> v(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        vr[k] = in.ConsumeBool() ? static_cast<fmi2ValueReference>(in.ConsumeIntegralInRange(1, 8)) : pick_vr(in, d);
+        order[k] = in.ConsumeIntegralInRange<int>(-1, 3);
+        v[k] = in.ConsumeBool() ? in.ConsumeFloatingPointInRange<double>(-10.0, 10.0) : awkward(in);
+      }
+      ++g_calls;
+      a.fmi2SetRealInputDerivatives(component(in, w, i), n ? vr.data() : nullptr, n,
+                                    in.ConsumeIntegralInRange<int>(0, 15) ? order.data() : nullptr, v.data());
+      break;
+    }
+    case 18: {  // not provided
+      const fmi2ValueReference vr = pick_vr(in, d);
+      const fmi2Integer order = 1;
+      double v[3] = {kGuard, kGuard, kGuard};
+      const double dv = 1.0;
+      g_calls += 3;
+      a.fmi2GetRealOutputDerivatives(component(in, w, i), &vr, 1, &order, &v[1]);
+      a.fmi2GetDirectionalDerivative(component(in, w, i), &vr, 1, &vr, 1, &dv, &v[1]);
+      a.fmi2CancelStep(component(in, w, i));
+      for (double x : v) require(x == kGuard, "a function that is not provided wrote a value");
+      break;
+    }
+    case 19:
+    case 20: do_step(in, w, i, step_size(in)); break;
+    case 21: {  // status functions, any kind
+      int kind_bits = in.ConsumeBool() ? in.ConsumeIntegralInRange<int>(0, 4) : in.ConsumeIntegral<int>();
+      fmi2StatusKind kind;
+      std::memcpy(&kind, &kind_bits, sizeof kind);  // a C importer may pass any int
+      fmi2Status st = fmi2Pending;
+      double r = kGuard;
+      fmi2Integer iv = 5;
+      fmi2Boolean bv = 5;
+      fmi2String sv = "g";
+      const bool null_value = in.ConsumeIntegralInRange<int>(0, 15) == 0;
+      g_calls += 5;
+      a.fmi2GetStatus(component(in, w, i), kind, null_value ? nullptr : &st);
+      a.fmi2GetRealStatus(component(in, w, i), kind, null_value ? nullptr : &r);
+      a.fmi2GetIntegerStatus(component(in, w, i), kind, null_value ? nullptr : &iv);
+      a.fmi2GetBooleanStatus(component(in, w, i), kind, null_value ? nullptr : &bv);
+      a.fmi2GetStringStatus(component(in, w, i), kind, null_value ? nullptr : &sv);
+      require(r == kGuard || std::isfinite(r), "fmi2GetRealStatus returned a non-finite time");
+      break;
+    }
+    case 22: {  // fmi2GetFMUstate: new, overwrite, or into junk
+      if (!sl.c) break;
+      const int how = in.ConsumeIntegralInRange<int>(0, 7);
+      if (how == 0) {
+        fmi2FMUstate junk = g_foreign;
+        ++g_calls;
+        a.fmi2GetFMUstate(sl.c, &junk);
+      } else if (how == 1 && !w.states.empty()) {
+        State& st = w.states[in.ConsumeIntegralInRange<std::size_t>(0, w.states.size() - 1)];
+        ++g_calls;
+        if (w.slots[st.owner].kind == sl.kind) a.fmi2GetFMUstate(sl.c, &st.s);
+      } else if (w.states.size() < 12) {
+        State st;
+        st.owner = i;
+        ++g_calls;
+        if (a.fmi2GetFMUstate(sl.c, &st.s) == fmi2OK) w.states.push_back(st);
+      }
+      break;
+    }
+    case 23: {  // fmi2SetFMUstate: own, another instance's (same or other FMU), NULL, junk
+      if (!sl.c) break;
+      fmi2FMUstate s = nullptr;
+      const int how = in.ConsumeIntegralInRange<int>(0, 7);
+      if (how == 0) s = g_foreign;
+      else if (how > 1 && !w.states.empty())
+        s = w.states[in.ConsumeIntegralInRange<std::size_t>(0, w.states.size() - 1)].s;
+      ++g_calls;
+      if (a.fmi2SetFMUstate(sl.c, s) == fmi2OK) {
+        double t = 0.0;
+        ++g_calls;
+        if (a.fmi2GetRealStatus(sl.c, fmi2LastSuccessfulTime, &t) == fmi2OK) sl.time = t;
+        else sl.time = 0.0;  // instantiated or initialisation mode: the experiment's start, not tracked
+        // (the harness re-reads the time when it can; a wrong guess only makes fmi2DoStep refuse)
+      }
+      break;
+    }
+    case 24: {  // fmi2FreeFMUstate, through any live instance of the same FMU
+      if (w.states.empty()) {
+        fmi2FMUstate junk = in.ConsumeBool() ? g_foreign : nullptr;
+        ++g_calls;
+        if (sl.c) a.fmi2FreeFMUstate(sl.c, &junk);
+        break;
+      }
+      const std::size_t k = in.ConsumeIntegralInRange<std::size_t>(0, w.states.size() - 1);
+      State st = w.states[k];
+      for (int j = 0; j < kSlots; ++j) {
+        if (w.slots[j].c && w.slots[j].kind == w.slots[st.owner].kind && (j == i || j == st.owner)) {
+          ++g_calls;
+          if (w.api(j).fmi2FreeFMUstate(w.slots[j].c, &st.s) == fmi2OK) {
+            require(st.s == nullptr, "fmi2FreeFMUstate did not clear the pointer");
+            w.states.erase(w.states.begin() + static_cast<long>(k));
+          }
+          break;
+        }
+      }
+      break;
+    }
+    case 25: {  // serialise a state (size query, exact or short buffer)
+      if (!sl.c || w.states.empty()) break;
+      const State& st = w.states[in.ConsumeIntegralInRange<std::size_t>(0, w.states.size() - 1)];
+      std::size_t size = 0;
+      ++g_calls;
+      if (a.fmi2SerializedFMUstateSize(sl.c, st.s, &size) != fmi2OK) break;
+      require(size > 0 && size < (1u << 20), "implausible serialised size");
+      const std::size_t given = in.ConsumeBool() ? size : in.ConsumeIntegralInRange<std::size_t>(0, size);
+      std::vector<fmi2Byte> blob(given + 2, 0x5a);
+      ++g_calls;
+      const fmi2Status s = a.fmi2SerializeFMUstate(sl.c, st.s, blob.data() + 1, given);
+      require(blob.front() == 0x5a && blob.back() == 0x5a, "fmi2SerializeFMUstate wrote outside its buffer");
+      if (s == fmi2OK && w.blobs.size() < 8) w.blobs.emplace_back(blob.begin() + 1, blob.end() - 1);
+      break;
+    }
+    case 26: {  // deserialise: a stored blob, mutated or truncated, or raw fuzz bytes
+      if (!sl.c) break;
+      std::vector<fmi2Byte> bytes;
+      if (!w.blobs.empty() && in.ConsumeIntegralInRange<int>(0, 3) != 0) {
+        bytes = w.blobs[in.ConsumeIntegralInRange<std::size_t>(0, w.blobs.size() - 1)];
+        const int flips = in.ConsumeIntegralInRange<int>(0, 2);
+        for (int f = 0; f < flips && !bytes.empty(); ++f)
+          bytes[in.ConsumeIntegralInRange<std::size_t>(0, bytes.size() - 1)] ^= static_cast<fmi2Byte>(
+              1u << in.ConsumeIntegralInRange<int>(0, 7));
+        if (in.ConsumeIntegralInRange<int>(0, 7) == 0) bytes.resize(in.ConsumeIntegralInRange<std::size_t>(0, bytes.size()));
+      } else {
+        const std::string raw = in.ConsumeRandomLengthString(200);
+        bytes.assign(raw.begin(), raw.end());
+      }
+      State st;
+      st.owner = i;
+      ++g_calls;
+      if (a.fmi2DeSerializeFMUstate(sl.c, bytes.empty() ? nullptr : bytes.data(), bytes.size(), &st.s) == fmi2OK) {
+        require(st.s != nullptr, "fmi2DeSerializeFMUstate returned fmi2OK without a state");
+        if (w.states.size() < 12) {
+          w.states.push_back(st);
+        } else {
+          ++g_calls;
+          a.fmi2FreeFMUstate(sl.c, &st.s);
+        }
+      }
+      break;
+    }
+    case 27: {  // logging
+      static const char* const cats[] = {"logEvents",  "logStatusWarning", "logStatusDiscard", "logStatusError",
+                                         "logStatusFatal", "logAll", "logNothing", "%s%n%x%%", ""};
+      const std::size_t n = in.ConsumeIntegralInRange<std::size_t>(0, 4);
+      std::vector<fmi2String> c(n);
+      for (auto& s : c) {
+        const std::size_t k = in.ConsumeIntegralInRange<std::size_t>(0, std::size(cats));
+        s = k == std::size(cats) ? nullptr : cats[k];
+      }
+      ++g_calls;
+      a.fmi2SetDebugLogging(component(in, w, i), in.ConsumeBool(), n, n || in.ConsumeBool() ? c.data() : nullptr);
+      break;
+    }
+    case 28:
+      g_calls += 2;
+      require(std::strcmp(a.fmi2GetVersion(), "2.0") == 0, "version");
+      require(std::strcmp(a.fmi2GetTypesPlatform(), "default") == 0, "types platform");
+      break;
+    default: {  // read everything readable
+      if (!sl.c) break;
+      std::vector<fmi2ValueReference> vrs;
+      for (std::size_t k = 0; k < d.n_variables; ++k)
+        if (d.variables[k].type == pkm_fmi::VarType::Real) vrs.push_back(d.variables[k].vr);
+      get_reals(a, sl.c, vrs.data(), vrs.size(), false);
+      break;
+    }
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  std::atexit(&print_calls);
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  ++g_inputs;
+  static const bool trace = std::getenv("PKM_FUZZ_TRACE") != nullptr;  // harness debugging: time per operation
+  FuzzedDataProvider in(data, size);
+  World w;
+  for (int op = 0; op < kMaxOps && in.remaining_bytes() > 0; ++op) {
+    const unsigned long long calls = g_calls;
+    const auto t0 = std::chrono::steady_clock::now();
+    one_op(in, w);
+    if (trace)
+      std::fprintf(stderr, "op %d: %llu calls, %.3f s\n", op, g_calls - calls,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  return 0;
+}

@@ -1,0 +1,125 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer harness fuzz/fmi_fuzzer.cpp with clang under
+# AddressSanitizer + UndefinedBehaviorSanitizer (a separate build directory,
+# -DPKM_FUZZ=ON; the default gcc build is untouched) and runs it.
+#
+#   fuzz/run_fuzz.sh [--build-dir DIR] [--seconds N | --runs N] [--jobs N] [-- libFuzzer options...]
+#   fuzz/run_fuzz.sh [--build-dir DIR] --coverage-report
+#
+# Defaults: --build-dir build-fuzz, --seconds 60, one job. The corpus grows in
+# DIR/corpus (seeded from fuzz/seed_corpus.tar.gz); findings (crash-*, leak-*,
+# timeout-*, oom-*) are written to DIR/findings/.
+# --coverage-report builds a source-coverage variant in DIR-cov, replays the
+# seed corpus and DIR/corpus through it and prints llvm-cov's region, line
+# and branch coverage of fmu_src/ (no fuzzing).
+# Exit status: 0 no finding, 1 a finding (or a build failure), 77 when clang
+# or its libFuzzer runtime is missing (ctest reports the test as skipped;
+# scripts/setup.sh installs them).
+# At the end it prints the figures: inputs, FMI calls, coverage.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="$root/build-fuzz"
+seconds=60
+runs=""
+jobs=1
+coverage=0
+extra=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build-dir) build="$2"; shift 2 ;;
+    --seconds) seconds="$2"; shift 2 ;;
+    --runs) runs="$2"; shift 2 ;;
+    --jobs) jobs="$2"; shift 2 ;;
+    --coverage-report) coverage=1; shift ;;
+    --) shift; extra=("$@"); break ;;
+    *) echo "run_fuzz: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+
+cxx="$(command -v clang++ || true)"
+cc="$(command -v clang || true)"
+if [ -z "$cxx" ] || [ -z "$cc" ]; then
+  echo "run_fuzz: SKIPPED: clang/clang++ not found (Debian: clang libclang-rt-14-dev; ./scripts/setup.sh installs them)" >&2
+  exit 77
+fi
+if ! echo 'extern "C" int LLVMFuzzerTestOneInput(const unsigned char*, unsigned long) { return 0; }' |
+     "$cxx" -x c++ -fsanitize=fuzzer,address,undefined -o /dev/null - 2>/dev/null; then
+  echo "run_fuzz: SKIPPED: $cxx cannot link -fsanitize=fuzzer,address,undefined (Debian: libclang-rt-14-dev)" >&2
+  exit 77
+fi
+
+mkdir -p "$build"
+fmi_headers=()
+if [ -n "${FMI2_HEADERS_DIR:-}" ]; then fmi_headers=(-DFMI2_HEADERS_DIR="$FMI2_HEADERS_DIR"); fi
+
+if [ "$coverage" -eq 1 ]; then
+  cov="$build-cov"
+  mkdir -p "$cov"
+  profdata="$(command -v llvm-profdata || command -v llvm-profdata-14 || true)"
+  llvmcov="$(command -v llvm-cov || command -v llvm-cov-14 || true)"
+  if [ -z "$profdata" ] || [ -z "$llvmcov" ]; then echo "run_fuzz: llvm-profdata/llvm-cov not found" >&2; exit 77; fi
+  if [ ! -f "$cov/CMakeCache.txt" ]; then
+    CC="$cc" CXX="$cxx" cmake -S "$root" -B "$cov" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPKM_FUZZ=ON \
+      -DPKM_BUILD_TESTS=OFF -DPKM_BUILD_BENCHMARKS=OFF -DPKM_LTO=OFF "${fmi_headers[@]}" \
+      -DCMAKE_CXX_FLAGS="-fprofile-instr-generate -fcoverage-mapping" \
+      -DCMAKE_EXE_LINKER_FLAGS="-fprofile-instr-generate" >"$cov/configure.log" 2>&1 || {
+      cat "$cov/configure.log" >&2; exit 1; }
+  fi
+  cmake --build "$cov" --target pkm_fmi_fuzzer -j"$(nproc)" >"$cov/build.log" 2>&1 || { tail -50 "$cov/build.log" >&2; exit 1; }
+  rm -f "$cov"/*.profraw
+  dirs=("$cov/seeds")
+  rm -rf "$cov/seeds" && mkdir -p "$cov/seeds"
+  [ -f "$root/fuzz/seed_corpus.tar.gz" ] && tar -C "$cov/seeds" -xzf "$root/fuzz/seed_corpus.tar.gz"
+  [ -d "$build/corpus" ] && dirs+=("$build/corpus")
+  LLVM_PROFILE_FILE="$cov/replay.profraw" "$cov/fuzz/pkm_fmi_fuzzer" -runs=0 "${dirs[@]}" >"$cov/replay.log" 2>&1 || {
+    tail -30 "$cov/replay.log" >&2; exit 1; }
+  "$profdata" merge -sparse "$cov/replay.profraw" -o "$cov/replay.profdata"
+  "$llvmcov" report "$cov/fuzz/pkm_fmi_fuzzer" -instr-profile="$cov/replay.profdata" \
+    "$root/fmu_src/fmi/fmi2_cs.cpp" "$root/fmu_src/fmi/fmi2_functions.cpp" "$root/fmu_src/fmi/pkm4puu.cpp" \
+    "$root/fmu_src/fmi/pkm4puu_inverse.cpp" "$root"/fmu_src/core/*.cpp
+  exit 0
+fi
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  CC="$cc" CXX="$cxx" cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPKM_FUZZ=ON \
+    -DPKM_BUILD_TESTS=OFF -DPKM_BUILD_BENCHMARKS=OFF -DPKM_LTO=OFF "${fmi_headers[@]}" >"$build/configure.log" 2>&1 || {
+    cat "$build/configure.log" >&2; exit 1; }
+fi
+cmake --build "$build" --target pkm_fmi_fuzzer -j"$(nproc)" >"$build/build.log" 2>&1 || {
+  tail -50 "$build/build.log" >&2; exit 1; }
+
+mkdir -p "$build/corpus" "$build/findings"
+# Seeds: fuzz/seed_corpus.tar.gz, the corpus of a 30-minute run merged by
+# libFuzzer (-merge=1), so that a short run starts from deep coverage.
+if [ -z "$(ls -A "$build/corpus")" ] && [ -f "$root/fuzz/seed_corpus.tar.gz" ]; then
+  tar -C "$build/corpus" -xzf "$root/fuzz/seed_corpus.tar.gz"
+fi
+seeds=()
+limit=(-max_total_time="$seconds")
+[ -n "$runs" ] && limit=(-runs="$runs")
+log="$build/fuzz.log"
+echo "run_fuzz: $build/fuzz/pkm_fmi_fuzzer ${limit[*]}, $jobs job(s), corpus $build/corpus (log: $log)" >&2
+set +e
+if [ "$jobs" -gt 1 ]; then
+  # Parallel jobs: -fork keeps one corpus and stops at the first finding.
+  "$build/fuzz/pkm_fmi_fuzzer" "$build/corpus" "${seeds[@]}" "${limit[@]}" -fork="$jobs" -ignore_crashes=0 \
+    -timeout=30 -rss_limit_mb=2048 -max_len=2048 -print_final_stats=1 -artifact_prefix="$build/findings/" \
+    "${extra[@]}" >"$log" 2>&1
+else
+  "$build/fuzz/pkm_fmi_fuzzer" "$build/corpus" "${seeds[@]}" "${limit[@]}" \
+    -timeout=30 -rss_limit_mb=2048 -max_len=2048 -print_final_stats=1 -artifact_prefix="$build/findings/" \
+    "${extra[@]}" >"$log" 2>&1
+fi
+status=$?
+set -e
+# Figures: libFuzzer's last status line, its final stats, the harness's call count.
+grep -E "^#[0-9]+.*(DONE|pulse|REDUCE|NEW)" "$log" | tail -1 >&2 || true
+grep -E "^stat::|PKM_FUZZ_CALLS" "$log" >&2 || true
+# Crashes, leaks, timeouts (> 30 s) and out-of-memory are findings; libFuzzer's
+# slow-unit-* files (> 10 s) are not (CVODE giving up after its step limit is slow).
+findings=$(find "$build/findings" -type f \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) | wc -l)
+if [ "$status" -ne 0 ] || [ "$findings" -ne 0 ]; then
+  echo "run_fuzz: FINDING (exit $status, $findings file(s) in $build/findings); the end of the log:" >&2
+  tail -60 "$log" >&2
+  exit 1
+fi
+echo "run_fuzz: no finding" >&2

@@ -1,0 +1,249 @@
+// The built FMU binaries (PKM4PUU.so, PKM4PUU_Inverse.so) loaded with dlopen
+// and driven through the raw FMI 2.0 functions, as an importer would: shared
+// by the tests/test_hardening_*.cpp suites. Value references come from the
+// models' variable tables (checked against modelDescription.xml by
+// test_fmi_model_description).
+#pragma once
+
+#include <dlfcn.h>
+
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fmi2FunctionTypes.h"
+#include "models.hpp"
+
+namespace pkm_test {
+
+constexpr double kStaticForce = 2.655616050;  // MODEL_SPEC "A check anyone can derive"
+constexpr double kPi = 3.14159265358979323846;
+
+struct FmuLibrary {
+  void* handle = nullptr;
+#define PKM_TEST_FMI2_FUNCTIONS(X)                                                                             \
+  X(fmi2GetTypesPlatform) X(fmi2GetVersion) X(fmi2SetDebugLogging) X(fmi2Instantiate) X(fmi2FreeInstance)      \
+  X(fmi2SetupExperiment) X(fmi2EnterInitializationMode) X(fmi2ExitInitializationMode) X(fmi2Terminate)         \
+  X(fmi2Reset) X(fmi2GetReal) X(fmi2GetInteger) X(fmi2GetBoolean) X(fmi2GetString) X(fmi2SetReal)              \
+  X(fmi2SetInteger) X(fmi2SetBoolean) X(fmi2SetString) X(fmi2GetFMUstate) X(fmi2SetFMUstate)                   \
+  X(fmi2FreeFMUstate) X(fmi2SerializedFMUstateSize) X(fmi2SerializeFMUstate) X(fmi2DeSerializeFMUstate)        \
+  X(fmi2GetDirectionalDerivative) X(fmi2SetRealInputDerivatives) X(fmi2GetRealOutputDerivatives) X(fmi2DoStep) \
+  X(fmi2CancelStep) X(fmi2GetStatus) X(fmi2GetRealStatus) X(fmi2GetIntegerStatus) X(fmi2GetBooleanStatus)      \
+  X(fmi2GetStringStatus)
+#define PKM_TEST_DECLARE(name) name##TYPE* name = nullptr;
+  PKM_TEST_FMI2_FUNCTIONS(PKM_TEST_DECLARE)
+#undef PKM_TEST_DECLARE
+  std::string missing;
+
+  explicit FmuLibrary(const char* path) {
+    handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!handle) {
+      missing = dlerror();
+      return;
+    }
+#define PKM_TEST_LOAD(name)                                   \
+  name = reinterpret_cast<name##TYPE*>(dlsym(handle, #name)); \
+  if (!name) missing += #name " ";
+    PKM_TEST_FMI2_FUNCTIONS(PKM_TEST_LOAD)
+#undef PKM_TEST_LOAD
+  }
+  ~FmuLibrary() {
+    if (handle) dlclose(handle);
+  }
+  FmuLibrary(const FmuLibrary&) = delete;
+  FmuLibrary& operator=(const FmuLibrary&) = delete;
+};
+
+inline FmuLibrary& plant_library() {
+  static FmuLibrary lib(PKM_FMU_PLANT_SO);
+  return lib;
+}
+inline FmuLibrary& inverse_library() {
+  static FmuLibrary lib(PKM_FMU_INVERSE_SO);
+  return lib;
+}
+
+struct LogMessage {
+  fmi2Status status;
+  std::string category, text;
+};
+
+/// Collects the FMU's log messages (thread-safe: one Log per instance).
+struct Log {
+  std::vector<LogMessage> messages;
+  bool contains(const std::string& s) const {
+    for (const auto& m : messages)
+      if (m.text.find(s) != std::string::npos) return true;
+    return false;
+  }
+  std::string last() const { return messages.empty() ? std::string() : messages.back().text; }
+  std::string dump() const {
+    std::string out;
+    for (const auto& m : messages) out += "  [" + m.category + "] " + m.text + "\n";
+    return out;
+  }
+};
+
+/// The importer's logger: formats the message as printf would (the FMU
+/// escapes '%'), as fmpy and most masters do.
+inline void collect_log(fmi2ComponentEnvironment env, fmi2String, fmi2Status status, fmi2String category,
+                        fmi2String message, ...) {
+  char text[4096];
+  va_list args;
+  va_start(args, message);
+  std::vsnprintf(text, sizeof text, message ? message : "", args);
+  va_end(args);
+  static_cast<Log*>(env)->messages.push_back({status, category ? category : "", text});
+}
+
+inline fmi2ValueReference vr_of(const pkm_fmi::ModelDefinition& d, const std::string& name) {
+  const pkm_fmi::Variable* v = d.find(name.c_str());
+  if (!v) ADD_FAILURE() << "no variable " << name;
+  return v ? v->vr : 0;
+}
+
+/// One instance of a dlopen'd FMU.
+class FmuInstance {
+ public:
+  FmuInstance(FmuLibrary& lib, const pkm_fmi::ModelDefinition& def, const char* guid, const char* name = "instance",
+              bool logging_on = false)
+      : lib(lib), def(def) {
+    functions_ = fmi2CallbackFunctions{&collect_log, &std::calloc, &std::free, nullptr, &log};
+    c = lib.fmi2Instantiate(name, fmi2CoSimulation, guid, "file:///nonexistent", &functions_, fmi2False,
+                            logging_on ? fmi2True : fmi2False);
+  }
+  ~FmuInstance() {
+    if (c) lib.fmi2FreeInstance(c);
+  }
+  FmuInstance(const FmuInstance&) = delete;
+  FmuInstance& operator=(const FmuInstance&) = delete;
+
+  fmi2ValueReference vr(const std::string& name) const { return vr_of(def, name); }
+
+  fmi2Status set(const std::string& name, double value) {
+    const fmi2ValueReference r = vr(name);
+    return lib.fmi2SetReal(c, &r, 1, &value);
+  }
+  fmi2Status set_int(const std::string& name, int value) {
+    const fmi2ValueReference r = vr(name);
+    const fmi2Integer v = value;
+    return lib.fmi2SetInteger(c, &r, 1, &v);
+  }
+  fmi2Status set_derivative(const std::string& name, double value) {
+    const fmi2ValueReference r = vr(name);
+    const fmi2Integer order = 1;
+    return lib.fmi2SetRealInputDerivatives(c, &r, 1, &order, &value);
+  }
+  double get(const std::string& name) {
+    const fmi2ValueReference r = vr(name);
+    double v = std::nan("");
+    EXPECT_EQ(lib.fmi2GetReal(c, &r, 1, &v), fmi2OK) << name << "\n" << log.dump();
+    return v;
+  }
+  fmi2Status setup() { return lib.fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0); }
+  fmi2Status enter() { return lib.fmi2EnterInitializationMode(c); }
+  fmi2Status exit() { return lib.fmi2ExitInitializationMode(c); }
+  /// Setup, initialisation mode, exit, at t = 0.
+  void initialize() {
+    ASSERT_EQ(setup(), fmi2OK) << log.dump();
+    ASSERT_EQ(enter(), fmi2OK) << log.dump();
+    ASSERT_EQ(exit(), fmi2OK) << log.dump();
+  }
+  fmi2Status step(double t, double h) { return lib.fmi2DoStep(c, t, h, fmi2True); }
+  /// Value references of every Real variable of a causality.
+  std::vector<fmi2ValueReference> reals(pkm_fmi::Causality causality) const {
+    std::vector<fmi2ValueReference> v;
+    for (std::size_t k = 0; k < def.n_variables; ++k)
+      if (def.variables[k].causality == causality && def.variables[k].type == pkm_fmi::VarType::Real)
+        v.push_back(def.variables[k].vr);
+    return v;
+  }
+  /// Every Real output, in table order.
+  std::vector<double> outputs() {
+    const std::vector<fmi2ValueReference> vrs = reals(pkm_fmi::Causality::Output);
+    std::vector<double> v(vrs.size(), std::nan(""));
+    EXPECT_EQ(lib.fmi2GetReal(c, vrs.data(), vrs.size(), v.data()), fmi2OK) << log.dump();
+    return v;
+  }
+  /// Every Real variable (parameters, inputs, outputs), in table order;
+  /// `status` receives the call's status.
+  std::vector<double> all_reals(fmi2Status* status = nullptr) {
+    std::vector<fmi2ValueReference> vrs;
+    for (std::size_t k = 0; k < def.n_variables; ++k)
+      if (def.variables[k].type == pkm_fmi::VarType::Real) vrs.push_back(def.variables[k].vr);
+    std::vector<double> v(vrs.size(), std::nan(""));
+    const fmi2Status s = lib.fmi2GetReal(c, vrs.data(), vrs.size(), v.data());
+    if (status) *status = s;
+    return v;
+  }
+  double last_successful_time() {
+    double t = std::nan("");
+    EXPECT_EQ(lib.fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &t), fmi2OK) << log.dump();
+    return t;
+  }
+  bool terminated() {
+    fmi2Boolean b = fmi2False;
+    EXPECT_EQ(lib.fmi2GetBooleanStatus(c, fmi2Terminated, &b), fmi2OK) << log.dump();
+    return b == fmi2True;
+  }
+
+  FmuLibrary& lib;
+  const pkm_fmi::ModelDefinition& def;
+  fmi2Component c = nullptr;
+  Log log;
+
+ private:
+  fmi2CallbackFunctions functions_;
+};
+
+struct PlantFmu : FmuInstance {
+  explicit PlantFmu(const char* name = "plant", bool logging_on = false)
+      : FmuInstance(plant_library(), pkm_fmi::pkm4puu_definition(), PKM_FMU_PLANT_GUID, name, logging_on) {}
+};
+
+struct InverseFmu : FmuInstance {
+  explicit InverseFmu(const char* name = "inverse", bool logging_on = false)
+      : FmuInstance(inverse_library(), pkm_fmi::pkm4puu_inverse_definition(), PKM_FMU_INVERSE_GUID, name,
+                    logging_on) {}
+};
+
+inline bool bit_identical(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+inline bool all_finite(const std::vector<double>& v) {
+  for (double x : v)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+
+inline std::string force_name(int i) { return "F[" + std::to_string(i) + "]"; }
+
+/// Runs a command, returns its output (stdout and stderr).
+inline std::string capture(const std::string& command, int* status = nullptr) {
+  std::string out;
+  FILE* f = popen(command.c_str(), "r");
+  if (!f) return out;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, f)) out += buf;
+  const int st = pclose(f);
+  if (status) *status = st;
+  return out;
+}
+
+inline bool have_fmpy() {
+  const std::string python = PKM_FMU_PYTHON;
+  if (python.empty()) return false;
+  int status = 0;
+  capture("'" + python + "' -c 'import fmpy' 2>&1", &status);
+  return status == 0;
+}
+
+}  // namespace pkm_test

@@ -1,0 +1,660 @@
+// Hardening, FMI misuse: calls out of the FMI 2.0 co-simulation state
+// machine's order, unknown value references, NULL pointers, fixed
+// parameters set after initialisation, bad communication steps, steps past
+// stopTime, foreign handles and FMU states. Each answer is what the
+// standard prescribes (fmi2Error, or fmi2Discard for status kinds it does
+// not define), nothing crashes, nothing is written outside the instance
+// (guard zones around every output buffer), and an instance that was
+// stepping goes on bit-identically to an untouched twin.
+// Every case prints a row of the hardening table ("| tried | answer | kept |").
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fmu_loader.hpp"
+#include "hardening_table.hpp"
+
+namespace {
+
+using namespace pkm_test;
+
+constexpr double kCanary = -7.77e77;
+
+void drive(FmuInstance& p, double t) {
+  for (int i = 1; i <= 4; ++i)
+    ASSERT_EQ(p.set(force_name(i), kStaticForce + 0.01 * std::sin(2.0 * kPi * (1.0 + 0.5 * i) * t)), fmi2OK);
+}
+
+/// Initialised and stepped five times (1 ms), inputs set for the next step.
+void prepare(PlantFmu& p, double& t) {
+  p.initialize();
+  t = 0.0;
+  for (int k = 0; k < 5; ++k) {
+    drive(p, t);
+    ASSERT_EQ(p.step(t, 1e-3), fmi2OK) << p.log.dump();
+    t += 1e-3;
+  }
+  drive(p, t);
+}
+
+/// A misuse on a stepping instance: `misuse` returns the statuses it got;
+/// all must equal `expected`; then every variable must be as before and the
+/// next step bit-identical to an untouched twin's.
+void on_stepping_instance(const std::string& tried, fmi2Status expected, const std::string& answer,
+                          const std::function<std::vector<fmi2Status>(PlantFmu&, double)>& misuse,
+                          bool expect_message = true) {
+  SCOPED_TRACE(tried);
+  PlantFmu p("misused"), twin("twin");
+  double t = 0.0, t2 = 0.0;
+  prepare(p, t);
+  prepare(twin, t2);
+  const std::vector<double> before = p.all_reals();
+  const std::size_t logged = p.log.messages.size();
+  for (fmi2Status s : misuse(p, t)) EXPECT_EQ(s, expected) << p.log.dump();
+  if (expect_message && expected != fmi2OK) {
+    EXPECT_GT(p.log.messages.size(), logged) << "every fmi2Error comes with a logged reason";
+    if (p.log.messages.size() > logged) {
+      EXPECT_EQ(p.log.messages.back().status, expected) << p.log.dump();
+    }
+  }
+  fmi2Status get_status = fmi2Error;
+  EXPECT_TRUE(bit_identical(p.all_reals(&get_status), before)) << "the misuse changed a variable";
+  EXPECT_EQ(get_status, fmi2OK);
+  EXPECT_EQ(p.last_successful_time(), t);
+  ASSERT_EQ(p.step(t, 1e-3), fmi2OK) << p.log.dump();
+  ASSERT_EQ(twin.step(t2, 1e-3), fmi2OK);
+  EXPECT_TRUE(bit_identical(p.outputs(), twin.outputs())) << "the next step differs from the twin's";
+  table_row(tried, answer, "yes: every variable bit-identical, the next step bit-identical to an untouched twin");
+}
+
+class HardeningMisuse : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(plant_library().missing.empty()) << plant_library().missing;
+    ASSERT_TRUE(inverse_library().missing.empty()) << inverse_library().missing;
+  }
+  FmuLibrary& lib = plant_library();
+};
+
+// ---------------------------------------------------------------- state machine
+
+TEST_F(HardeningMisuse, CallsOutOfOrderBeforeInitialisation) {
+  PlantFmu p;
+  ASSERT_NE(p.c, nullptr);
+  const fmi2ValueReference x = p.vr("x");
+  double buf[3] = {kCanary, kCanary, kCanary};
+  fmi2Status st = fmi2Pending;
+  fmi2Real r = kCanary;
+  fmi2Boolean b = 77;
+  EXPECT_EQ(p.step(0.0, 1e-3), fmi2Error);
+  EXPECT_EQ(p.exit(), fmi2Error);
+  EXPECT_EQ(lib.fmi2GetReal(p.c, &x, 1, &buf[1]), fmi2Error);
+  EXPECT_EQ(lib.fmi2Terminate(p.c), fmi2Error);
+  EXPECT_EQ(lib.fmi2GetStatus(p.c, fmi2DoStepStatus, &st), fmi2Error);
+  EXPECT_EQ(lib.fmi2GetRealStatus(p.c, fmi2LastSuccessfulTime, &r), fmi2Error);
+  EXPECT_EQ(lib.fmi2GetBooleanStatus(p.c, fmi2Terminated, &b), fmi2Error);
+  EXPECT_EQ(lib.fmi2GetRealOutputDerivatives(p.c, &x, 1, nullptr, &buf[1]), fmi2Error);
+  EXPECT_EQ(lib.fmi2CancelStep(p.c), fmi2Error);
+  for (double v : buf) EXPECT_EQ(v, kCanary);
+  EXPECT_EQ(st, fmi2Pending);
+  EXPECT_EQ(r, kCanary);
+  EXPECT_EQ(b, 77);
+  EXPECT_TRUE(p.log.contains("not allowed in state Instantiated (illegal call sequence)")) << p.log.dump();
+  // Then the normal sequence works.
+  p.initialize();
+  EXPECT_EQ(p.step(0.0, 1e-3), fmi2OK);
+  table_row("before initialisation (Instantiated): fmi2DoStep, fmi2ExitInitializationMode, fmi2GetReal(x), "
+            "fmi2Terminate, fmi2GetStatus / GetRealStatus / GetBooleanStatus, fmi2GetRealOutputDerivatives, "
+            "fmi2CancelStep",
+            "fmi2Error each, \"<function>: not allowed in state Instantiated (illegal call sequence); the call has "
+            "no effect\"",
+            "yes: nothing written (guard values intact); setup, initialisation and steps then work");
+}
+
+TEST_F(HardeningMisuse, CallsOutOfOrderDuringInitialisation) {
+  PlantFmu p;
+  ASSERT_EQ(p.setup(), fmi2OK);
+  ASSERT_EQ(p.enter(), fmi2OK);
+  EXPECT_EQ(p.setup(), fmi2Error);
+  EXPECT_EQ(p.enter(), fmi2Error);
+  EXPECT_EQ(p.step(0.0, 1e-3), fmi2Error);
+  EXPECT_EQ(lib.fmi2Terminate(p.c), fmi2Error);
+  fmi2Real r = kCanary;
+  EXPECT_EQ(lib.fmi2GetRealStatus(p.c, fmi2LastSuccessfulTime, &r), fmi2Error);
+  EXPECT_EQ(r, kCanary);
+  ASSERT_EQ(p.exit(), fmi2OK);
+  EXPECT_EQ(p.exit(), fmi2Error);
+  EXPECT_EQ(p.enter(), fmi2Error);
+  EXPECT_EQ(p.setup(), fmi2Error);
+  EXPECT_EQ(p.step(0.0, 1e-3), fmi2OK);
+  table_row("in initialisation mode: fmi2SetupExperiment, fmi2EnterInitializationMode again, fmi2DoStep, "
+            "fmi2Terminate, fmi2GetRealStatus; after it: fmi2ExitInitializationMode, fmi2EnterInitializationMode, "
+            "fmi2SetupExperiment again",
+            "fmi2Error each (illegal call sequence)", "yes: initialisation completes, steps work");
+}
+
+TEST_F(HardeningMisuse, CallsAfterTermination) {
+  PlantFmu p;
+  double t = 0.0;
+  prepare(p, t);
+  ASSERT_EQ(lib.fmi2Terminate(p.c), fmi2OK);
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(t, 1e-3), fmi2Error);
+  EXPECT_EQ(p.set("F[1]", 1.0), fmi2Error);
+  EXPECT_EQ(p.set_derivative("F[1]", 1.0), fmi2Error);
+  EXPECT_EQ(lib.fmi2Terminate(p.c), fmi2Error);
+  EXPECT_EQ(p.enter(), fmi2Error);
+  EXPECT_TRUE(bit_identical(p.all_reals(), before)) << "outputs stay readable and unchanged";
+  EXPECT_EQ(lib.fmi2Reset(p.c), fmi2OK);
+  p.initialize();
+  EXPECT_EQ(p.step(0.0, 1e-3), fmi2OK);
+  table_row("after fmi2Terminate: fmi2DoStep, fmi2SetReal(F[1]), fmi2SetRealInputDerivatives, fmi2Terminate "
+            "again, fmi2EnterInitializationMode",
+            "fmi2Error each (illegal call sequence); fmi2GetReal allowed",
+            "yes: every variable bit-identical; fmi2Reset then works");
+}
+
+TEST_F(HardeningMisuse, CallsInTheStepFailedState) {
+  PlantFmu p;
+  ASSERT_EQ(p.set_int("solver", 1), fmi2OK);
+  p.initialize();
+  ASSERT_EQ(p.set("Fe[1]", 50.0), fmi2OK);
+  double t = 0.0;
+  fmi2Status s = fmi2OK;
+  while (s == fmi2OK && t < 1.0) {
+    s = p.step(t, 1e-3);
+    if (s == fmi2OK) t += 1e-3;
+  }
+  ASSERT_EQ(s, fmi2Discard);
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(t, 1e-3), fmi2Error);
+  EXPECT_EQ(p.set("Fe[1]", 0.0), fmi2Error);
+  EXPECT_EQ(p.set_derivative("Fe[1]", 0.0), fmi2Error);
+  EXPECT_EQ(p.setup(), fmi2Error);
+  fmi2Status st = fmi2Pending;
+  EXPECT_EQ(lib.fmi2GetStatus(p.c, fmi2DoStepStatus, &st), fmi2OK);
+  EXPECT_EQ(st, fmi2OK) << "fmi2DoStep never pends";
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  EXPECT_EQ(p.last_successful_time(), t);
+  EXPECT_TRUE(p.terminated());
+  EXPECT_EQ(lib.fmi2Terminate(p.c), fmi2OK);
+  table_row("after an fmi2Discard (StepFailed): fmi2DoStep again, fmi2SetReal / SetRealInputDerivatives of an "
+            "input, fmi2SetupExperiment",
+            "fmi2Error each (illegal call sequence); fmi2GetReal, fmi2GetStatus, fmi2GetRealStatus, "
+            "fmi2GetBooleanStatus(fmi2Terminated) = true, fmi2Terminate allowed",
+            "yes: every variable bit-identical, fmi2LastSuccessfulTime unchanged");
+}
+
+TEST_F(HardeningMisuse, FunctionsThisFmuDoesNotProvide) {
+  on_stepping_instance(
+      "fmi2CancelStep (fmi2DoStep never returns fmi2Pending), fmi2GetRealOutputDerivatives "
+      "(maxOutputDerivativeOrder = 0), fmi2GetDirectionalDerivative (not provided)",
+      fmi2Error, "fmi2Error each, with the reason logged (\"not allowed in state StepComplete\", \"not provided\")",
+      [&](PlantFmu& p, double) {
+        const fmi2ValueReference x = p.vr("x"), f = p.vr("F[1]");
+        const fmi2Integer order = 1;
+        double buf[3] = {kCanary, kCanary, kCanary};
+        const double dv = 1.0;
+        std::vector<fmi2Status> s = {lib.fmi2CancelStep(p.c),
+                                     lib.fmi2GetRealOutputDerivatives(p.c, &x, 1, &order, &buf[1]),
+                                     lib.fmi2GetDirectionalDerivative(p.c, &x, 1, &f, 1, &dv, &buf[1])};
+        for (double v : buf) EXPECT_EQ(v, kCanary);
+        return s;
+      });
+}
+
+// ---------------------------------------------------------------- value references
+
+TEST_F(HardeningMisuse, UnknownAndMistypedValueReferences) {
+  on_stepping_instance(
+      "unknown value references (0, 9, 99999, 0xFFFFFFFF) in fmi2GetReal / fmi2SetReal, alone and within a vector "
+      "call with valid ones; a Real's reference in fmi2GetInteger / GetBoolean / GetString and an Integer's in "
+      "fmi2GetReal / SetReal; fmi2SetInteger, SetBoolean, SetString",
+      fmi2Error, "fmi2Error each, \"unknown value reference <vr> (no <type> variable has it)\"",
+      [&](PlantFmu& p, double) {
+        std::vector<fmi2Status> s;
+        for (fmi2ValueReference bad : {0u, 9u, 99999u, 0xFFFFFFFFu}) {
+          double buf[4] = {kCanary, kCanary, kCanary, kCanary};
+          const fmi2ValueReference mixed[2] = {p.vr("x"), bad};
+          s.push_back(lib.fmi2GetReal(p.c, &bad, 1, &buf[1]));
+          s.push_back(lib.fmi2GetReal(p.c, mixed, 2, &buf[1]));
+          for (double v : buf) EXPECT_EQ(v, kCanary) << "nothing written for vr " << bad;
+          const fmi2ValueReference set_mixed[2] = {p.vr("F[1]"), bad};
+          const double values[2] = {123.0, 456.0};
+          s.push_back(lib.fmi2SetReal(p.c, &bad, 1, values));
+          s.push_back(lib.fmi2SetReal(p.c, set_mixed, 2, values));
+        }
+        const fmi2ValueReference real = p.vr("x"), integer = p.vr("solver"), input = p.vr("F[2]");
+        fmi2Integer ibuf[3] = {-5, -5, -5};
+        fmi2Boolean bbuf[3] = {-5, -5, -5};
+        fmi2String sbuf[3] = {"canary", "canary", "canary"};
+        double rbuf[3] = {kCanary, kCanary, kCanary};
+        s.push_back(lib.fmi2GetInteger(p.c, &real, 1, &ibuf[1]));
+        s.push_back(lib.fmi2GetBoolean(p.c, &real, 1, &bbuf[1]));
+        s.push_back(lib.fmi2GetString(p.c, &real, 1, &sbuf[1]));
+        s.push_back(lib.fmi2GetReal(p.c, &integer, 1, &rbuf[1]));
+        const double one = 1.0;
+        const fmi2Integer ione = 1;
+        const fmi2Boolean btrue = fmi2True;
+        const fmi2String str = "x";
+        s.push_back(lib.fmi2SetReal(p.c, &integer, 1, &one));
+        s.push_back(lib.fmi2SetInteger(p.c, &input, 1, &ione));
+        s.push_back(lib.fmi2SetBoolean(p.c, &input, 1, &btrue));
+        s.push_back(lib.fmi2SetString(p.c, &input, 1, &str));
+        for (int k = 0; k < 3; ++k) {
+          EXPECT_EQ(ibuf[k], -5);
+          EXPECT_EQ(bbuf[k], -5);
+          EXPECT_STREQ(sbuf[k], "canary");
+          EXPECT_EQ(rbuf[k], kCanary);
+        }
+        EXPECT_TRUE(p.log.contains("unknown value reference 99999")) << p.log.dump();
+        EXPECT_TRUE(p.log.contains("unknown value reference 4294967295")) << p.log.dump();
+        return s;
+      });
+}
+
+TEST_F(HardeningMisuse, OutputsAndFixedParametersCannotBeSetAfterInitialisation) {
+  on_stepping_instance(
+      "fmi2SetReal of an output (x, lambda[3]) or of a fixed parameter after initialisation (l, m_platform, x0, "
+      "rk4_step, max_jacobian_condition, min_leg_measure); fmi2SetInteger of solver, formulation",
+      fmi2Error,
+      "fmi2Error each, \"<name> is a fixed parameter: it can only be set before fmi2ExitInitializationMode\" / "
+      "\"<name> ... is a continuous output variable and cannot be set\"",
+      [&](PlantFmu& p, double) {
+        std::vector<fmi2Status> s;
+        for (const char* name : {"x", "lambda[3]", "l", "m_platform", "x0", "rk4_step", "max_jacobian_condition",
+                                 "min_leg_measure"})
+          s.push_back(p.set(name, 0.5));
+        for (const char* name : {"solver", "formulation"}) s.push_back(p.set_int(name, 1));
+        EXPECT_TRUE(p.log.contains("l is a fixed parameter")) << p.log.dump();
+        EXPECT_TRUE(p.log.contains("max_jacobian_condition is a fixed parameter")) << p.log.dump();
+        return s;
+      });
+}
+
+// ---------------------------------------------------------------- NULL pointers and foreign handles
+
+TEST_F(HardeningMisuse, NullArgumentsAreErrors) {
+  on_stepping_instance(
+      "NULL arrays with n > 0 in fmi2Get/Set Real/Integer/Boolean/String and fmi2SetRealInputDerivatives; "
+      "NULL FMUstate / size / buffer in the FMU-state functions; NULL value in fmi2GetStatus / GetRealStatus / "
+      "GetBooleanStatus; NULL category list or a NULL category in fmi2SetDebugLogging",
+      fmi2Error, "fmi2Error each, \"<function>: ... is NULL\"", [&](PlantFmu& p, double) {
+        std::vector<fmi2Status> s;
+        const fmi2ValueReference x = p.vr("x"), f = p.vr("F[1]");
+        double v = kCanary;
+        fmi2Integer i = 0;
+        fmi2Boolean b = 0;
+        fmi2String str = nullptr;
+        s.push_back(lib.fmi2GetReal(p.c, nullptr, 1, &v));
+        s.push_back(lib.fmi2GetReal(p.c, &x, 1, nullptr));
+        s.push_back(lib.fmi2SetReal(p.c, nullptr, 1, &v));
+        s.push_back(lib.fmi2SetReal(p.c, &f, 1, nullptr));
+        s.push_back(lib.fmi2GetInteger(p.c, nullptr, 1, &i));
+        s.push_back(lib.fmi2SetInteger(p.c, &x, 1, nullptr));
+        s.push_back(lib.fmi2GetBoolean(p.c, nullptr, 1, &b));
+        s.push_back(lib.fmi2SetBoolean(p.c, &x, 1, nullptr));
+        s.push_back(lib.fmi2GetString(p.c, nullptr, 1, &str));
+        s.push_back(lib.fmi2SetString(p.c, &x, 1, nullptr));
+        const fmi2Integer order = 1;
+        s.push_back(lib.fmi2SetRealInputDerivatives(p.c, nullptr, 1, &order, &v));
+        s.push_back(lib.fmi2SetRealInputDerivatives(p.c, &f, 1, nullptr, &v));
+        s.push_back(lib.fmi2SetRealInputDerivatives(p.c, &f, 1, &order, nullptr));
+        s.push_back(lib.fmi2GetFMUstate(p.c, nullptr));
+        s.push_back(lib.fmi2SetFMUstate(p.c, nullptr));
+        fmi2FMUstate state = nullptr;
+        EXPECT_EQ(lib.fmi2GetFMUstate(p.c, &state), fmi2OK);
+        std::size_t size = 0;
+        s.push_back(lib.fmi2SerializedFMUstateSize(p.c, state, nullptr));
+        s.push_back(lib.fmi2SerializedFMUstateSize(p.c, nullptr, &size));
+        s.push_back(lib.fmi2SerializeFMUstate(p.c, state, nullptr, 1000));
+        s.push_back(lib.fmi2SerializeFMUstate(p.c, nullptr, reinterpret_cast<fmi2Byte*>(&v), sizeof v));
+        fmi2FMUstate out = nullptr;
+        s.push_back(lib.fmi2DeSerializeFMUstate(p.c, nullptr, 100, &out));
+        s.push_back(lib.fmi2DeSerializeFMUstate(p.c, reinterpret_cast<const fmi2Byte*>(&v), sizeof v, nullptr));
+        EXPECT_EQ(out, nullptr);
+        EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, &state), fmi2OK);
+        EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, nullptr), fmi2OK) << "freeing nothing is fine";
+        s.push_back(lib.fmi2GetStatus(p.c, fmi2DoStepStatus, nullptr));
+        s.push_back(lib.fmi2GetRealStatus(p.c, fmi2LastSuccessfulTime, nullptr));
+        s.push_back(lib.fmi2GetBooleanStatus(p.c, fmi2Terminated, nullptr));
+        s.push_back(lib.fmi2SetDebugLogging(p.c, fmi2True, 2, nullptr));
+        const fmi2String with_null[2] = {"logEvents", nullptr};
+        s.push_back(lib.fmi2SetDebugLogging(p.c, fmi2True, 2, with_null));
+        EXPECT_EQ(v, kCanary);
+        // n = 0 with NULL arrays: nothing to do, fine.
+        EXPECT_EQ(lib.fmi2GetReal(p.c, nullptr, 0, nullptr), fmi2OK);
+        EXPECT_EQ(lib.fmi2SetReal(p.c, nullptr, 0, nullptr), fmi2OK);
+        return s;
+      });
+}
+
+TEST_F(HardeningMisuse, NullAndForeignComponentsAreErrorsWithoutACrash) {
+  // Not an instance: NULL, and a pointer to memory that is not one (the tag check).
+  alignas(16) unsigned char not_an_instance[256] = {};
+  for (void* c : {static_cast<void*>(nullptr), static_cast<void*>(not_an_instance)}) {
+    const fmi2ValueReference vr = 10;
+    double v = kCanary;
+    fmi2Integer i = 0;
+    fmi2Boolean b = 0;
+    fmi2String s = nullptr;
+    fmi2FMUstate state = nullptr;
+    std::size_t size = 0;
+    fmi2Status st = fmi2Pending;
+    const fmi2Integer order = 1;
+    EXPECT_EQ(lib.fmi2SetDebugLogging(c, fmi2True, 0, nullptr), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0), fmi2Error);
+    EXPECT_EQ(lib.fmi2EnterInitializationMode(c), fmi2Error);
+    EXPECT_EQ(lib.fmi2ExitInitializationMode(c), fmi2Error);
+    EXPECT_EQ(lib.fmi2Terminate(c), fmi2Error);
+    EXPECT_EQ(lib.fmi2Reset(c), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetReal(c, &vr, 1, &v), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetInteger(c, &vr, 1, &i), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetBoolean(c, &vr, 1, &b), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetString(c, &vr, 1, &s), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetReal(c, &vr, 1, &v), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetInteger(c, &vr, 1, &i), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetBoolean(c, &vr, 1, &b), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetString(c, &vr, 1, &s), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetFMUstate(c, &state), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetFMUstate(c, state), fmi2Error);
+    EXPECT_EQ(lib.fmi2FreeFMUstate(c, &state), fmi2Error);
+    EXPECT_EQ(lib.fmi2SerializedFMUstateSize(c, state, &size), fmi2Error);
+    EXPECT_EQ(lib.fmi2SerializeFMUstate(c, state, nullptr, 0), fmi2Error);
+    EXPECT_EQ(lib.fmi2DeSerializeFMUstate(c, nullptr, 0, &state), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetDirectionalDerivative(c, &vr, 1, &vr, 1, &v, &v), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetRealInputDerivatives(c, &vr, 1, &order, &v), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetRealOutputDerivatives(c, &vr, 1, &order, &v), fmi2Error);
+    EXPECT_EQ(lib.fmi2DoStep(c, 0.0, 1e-3, fmi2True), fmi2Error);
+    EXPECT_EQ(lib.fmi2CancelStep(c), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetStatus(c, fmi2DoStepStatus, &st), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &v), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetIntegerStatus(c, fmi2DoStepStatus, &i), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetBooleanStatus(c, fmi2Terminated, &b), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetStringStatus(c, fmi2PendingStatus, &s), fmi2Error);
+    lib.fmi2FreeInstance(c);
+    EXPECT_EQ(v, kCanary);
+    EXPECT_EQ(st, fmi2Pending);
+    EXPECT_EQ(state, nullptr);
+  }
+  for (unsigned char byte : not_an_instance) EXPECT_EQ(byte, 0) << "the foreign memory was written";
+  table_row("a NULL fmi2Component, or a pointer to memory that is not an instance, passed to every one of the "
+            "32 functions that take one (and fmi2FreeInstance)",
+            "fmi2Error each (nobody to log to); fmi2FreeInstance ignores it",
+            "yes: no crash, the foreign memory untouched");
+}
+
+TEST_F(HardeningMisuse, InstantiateWithBadArguments) {
+  Log log;
+  const fmi2CallbackFunctions f{&collect_log, &std::calloc, &std::free, nullptr, &log};
+  EXPECT_EQ(lib.fmi2Instantiate(nullptr, fmi2CoSimulation, PKM_FMU_PLANT_GUID, "", &f, fmi2False, fmi2False), nullptr);
+  EXPECT_EQ(lib.fmi2Instantiate("x", fmi2CoSimulation, nullptr, "", &f, fmi2False, fmi2False), nullptr);
+  EXPECT_EQ(lib.fmi2Instantiate("x", fmi2CoSimulation, "{00000000-0000-0000-0000-000000000000}", "", &f, fmi2False,
+                                fmi2False),
+            nullptr);
+  EXPECT_EQ(lib.fmi2Instantiate("x", fmi2ModelExchange, PKM_FMU_PLANT_GUID, "", &f, fmi2False, fmi2False), nullptr);
+  EXPECT_EQ(lib.fmi2Instantiate("x", static_cast<fmi2Type>(7), PKM_FMU_PLANT_GUID, "", &f, fmi2False, fmi2False),
+            nullptr);
+  EXPECT_EQ(log.messages.size(), 5u) << log.dump();
+  // No callbacks at all, no resource location: a working, silent instance.
+  fmi2Component c = lib.fmi2Instantiate("x", fmi2CoSimulation, PKM_FMU_PLANT_GUID, nullptr, nullptr, fmi2False,
+                                        fmi2True);
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(lib.fmi2SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0), fmi2OK);
+  EXPECT_EQ(lib.fmi2EnterInitializationMode(c), fmi2OK);
+  EXPECT_EQ(lib.fmi2ExitInitializationMode(c), fmi2OK);
+  EXPECT_EQ(lib.fmi2DoStep(c, 0.0, -1.0, fmi2True), fmi2Error);  // an error with nobody to tell
+  EXPECT_EQ(lib.fmi2DoStep(c, 0.0, 1e-3, fmi2True), fmi2OK);
+  lib.fmi2FreeInstance(c);
+  table_row("fmi2Instantiate with instanceName NULL, GUID NULL or of another model, fmuType ModelExchange or 7; "
+            "with no callback functions at all",
+            "NULL, with the reason logged when there is a logger; without callbacks: a working instance that logs "
+            "nothing",
+            "nothing to lose yet");
+}
+
+// ---------------------------------------------------------------- communication steps
+
+TEST_F(HardeningMisuse, BadCommunicationSteps) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  on_stepping_instance(
+      "fmi2DoStep with communicationStepSize 0, -1e-3, NaN, +Inf, -Inf",
+      fmi2Error, "fmi2Error, \"communicationStepSize = ... must be positive and finite; the call has no effect\"",
+      [&](PlantFmu& p, double t) {
+        return std::vector<fmi2Status>{p.step(t, 0.0), p.step(t, -1e-3), p.step(t, nan), p.step(t, inf),
+                                       p.step(t, -inf)};
+      });
+  on_stepping_instance(
+      "fmi2DoStep whose currentCommunicationPoint is not the FMU's time: t + 1 ms (skipping ahead), t - 1 ms "
+      "(going back), 0, NaN, +Inf",
+      fmi2Error,
+      "fmi2Error, \"currentCommunicationPoint = ... differs from the FMU's time ...; the call has no effect\"",
+      [&](PlantFmu& p, double t) {
+        return std::vector<fmi2Status>{p.step(t + 1e-3, 1e-3), p.step(t - 1e-3, 1e-3), p.step(0.0, 1e-3),
+                                       p.step(nan, 1e-3), p.step(inf, 1e-3)};
+      });
+}
+
+TEST_F(HardeningMisuse, AStepWhoseEndOverflowsIsAnError) {
+  PlantFmu p;
+  ASSERT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 1e308, fmi2False, 0.0), fmi2OK);
+  ASSERT_EQ(p.enter(), fmi2OK);
+  ASSERT_EQ(p.exit(), fmi2OK);
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(1e308, 1e308), fmi2Error);
+  EXPECT_TRUE(p.log.contains("is not finite; the call has no effect")) << p.log.dump();
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  EXPECT_EQ(p.last_successful_time(), 1e308);
+  table_row("startTime = 1e308, then fmi2DoStep(1e308, 1e308): the step's end overflows to +Inf",
+            "fmi2Error, \"currentCommunicationPoint + communicationStepSize = inf is not finite; the call has no "
+            "effect\"",
+            "yes: every variable bit-identical, time unchanged");
+}
+
+TEST_F(HardeningMisuse, AStepTooLongForCvodeIsDiscarded) {
+  PlantFmu p;
+  p.initialize();
+  for (int i = 1; i <= 4; ++i) ASSERT_EQ(p.set(force_name(i), kStaticForce + 0.01 * i), fmi2OK);
+  ASSERT_EQ(p.step(0.0, 1e-3), fmi2OK);
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(1e-3, 1e6), fmi2Discard);
+  EXPECT_TRUE(p.log.contains("mxstep")) << p.log.dump();
+  EXPECT_TRUE(p.terminated());
+  EXPECT_EQ(p.last_successful_time(), 1e-3);
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  table_row("CVODE, fmi2DoStep(h = 1e6 s): more than CVODE's 100000 internal steps",
+            "fmi2Discard, fmi2Terminated = true (\"CVODE ... mxstep steps taken before reaching tout\")",
+            "yes: every variable bit-identical at fmi2LastSuccessfulTime = the step start");
+}
+
+TEST_F(HardeningMisuse, AStepPastTheStopTimeIsAnError) {
+  PlantFmu p;
+  ASSERT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 0.0, fmi2True, 0.01), fmi2OK);
+  ASSERT_EQ(p.enter(), fmi2OK);
+  ASSERT_EQ(p.exit(), fmi2OK);
+  for (int i = 1; i <= 4; ++i) ASSERT_EQ(p.set(force_name(i), kStaticForce), fmi2OK);
+  for (int k = 0; k < 9; ++k) ASSERT_EQ(p.step(k * 1e-3, 1e-3), fmi2OK);
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(0.009, 2e-3), fmi2Error);
+  EXPECT_TRUE(p.log.contains("would pass stopTime")) << p.log.dump();
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  EXPECT_EQ(p.step(0.009, 1e-3 + 1e-15), fmi2OK) << "rounding of the last step is tolerated\n" << p.log.dump();
+  EXPECT_EQ(p.step(0.01, 1e-3), fmi2Error);
+  table_row("fmi2SetupExperiment(stopTimeDefined, stopTime = 0.01 s), then fmi2DoStep(0.009, 0.002) past it",
+            "fmi2Error (FMI 2.0: computing past a defined stopTime), \"the step to t = 0.011 would pass stopTime "
+            "= 0.01 ...; the call has no effect\"",
+            "yes: every variable bit-identical; the step to exactly stopTime (within 1e-9 relative) succeeds");
+}
+
+TEST_F(HardeningMisuse, TooManyRk4StepsAreRefusedBeforeAnyWork) {
+  PlantFmu p;
+  ASSERT_EQ(p.set_int("solver", 1), fmi2OK);
+  ASSERT_EQ(p.set("rk4_step", 1e-9), fmi2OK);
+  p.initialize();
+  for (int i = 1; i <= 4; ++i) ASSERT_EQ(p.set(force_name(i), kStaticForce), fmi2OK);
+  ASSERT_EQ(p.step(0.0, 1e-6), fmi2OK);
+  const std::vector<double> before = p.outputs();
+  fmi2FMUstate s = nullptr;
+  ASSERT_EQ(lib.fmi2GetFMUstate(p.c, &s), fmi2OK);
+  EXPECT_EQ(p.step(1e-6, 1.0), fmi2Error);  // 1e9 RK4 steps: about 40 minutes of computing
+  EXPECT_TRUE(p.log.contains("more than 1e+07")) << p.log.dump();
+  EXPECT_TRUE(bit_identical(p.outputs(), before)) << "readable in the Error state, unchanged";
+  ASSERT_EQ(lib.fmi2SetFMUstate(p.c, s), fmi2OK);
+  EXPECT_EQ(p.step(1e-6, 1e-6), fmi2OK);
+  lib.fmi2FreeFMUstate(p.c, &s);
+  table_row("RK4 with rk4_step = 1e-9 s, then fmi2DoStep(h = 1 s): 1e9 RK4 steps",
+            "fmi2Error at once, \"an interval of 1 s needs 1e+09 RK4 steps of rk4_step = 1e-09 s, more than 1e+07\" "
+            "(Error state)",
+            "yes: outputs bit-identical; fmi2SetFMUstate to a saved state and stepping go on");
+}
+
+TEST_F(HardeningMisuse, HugeFiniteInputsEndTheStepWithADiscard) {
+  for (int solver : {0, 1}) {
+    PlantFmu p;
+    ASSERT_EQ(p.set_int("solver", solver), fmi2OK);
+    p.initialize();
+    const std::vector<double> before = p.outputs();
+    ASSERT_EQ(p.set("F[3]", 1e300), fmi2OK);
+    EXPECT_EQ(p.step(0.0, 1e-3), fmi2Discard) << p.log.dump();
+    EXPECT_TRUE(p.terminated());
+    EXPECT_EQ(p.last_successful_time(), 0.0);
+    const std::vector<double> after = p.outputs();
+    EXPECT_TRUE(all_finite(after));
+    // The state is that of t = 0; only lambda (which depends on the input at t) differs.
+    for (std::size_t k = 0; k < 24; ++k) EXPECT_EQ(after[k], before[k]) << "pose, velocity, rho, drho, theta1, theta2";
+  }
+  table_row("F[3] = 1e300 N (finite, absurd), then fmi2DoStep, CVODE and RK4",
+            "fmi2Discard, fmi2Terminated = true (RK4: \"pose unreachable\"; CVODE: \"the corrector convergence test "
+            "failed repeatedly or with |h| = hmin\" -- before the fixes CVODE 6.4 reported success there, with the "
+            "state unchanged)",
+            "yes: pose and velocity bit-identical at fmi2LastSuccessfulTime = 0, all outputs finite");
+}
+
+// ---------------------------------------------------------------- FMU states and logging
+
+TEST_F(HardeningMisuse, ForeignOrBrokenFmuStates) {
+  on_stepping_instance(
+      "fmi2SetFMUstate / FreeFMUstate / SerializedFMUstateSize / SerializeFMUstate with a pointer that is not an "
+      "FMU state; fmi2GetFMUstate into a *FMUstate that is not one; fmi2DeSerializeFMUstate of zeros, of a "
+      "truncated, a bit-flipped or an inverse-FMU state; fmi2SerializeFMUstate into a buffer one byte short",
+      fmi2Error,
+      "fmi2Error each, \"not an FMU state of this FMU\" / \"checksum mismatch\" / \"belongs to another FMU\" / "
+      "\"buffer of n bytes, n+1 needed\"",
+      [&](PlantFmu& p, double) {
+        std::vector<fmi2Status> s;
+        alignas(16) unsigned char junk[256] = {};
+        void* foreign = junk;
+        std::size_t size = 0;
+        s.push_back(lib.fmi2SetFMUstate(p.c, foreign));
+        fmi2FMUstate f = foreign;
+        s.push_back(lib.fmi2FreeFMUstate(p.c, &f));
+        s.push_back(lib.fmi2SerializedFMUstateSize(p.c, foreign, &size));
+        s.push_back(lib.fmi2SerializeFMUstate(p.c, foreign, reinterpret_cast<fmi2Byte*>(junk), sizeof junk));
+        s.push_back(lib.fmi2GetFMUstate(p.c, &f));
+        fmi2FMUstate good = nullptr;
+        EXPECT_EQ(lib.fmi2GetFMUstate(p.c, &good), fmi2OK);
+        EXPECT_EQ(lib.fmi2SerializedFMUstateSize(p.c, good, &size), fmi2OK);
+        std::vector<fmi2Byte> bytes(size + 2, 0x11);
+        s.push_back(lib.fmi2SerializeFMUstate(p.c, good, bytes.data() + 1, size - 1));
+        for (fmi2Byte byte : bytes) EXPECT_EQ(byte, 0x11) << "nothing written into a short buffer";
+        EXPECT_EQ(lib.fmi2SerializeFMUstate(p.c, good, bytes.data() + 1, size), fmi2OK);
+        EXPECT_EQ(bytes[0], 0x11);
+        EXPECT_EQ(bytes[size + 1], 0x11);
+        fmi2FMUstate out = nullptr;
+        std::vector<fmi2Byte> zeros(size, 0);
+        s.push_back(lib.fmi2DeSerializeFMUstate(p.c, zeros.data(), zeros.size(), &out));
+        s.push_back(lib.fmi2DeSerializeFMUstate(p.c, bytes.data() + 1, size - 1, &out));
+        std::vector<fmi2Byte> flipped(bytes.begin() + 1, bytes.begin() + 1 + static_cast<long>(size));
+        flipped[size / 3] = static_cast<fmi2Byte>(flipped[size / 3] ^ 0x40);
+        s.push_back(lib.fmi2DeSerializeFMUstate(p.c, flipped.data(), flipped.size(), &out));
+        InverseFmu inv;
+        inv.initialize();
+        fmi2FMUstate is = nullptr;
+        EXPECT_EQ(inv.lib.fmi2GetFMUstate(inv.c, &is), fmi2OK);
+        std::size_t isize = 0;
+        EXPECT_EQ(inv.lib.fmi2SerializedFMUstateSize(inv.c, is, &isize), fmi2OK);
+        std::vector<fmi2Byte> other(isize);
+        EXPECT_EQ(inv.lib.fmi2SerializeFMUstate(inv.c, is, other.data(), other.size()), fmi2OK);
+        s.push_back(lib.fmi2DeSerializeFMUstate(p.c, other.data(), other.size(), &out));
+        EXPECT_EQ(out, nullptr);
+        // The inverse FMU's in-memory state handed to the plant: a state object, of the other model.
+        s.push_back(lib.fmi2SetFMUstate(p.c, is));
+        inv.lib.fmi2FreeFMUstate(inv.c, &is);
+        EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, &good), fmi2OK);
+        for (unsigned char byte : junk) EXPECT_EQ(byte, 0);
+        return s;
+      });
+}
+
+TEST_F(HardeningMisuse, StatesLeftBehindAreFreedWithTheInstance) {
+  // FMI 2.0: fmi2FreeInstance frees everything the instance allocated. The
+  // valgrind test (hardening_valgrind) checks that nothing leaks; here: a
+  // state freed through another instance of the FMU is forgotten by its creator.
+  PlantFmu a("a"), b("b");
+  a.initialize();
+  b.initialize();
+  fmi2FMUstate s1 = nullptr, s2 = nullptr, s3 = nullptr;
+  ASSERT_EQ(lib.fmi2GetFMUstate(a.c, &s1), fmi2OK);
+  ASSERT_EQ(lib.fmi2GetFMUstate(a.c, &s2), fmi2OK);
+  ASSERT_EQ(lib.fmi2GetFMUstate(a.c, &s3), fmi2OK);
+  ASSERT_EQ(lib.fmi2FreeFMUstate(b.c, &s2), fmi2OK);  // freed through b
+  ASSERT_EQ(lib.fmi2SetFMUstate(b.c, s3), fmi2OK);    // used by b
+  EXPECT_EQ(lib.fmi2FreeFMUstate(a.c, &s1), fmi2OK);
+  // s3 stays with a, which frees it.
+  table_row("FMU states never freed by the importer (fmi2GetFMUstate / fmi2DeSerializeFMUstate, then "
+            "fmi2FreeInstance); a state freed or used through another instance of the FMU",
+            "fmi2FreeInstance frees them (FMI 2.0: all memory of the instance); fmi2OK for the others",
+            "no leak (valgrind: 0 bytes definitely lost)");
+}
+
+TEST_F(HardeningMisuse, LogMessagesWithFormatCharactersAreSafe) {
+  on_stepping_instance(
+      "fmi2SetDebugLogging with the category \"%s%s%n%x\", an unknown category, n = 1000 categories",
+      fmi2Error,
+      "fmi2Error, \"unknown log category \\\"%s%s%n%x\\\"\" delivered with '%' escaped (the importer's printf "
+      "prints it literally)",
+      [&](PlantFmu& p, double) {
+        std::vector<fmi2Status> s;
+        const fmi2String evil[1] = {"%s%s%n%x"};
+        s.push_back(lib.fmi2SetDebugLogging(p.c, fmi2True, 1, evil));
+        EXPECT_TRUE(p.log.contains("\"%s%s%n%x\"")) << p.log.dump();
+        const fmi2String unknown[1] = {"logNothing"};
+        s.push_back(lib.fmi2SetDebugLogging(p.c, fmi2True, 1, unknown));
+        std::vector<fmi2String> many(1000, "logEvents");
+        s.push_back(lib.fmi2SetDebugLogging(p.c, fmi2True, many.size(), many.data()));
+        return s;
+      });
+}
+
+TEST_F(HardeningMisuse, StatusKindsTheStandardDoesNotDefine) {
+  on_stepping_instance(
+      "fmi2GetStatus(fmi2LastSuccessfulTime), fmi2GetRealStatus(fmi2DoStepStatus), fmi2GetIntegerStatus(any), "
+      "fmi2GetBooleanStatus(fmi2DoStepStatus), fmi2GetStringStatus(fmi2PendingStatus) (nothing pending)",
+      fmi2Discard, "fmi2Discard (FMI 2.0: the status is not available), value untouched",
+      [&](PlantFmu& p, double) {
+        fmi2Status st = fmi2Pending;
+        fmi2Real r = kCanary;
+        fmi2Integer i = -5;
+        fmi2Boolean b = -5;
+        fmi2String str = "canary";
+        std::vector<fmi2Status> s = {lib.fmi2GetStatus(p.c, fmi2LastSuccessfulTime, &st),
+                                     lib.fmi2GetRealStatus(p.c, fmi2DoStepStatus, &r),
+                                     lib.fmi2GetIntegerStatus(p.c, fmi2DoStepStatus, &i),
+                                     lib.fmi2GetBooleanStatus(p.c, fmi2DoStepStatus, &b),
+                                     lib.fmi2GetStringStatus(p.c, fmi2PendingStatus, &str)};
+        EXPECT_EQ(st, fmi2Pending);
+        EXPECT_EQ(r, kCanary);
+        EXPECT_EQ(i, -5);
+        EXPECT_EQ(b, -5);
+        EXPECT_STREQ(str, "canary");
+        return s;
+      },
+      /*expect_message=*/false);
+}
+
+}  // namespace
