@@ -5,18 +5,30 @@
 
 namespace pkm {
 
-/// Below this |det L_i| / l^2 a leg is treated as singular.
-constexpr double kLegSingularTol = 1e-12;
-
 Status ReducedDynamics::prepare_leg(const Model& m, int leg, const LegConfig& c,
                                     const PlatformConfig& pc) {
-  if (leg_singularity_measure(m.p, c) < kLegSingularTol) return Status::Singular;
+  if (leg_singularity_measure(m.p, c) < kLegSingularFloor) return Status::Singular;
   Leg& L = legs_[leg];
   L.c = c;
   L.attach = rotated_attachment(m, leg, pc);
-  L.Linv = leg_block(m, leg, c).inverse();
-  L.A = L.Linv * platform_point_jacobian(m, leg, pc);
-  L.M = leg_mass_matrix(m.p, c);
+  // L_i = Rz(beta_i) J_i with J_i = [0 a e; 0 b f; 1 0 g] (leg_point_jacobian),
+  // so L_i^{-1} = J_i^{-1} Rz(beta_i)^T in closed form, D = a f - b e = det J_i.
+  const Params& p = m.p;
+  const double a = -p.l * c.s1 * c.c2 + p.h_prime * c.c1, b = p.l * c.c1 * c.c2 + p.h_prime * c.s1;
+  const double e = -p.l * c.c1 * c.s2, f = -p.l * c.s1 * c.s2, g = p.l * c.c2;
+  const double inv_D = 1.0 / (a * f - b * e);
+  Mat3 Jinv;
+  Jinv << b * g * inv_D, -a * g * inv_D, 1.0,
+          f * inv_D,     -e * inv_D,     0.0,
+          -b * inv_D,    a * inv_D,      0.0;
+  const double cb = m.cos_beta[leg], sb = m.sin_beta[leg];
+  L.Linv.col(0) = cb * Jinv.col(0) - sb * Jinv.col(1);
+  L.Linv.col(1) = sb * Jinv.col(0) + cb * Jinv.col(1);
+  L.Linv.col(2) = Jinv.col(2);
+  // A_i = L_i^{-1} P_i with P_i = [I3, e_z x Rz(phi) r_Qi].
+  L.A.leftCols<3>() = L.Linv;
+  L.A.col(3) = L.Linv.col(1) * L.attach.x() - L.Linv.col(0) * L.attach.y();
+  L.M = leg_mass_matrix(p, c);
   return Status::Ok;
 }
 
@@ -31,19 +43,44 @@ void ReducedDynamics::add_leg(const Model& m, int leg, const Vec3& qd_leg, doubl
     Mr_.setZero();
     rhs_.setZero();
   }
-  Mr_.noalias() += L.A.transpose() * L.M * L.A;
+  // A^T M A with M's zeros (M01 = M12 = 0) and the result's symmetry.
+  Mat34 MA;
+  MA.row(0) = L.M(0, 0) * L.A.row(0) + L.M(0, 2) * L.A.row(2);
+  MA.row(1) = L.M(1, 1) * L.A.row(1);
+  MA.row(2) = L.M(0, 2) * L.A.row(0) + L.M(2, 2) * L.A.row(2);
+  for (int j = 0; j < 4; ++j)
+    for (int k = j; k < 4; ++k) Mr_(j, k) += L.A.col(j).dot(MA.col(k));
   rhs_.noalias() += L.A.transpose() * L.r;
 }
 
 Status ReducedDynamics::solve_platform(const Model& m, const Wrench& we, Pose& a) const {
   const Params& p = m.p;
+  // The upper triangle of the reduced mass matrix (add_leg fills only it).
   Mat4 Mr = Mr_;
   Mr.diagonal() += Vec4(p.m_platform, p.m_platform, p.m_platform, p.Izz_platform);
   Vec4 rhs = rhs_ + we;
   rhs[2] -= p.m_platform * p.g;  // G_p
-  const Eigen::LLT<Mat4> llt(Mr);
-  if (llt.info() != Eigen::Success) return Status::Singular;
-  a = llt.solve(rhs);
+  // LDL^T of the symmetric positive definite 4x4, written out (no square
+  // roots): Mr = U^T D U with unit upper-triangular U, then two substitutions.
+  double d[4];
+  Mat4 U = Mat4::Identity();
+  for (int j = 0; j < 4; ++j) {
+    double dj = Mr(j, j);
+    for (int k = 0; k < j; ++k) dj -= U(k, j) * U(k, j) * d[k];
+    if (!(dj > 0.0)) return Status::Singular;  // also NaN
+    d[j] = dj;
+    for (int i = j + 1; i < 4; ++i) {
+      double u = Mr(j, i);
+      for (int k = 0; k < j; ++k) u -= U(k, j) * U(k, i) * d[k];
+      U(j, i) = u / dj;
+    }
+  }
+  for (int i = 0; i < 4; ++i)  // U^T z = rhs
+    for (int k = 0; k < i; ++k) rhs[i] -= U(k, i) * rhs[k];
+  for (int i = 0; i < 4; ++i) rhs[i] /= d[i];
+  for (int i = 3; i >= 0; --i)  // U a = z / d
+    for (int k = i + 1; k < 4; ++k) rhs[i] -= U(i, k) * rhs[k];
+  a = rhs;
   return a.allFinite() ? Status::Ok : Status::Singular;
 }
 
