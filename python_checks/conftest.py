@@ -43,3 +43,9 @@ def results_dir() -> Path:
     path = REPO / "results"
     path.mkdir(parents=True, exist_ok=True)
     return path
+
+
+@pytest.fixture(scope="session")
+def pkm_library() -> Path:
+    """fmu_src/libpkm.so, the plain C API (pkm.h)."""
+    return _require_fmu("fmu_src/libpkm.so")

@@ -1,0 +1,592 @@
+/* pkm_comparison_bench: the cost of one simulated second of the paper's
+ * comparison test (MODEL_SPEC "Comparison test": from rest at P0, g = 0,
+ * F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s), F2 = F3 = 0) at a 1 ms step, through
+ * this project's plain C API (libpkm.so, pkm.h) and through the plant FMU
+ * (PKM4PUU.so, dlopen + raw FMI 2.0 Co-Simulation calls, as a master would).
+ * Plain C11. bench/engines_bench.py runs it beside MuJoCo and Pinocchio.
+ *
+ *   pkm_comparison_bench [--out DIR] [--batches N] [--fmu PKM4PUU.so [--xml modelDescription.xml]]
+ *
+ * Cases (each step is 1 ms of simulated time; 1000 steps = 1 simulated s):
+ *   capi_rk4        pkm_advance_fn to the next millisecond, forces from a C
+ *                   callback at the integrator's own stage times; RK4,
+ *                   rk4_step 1 ms; then pkm_get_state (x, y, z, phi, rates)
+ *   capi_cvode      the same with CVODE Adams at its defaults (rtol 1e-8,
+ *                   atol 1e-10), not restarted between steps (continuous = 1)
+ *   capi_cvode_tight  the same with rtol 1e-12, atol 1e-14
+ *   capi_rk4_one_call, capi_cvode_one_call  RK4 and CVODE rtol 1e-12 with the
+ *                   simulated second as a single pkm_advance_fn call (no
+ *                   per-call overhead; CVODE then takes its own steps instead
+ *                   of stopping at every millisecond)
+ * The C API's forces F1 = -F4 come from a table at every half millisecond
+ * (every RK4 stage time), as MuJoCo's controls come from an array; at other
+ * times (CVODE's) the sine is evaluated.
+ *   fmu_rk4         fmi2SetReal(F[1..4], held at the step's midpoint value) +
+ *                   fmi2DoStep + fmi2GetReal(x, y, z, phi); solver = 1 (RK4,
+ *                   rk4_step 1 ms)
+ *   fmu_cvode       the same with solver = 0 (CVODE, rtol 1e-8, atol 1e-10;
+ *                   the FMU restarts it every communication step)
+ * Timing: a batch is 1 simulated second from rest at P0 (the initial state is
+ * set up outside the timed region: pkm_init_pose, or fmi2SetFMUstate to the
+ * state saved after initialisation); one untimed warm-up batch, then N timed
+ * batches (default 21); median and minimum wall time per simulated second
+ * (clock_gettime(CLOCK_MONOTONIC)).
+ * Accuracy: after timing, one untimed run of the full 1.5 s test records, at
+ * every 1 ms point (one-call cases: at 0, 0.5, 1 and 1.5 s, each reached by
+ * one call), t, x, y, z, phi, rho1 and ||C(q)|| (pkm_get_outputs'
+ * constraint_residual, the FMU's constraint_residual output); the largest
+ * ||C(q)|| is printed, and with --out DIR the run is written to
+ * DIR/<case>.csv and the summary to DIR/summary.csv.
+ *
+ * Exit status: 0, or 1 if anything fails. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <dlfcn.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/utsname.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "fmi2FunctionTypes.h"
+#include "pkm.h"
+
+#ifndef PKM_FMU_PLANT_SO
+#define PKM_FMU_PLANT_SO "PKM4PUU.so"
+#endif
+
+#define PI 3.14159265358979323846
+#define STEP 1e-3          /* s */
+#define STEPS_TIMED 1000   /* 1 simulated second */
+#define STEPS_TEST 1500    /* the whole 1.5 s comparison test */
+#define AMPLITUDE 0.02     /* N */
+#define PERIOD 1.5         /* s */
+#define MAX_BATCHES 101
+
+static const double P0[4] = {0.0, 0.0, 0.05, 0.0}; /* MODEL_SPEC home pose */
+
+static void forces(double t, double F[4]) {
+  const double f = AMPLITUDE * sin(2.0 * PI * t / PERIOD);
+  F[0] = f;
+  F[1] = 0.0;
+  F[2] = 0.0;
+  F[3] = -f;
+}
+
+static double now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int compare_double(const void* a, const void* b) {
+  const double x = *(const double*)a, y = *(const double*)b;
+  return (x > y) - (x < y);
+}
+
+typedef struct {
+  const char* name;
+  const char* what;
+  double median_s, min_s; /* per simulated second */
+  double max_c;           /* m, over the 1.5 s test */
+} Result;
+
+/* One row of the 1.5 s run: t, x, y, z, phi, rho1, ||C||. */
+typedef struct {
+  double v[7];
+} Row;
+
+static Row rows[STEPS_TEST + 1];
+
+static int write_rows(const char* dir, const char* name, int n_rows) {
+  char path[1024];
+  FILE* fp;
+  int k;
+  if (!dir) return 1;
+  snprintf(path, sizeof path, "%s/%s.csv", dir, name);
+  fp = fopen(path, "w");
+  if (!fp) {
+    fprintf(stderr, "pkm_comparison_bench: cannot write %s\n", path);
+    return 0;
+  }
+  fprintf(fp, "t,x,y,z,phi,rho1,constraint_residual\n");
+  for (k = 0; k < n_rows; ++k)
+    fprintf(fp, "%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.6e\n", rows[k].v[0], rows[k].v[1], rows[k].v[2],
+            rows[k].v[3], rows[k].v[4], rows[k].v[5], rows[k].v[6]);
+  fclose(fp);
+  return 1;
+}
+
+static double finish_timing(double* per, int n, double* min_out) {
+  qsort(per, (size_t)n, sizeof per[0], compare_double);
+  *min_out = per[0];
+  return per[n / 2];
+}
+
+/* ------------------------------------------------------------ the C API */
+
+/* F1(t) tabulated at every half step t_j = j h/2 (every RK4 stage time at
+ * h = 1 ms, and every communication point), as MuJoCo gets its controls from
+ * an array; other times (CVODE's own) evaluate the sine. */
+#define TABLE_SIZE (2 * STEPS_TEST + 1)
+static double force_table[TABLE_SIZE];
+
+static void fill_force_table(void) {
+  double F[4];
+  int j;
+  for (j = 0; j < TABLE_SIZE; ++j) {
+    forces(0.5 * STEP * (double)j, F);
+    force_table[j] = F[0];
+  }
+}
+
+static void input_callback(void* user, double t, double F[4], double wrench[4]) {
+  const double u = t / (0.5 * STEP);
+  const long j = lround(u);
+  (void)user;
+  if (j >= 0 && j < TABLE_SIZE && fabs(u - (double)j) < 1e-9) {
+    F[0] = force_table[j];
+    F[1] = 0.0;
+    F[2] = 0.0;
+    F[3] = -force_table[j];
+  } else {
+    forces(t, F);
+  }
+  wrench[0] = wrench[1] = wrench[2] = wrench[3] = 0.0;
+}
+
+#define PKM_CHECK(call)                                                                              \
+  do {                                                                                               \
+    const pkm_status s_ = (call);                                                                    \
+    if (s_ != PKM_OK) {                                                                              \
+      fprintf(stderr, "pkm_comparison_bench: %s:%d: %s: %s (%s)\n", __FILE__, __LINE__, #call,       \
+              pkm_status_string(s_), pkm_last_error(m));                                             \
+      pkm_destroy(m);                                                                                \
+      return 0;                                                                                      \
+    }                                                                                                \
+  } while (0)
+
+/* one_call: the timed second is a single pkm_advance_fn(t_end = 1 s) (the
+ * integrator's own steps, no stop at every millisecond) instead of 1000 calls. */
+static int run_capi(const pkm_solver_settings* settings, int one_call, int batches, const char* out_dir,
+                    Result* res) {
+  pkm_params p;
+  pkm_model* m = NULL;
+  char err[256];
+  double per[MAX_BATCHES], y[8], t, F[4];
+  pkm_outputs o;
+  int b, k;
+  pkm_default_params(&p);
+  p.g = 0.0;
+  if (pkm_create(&p, &m, err, sizeof err) != PKM_OK) {
+    fprintf(stderr, "pkm_comparison_bench: pkm_create: %s\n", err);
+    return 0;
+  }
+  PKM_CHECK(pkm_set_solver(m, settings));
+  for (b = -1; b < batches; ++b) {
+    double t0;
+    PKM_CHECK(pkm_init_pose(m, 0.0, P0, NULL));
+    t0 = now_seconds();
+    if (one_call) {
+      PKM_CHECK(pkm_advance_fn(m, (double)STEPS_TIMED * STEP, input_callback, NULL, 1));
+      PKM_CHECK(pkm_get_state(m, &t, y, NULL));
+    } else {
+      for (k = 0; k < STEPS_TIMED; ++k) {
+        PKM_CHECK(pkm_advance_fn(m, (double)(k + 1) * STEP, input_callback, NULL, 1));
+        PKM_CHECK(pkm_get_state(m, &t, y, NULL));
+      }
+    }
+    if (b >= 0) per[b] = now_seconds() - t0;
+  }
+  res->median_s = finish_timing(per, batches, &res->min_s);
+  /* the untimed 1.5 s run: outputs at every millisecond (one_call: at the
+   * ends of single calls to 0.5, 1.0 and 1.5 s only) */
+  res->max_c = 0.0;
+  PKM_CHECK(pkm_init_pose(m, 0.0, P0, NULL));
+  {
+    const int stride = one_call ? STEPS_TEST / 3 : 1;
+    int n_rows = 0;
+    for (k = 0; k <= STEPS_TEST; k += stride, ++n_rows) {
+      if (k > 0) PKM_CHECK(pkm_advance_fn(m, (double)k * STEP, input_callback, NULL, 1));
+      forces((double)k * STEP, F);
+      PKM_CHECK(pkm_get_outputs(m, F, NULL, &o));
+      rows[n_rows].v[0] = (double)k * STEP;
+      memcpy(&rows[n_rows].v[1], o.pose, sizeof o.pose);
+      rows[n_rows].v[5] = o.rho[0];
+      rows[n_rows].v[6] = o.constraint_residual;
+      if (o.constraint_residual > res->max_c) res->max_c = o.constraint_residual;
+    }
+    pkm_destroy(m);
+    return write_rows(out_dir, res->name, n_rows);
+  }
+}
+
+/* ------------------------------------------------------------- the FMU */
+
+typedef struct {
+  void* handle;
+  fmi2InstantiateTYPE* fmi2Instantiate;
+  fmi2FreeInstanceTYPE* fmi2FreeInstance;
+  fmi2SetupExperimentTYPE* fmi2SetupExperiment;
+  fmi2EnterInitializationModeTYPE* fmi2EnterInitializationMode;
+  fmi2ExitInitializationModeTYPE* fmi2ExitInitializationMode;
+  fmi2TerminateTYPE* fmi2Terminate;
+  fmi2GetRealTYPE* fmi2GetReal;
+  fmi2SetRealTYPE* fmi2SetReal;
+  fmi2SetIntegerTYPE* fmi2SetInteger;
+  fmi2GetFMUstateTYPE* fmi2GetFMUstate;
+  fmi2SetFMUstateTYPE* fmi2SetFMUstate;
+  fmi2FreeFMUstateTYPE* fmi2FreeFMUstate;
+  fmi2DoStepTYPE* fmi2DoStep;
+} Fmu;
+
+/* dlsym returns an object pointer; POSIX guarantees the representation of a
+ * function pointer is the same: copy the bytes (as fmu_step_bench.c). */
+static int load_symbol(void* handle, const char* name, void* fn_ptr, size_t fn_size) {
+  void* p = dlsym(handle, name);
+  if (!p || fn_size != sizeof p) {
+    fprintf(stderr, "pkm_comparison_bench: symbol %s not found\n", name);
+    return 0;
+  }
+  memcpy(fn_ptr, &p, fn_size);
+  return 1;
+}
+
+static int load_fmu(const char* path, Fmu* f) {
+  int ok = 1;
+  memset(f, 0, sizeof *f);
+  f->handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+  if (!f->handle) {
+    fprintf(stderr, "pkm_comparison_bench: dlopen(%s): %s\n", path, dlerror());
+    return 0;
+  }
+#define LOAD(name) ok &= load_symbol(f->handle, #name, &f->name, sizeof f->name)
+  LOAD(fmi2Instantiate);
+  LOAD(fmi2FreeInstance);
+  LOAD(fmi2SetupExperiment);
+  LOAD(fmi2EnterInitializationMode);
+  LOAD(fmi2ExitInitializationMode);
+  LOAD(fmi2Terminate);
+  LOAD(fmi2GetReal);
+  LOAD(fmi2SetReal);
+  LOAD(fmi2SetInteger);
+  LOAD(fmi2GetFMUstate);
+  LOAD(fmi2SetFMUstate);
+  LOAD(fmi2FreeFMUstate);
+  LOAD(fmi2DoStep);
+#undef LOAD
+  return ok;
+}
+
+static void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status, fmi2String category,
+                   fmi2String message, ...) {
+  va_list ap;
+  (void)env;
+  (void)category;
+  if (status != fmi2Error && status != fmi2Fatal) return;
+  fprintf(stderr, "[%s] ", instance ? instance : "?");
+  va_start(ap, message);
+  vfprintf(stderr, message ? message : "", ap);
+  va_end(ap);
+  fputc('\n', stderr);
+}
+
+static void* allocate_memory(size_t nobj, size_t size) { return calloc(nobj, size); }
+
+static char* read_text(const char* path) {
+  FILE* fp = fopen(path, "rb");
+  char* text = NULL;
+  long n;
+  if (!fp) return NULL;
+  if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0) {
+    text = malloc((size_t)n + 1);
+    if (text && fread(text, 1, (size_t)n, fp) == (size_t)n) {
+      text[n] = '\0';
+    } else {
+      free(text);
+      text = NULL;
+    }
+  }
+  fclose(fp);
+  return text;
+}
+
+/* The value of attribute `name` inside [begin, end), copied to out. */
+static int attribute(const char* begin, const char* end, const char* name, char* out, size_t size) {
+  char key[64];
+  const char *p, *v, *q;
+  snprintf(key, sizeof key, " %s=\"", name);
+  p = strstr(begin, key);
+  if (!p || p >= end) return 0;
+  v = p + strlen(key);
+  q = strchr(v, '"');
+  if (!q || q >= end || (size_t)(q - v) >= size) return 0;
+  memcpy(out, v, (size_t)(q - v));
+  out[q - v] = '\0';
+  return 1;
+}
+
+static int value_reference(const char* text, const char* name, fmi2ValueReference* vr) {
+  const char* p = text;
+  while ((p = strstr(p, "<ScalarVariable")) != NULL) {
+    const char* end = strstr(p, "</ScalarVariable>");
+    char buf[128];
+    if (!end) break;
+    if (attribute(p, end, "name", buf, sizeof buf) && strcmp(buf, name) == 0 &&
+        attribute(p, end, "valueReference", buf, sizeof buf)) {
+      *vr = (fmi2ValueReference)strtoul(buf, NULL, 10);
+      return 1;
+    }
+    p = end;
+  }
+  fprintf(stderr, "pkm_comparison_bench: no variable %s in the model description\n", name);
+  return 0;
+}
+
+typedef struct {
+  char guid[128];
+  fmi2ValueReference F[4], pose[4], rho1, residual, solver, rk4_step, g, z0;
+} Fmi;
+
+static int read_model_description(const char* xml, Fmi* md) {
+  static const char* f_names[] = {"F[1]", "F[2]", "F[3]", "F[4]"};
+  static const char* pose_names[] = {"x", "y", "z", "phi"};
+  char* text = read_text(xml);
+  const char *root, *root_end;
+  int i, ok = 1;
+  if (!text) {
+    fprintf(stderr, "pkm_comparison_bench: cannot read %s\n", xml);
+    return 0;
+  }
+  root = strstr(text, "<fmiModelDescription");
+  root_end = root ? strchr(root, '>') : NULL;
+  if (!root || !root_end || !attribute(root, root_end, "guid", md->guid, sizeof md->guid)) {
+    fprintf(stderr, "pkm_comparison_bench: no guid in %s\n", xml);
+    ok = 0;
+  }
+  for (i = 0; ok && i < 4; ++i)
+    ok = value_reference(text, f_names[i], &md->F[i]) && value_reference(text, pose_names[i], &md->pose[i]);
+  ok = ok && value_reference(text, "rho[1]", &md->rho1) &&
+       value_reference(text, "constraint_residual", &md->residual) &&
+       value_reference(text, "solver", &md->solver) && value_reference(text, "rk4_step", &md->rk4_step) &&
+       value_reference(text, "g", &md->g) && value_reference(text, "z0", &md->z0);
+  free(text);
+  return ok;
+}
+
+#define FMI_CHECK(call)                                                                              \
+  do {                                                                                               \
+    if ((call) != fmi2OK) {                                                                          \
+      fprintf(stderr, "pkm_comparison_bench: %s:%d: %s failed\n", __FILE__, __LINE__, #call);        \
+      ok = 0;                                                                                        \
+      goto done;                                                                                     \
+    }                                                                                                \
+  } while (0)
+
+static int run_fmu(const Fmu* f, const Fmi* md, int solver, int batches, const char* out_dir, Result* res) {
+  fmi2CallbackFunctions callbacks = {logger, allocate_memory, free, NULL, NULL};
+  fmi2FMUstate home = NULL;
+  fmi2Component c;
+  double per[MAX_BATCHES], F[4], pose[4];
+  const fmi2Real g = 0.0, z0 = P0[2], rk4_step = STEP;
+  const fmi2Integer solver_value = solver;
+  int b, k, ok = 1;
+
+  c = f->fmi2Instantiate(res->name, fmi2CoSimulation, md->guid, "", &callbacks, fmi2False, fmi2False);
+  if (!c) {
+    fprintf(stderr, "pkm_comparison_bench: fmi2Instantiate failed\n");
+    return 0;
+  }
+  FMI_CHECK(f->fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0));
+  FMI_CHECK(f->fmi2SetInteger(c, &md->solver, 1, &solver_value));
+  FMI_CHECK(f->fmi2SetReal(c, &md->rk4_step, 1, &rk4_step));
+  FMI_CHECK(f->fmi2SetReal(c, &md->g, 1, &g));
+  FMI_CHECK(f->fmi2SetReal(c, &md->z0, 1, &z0)); /* x0, y0, phi0 default to 0 */
+  FMI_CHECK(f->fmi2EnterInitializationMode(c));
+  FMI_CHECK(f->fmi2ExitInitializationMode(c));
+  FMI_CHECK(f->fmi2GetFMUstate(c, &home));
+  for (b = -1; b < batches; ++b) {
+    double t0;
+    FMI_CHECK(f->fmi2SetFMUstate(c, home));
+    t0 = now_seconds();
+    for (k = 0; k < STEPS_TIMED; ++k) {
+      const double t = (double)k * STEP;
+      forces(t + 0.5 * STEP, F);
+      FMI_CHECK(f->fmi2SetReal(c, md->F, 4, F));
+      FMI_CHECK(f->fmi2DoStep(c, t, STEP, fmi2True));
+      FMI_CHECK(f->fmi2GetReal(c, md->pose, 4, pose));
+    }
+    if (b >= 0) per[b] = now_seconds() - t0;
+  }
+  res->median_s = finish_timing(per, batches, &res->min_s);
+  /* the untimed 1.5 s run */
+  res->max_c = 0.0;
+  FMI_CHECK(f->fmi2SetFMUstate(c, home));
+  for (k = 0; k <= STEPS_TEST; ++k) {
+    const double t = (double)k * STEP;
+    if (k > 0) {
+      forces(t - 0.5 * STEP, F);
+      FMI_CHECK(f->fmi2SetReal(c, md->F, 4, F));
+      FMI_CHECK(f->fmi2DoStep(c, t - STEP, STEP, fmi2True));
+    }
+    rows[k].v[0] = t;
+    FMI_CHECK(f->fmi2GetReal(c, md->pose, 4, &rows[k].v[1]));
+    FMI_CHECK(f->fmi2GetReal(c, &md->rho1, 1, &rows[k].v[5]));
+    FMI_CHECK(f->fmi2GetReal(c, &md->residual, 1, &rows[k].v[6]));
+    if (rows[k].v[6] > res->max_c) res->max_c = rows[k].v[6];
+  }
+done:
+  if (home && f->fmi2FreeFMUstate(c, &home) != fmi2OK) ok = 0;
+  if (f->fmi2Terminate(c) != fmi2OK) ok = 0;
+  f->fmi2FreeInstance(c);
+  return ok && write_rows(out_dir, res->name, STEPS_TEST + 1);
+}
+
+/* ------------------------------------------------------------------ main */
+
+static char* default_xml_path(const char* so) {
+  /* <stage>/binaries/<platform>/<id>.so -> <stage>/modelDescription.xml */
+  const char* suffix = "modelDescription.xml";
+  size_t n = strlen(so);
+  int slashes = 0;
+  char* path;
+  while (n > 0 && slashes < 3)
+    if (so[--n] == '/') ++slashes;
+  if (slashes < 3) return NULL;
+  path = malloc(n + 1 + strlen(suffix) + 1);
+  if (!path) return NULL;
+  memcpy(path, so, n + 1);
+  strcpy(path + n + 1, suffix);
+  return path;
+}
+
+static void print_machine(void) {
+  struct utsname u;
+  char line[512], cpu[256] = "unknown";
+  FILE* fp = fopen("/proc/cpuinfo", "r");
+  if (fp) {
+    while (fgets(line, sizeof line, fp)) {
+      if (strncmp(line, "model name", 10) == 0) {
+        const char* v = strchr(line, ':');
+        if (v) {
+          size_t n;
+          v += strspn(v + 1, " \t") + 1;
+          snprintf(cpu, sizeof cpu, "%s", v);
+          n = strlen(cpu);
+          while (n > 0 && (cpu[n - 1] == '\n' || cpu[n - 1] == '\r')) cpu[--n] = '\0';
+        }
+        break;
+      }
+    }
+    fclose(fp);
+  }
+  if (uname(&u) == 0) printf("machine: %s %s %s\n", u.sysname, u.release, u.machine);
+  printf("cpu:     %s; %ld cores online\n", cpu, sysconf(_SC_NPROCESSORS_ONLN));
+}
+
+static void usage(void) {
+  fprintf(stderr, "usage: pkm_comparison_bench [--out DIR] [--batches N] [--fmu PKM4PUU.so [--xml FILE]]\n");
+}
+
+int main(int argc, char** argv) {
+  const char* out_dir = NULL;
+  const char* so = PKM_FMU_PLANT_SO;
+  const char* xml_arg = NULL;
+  char* xml = NULL;
+  int batches = 21, i, ok = 1, n = 0;
+  Result results[7];
+  Fmu fmu;
+  Fmi md;
+  pkm_solver_settings rk4, cvode, cvode_tight;
+
+  for (i = 1; i < argc; ++i) {
+    if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
+      out_dir = argv[++i];
+    } else if (strcmp(argv[i], "--batches") == 0 && i + 1 < argc) {
+      batches = atoi(argv[++i]);
+      if (batches < 1 || batches > MAX_BATCHES) {
+        fprintf(stderr, "pkm_comparison_bench: --batches must be in 1..%d\n", MAX_BATCHES);
+        return 1;
+      }
+    } else if (strcmp(argv[i], "--fmu") == 0 && i + 1 < argc) {
+      so = argv[++i];
+    } else if (strcmp(argv[i], "--xml") == 0 && i + 1 < argc) {
+      xml_arg = argv[++i];
+    } else {
+      usage();
+      return 1;
+    }
+  }
+  xml = xml_arg ? NULL : default_xml_path(so);
+  if (!xml_arg && !xml) {
+    fprintf(stderr, "pkm_comparison_bench: cannot derive the model description path from %s\n", so);
+    return 1;
+  }
+  if (!read_model_description(xml_arg ? xml_arg : xml, &md) || !load_fmu(so, &fmu)) {
+    free(xml);
+    return 1;
+  }
+
+  pkm_default_solver_settings(&rk4);
+  rk4.solver = PKM_SOLVER_RK4;
+  rk4.rk4_step = STEP;
+  pkm_default_solver_settings(&cvode); /* CVODE Adams, rtol 1e-8, atol 1e-10 */
+  cvode_tight = cvode;
+  cvode_tight.rtol = 1e-12;
+  cvode_tight.atol = 1e-14;
+
+  printf("pkm_comparison_bench: one simulated second of the comparison test (MODEL_SPEC; g = 0,\n"
+         "F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s)) at a 1 ms step; median of %d batches after 1 warm-up\n",
+         batches);
+  print_machine();
+  printf("fmu:     %s\n\n", so);
+
+  fill_force_table();
+  results[n] = (Result){"capi_rk4", "C API, RK4 1 ms, forces at stage times", 0, 0, 0};
+  ok = ok && run_capi(&rk4, 0, batches, out_dir, &results[n++]);
+  results[n] = (Result){"capi_cvode", "C API, CVODE rtol 1e-8 (default)", 0, 0, 0};
+  ok = ok && run_capi(&cvode, 0, batches, out_dir, &results[n++]);
+  results[n] = (Result){"capi_cvode_tight", "C API, CVODE rtol 1e-12", 0, 0, 0};
+  ok = ok && run_capi(&cvode_tight, 0, batches, out_dir, &results[n++]);
+  results[n] = (Result){"capi_rk4_one_call", "C API, RK4 1 ms, one call for the second", 0, 0, 0};
+  ok = ok && run_capi(&rk4, 1, batches, out_dir, &results[n++]);
+  results[n] = (Result){"capi_cvode_one_call", "C API, CVODE rtol 1e-12, one call", 0, 0, 0};
+  ok = ok && run_capi(&cvode_tight, 1, batches, out_dir, &results[n++]);
+  results[n] = (Result){"fmu_rk4", "plant FMU, RK4 1 ms, midpoint-held F", 0, 0, 0};
+  ok = ok && run_fmu(&fmu, &md, 1, batches, out_dir, &results[n++]);
+  results[n] = (Result){"fmu_cvode", "plant FMU, CVODE rtol 1e-8, midpoint-held F", 0, 0, 0};
+  ok = ok && run_fmu(&fmu, &md, 0, batches, out_dir, &results[n++]);
+
+  if (ok) {
+    printf("%-18s %-44s %14s %14s %16s\n", "case", "what", "median ms/s", "min ms/s", "max ||C|| (m)");
+    for (i = 0; i < n; ++i)
+      printf("%-18s %-44s %14.4f %14.4f %16.2e\n", results[i].name, results[i].what, 1e3 * results[i].median_s,
+             1e3 * results[i].min_s, results[i].max_c);
+  }
+  if (ok && out_dir) {
+    char path[1024];
+    FILE* fp;
+    snprintf(path, sizeof path, "%s/summary.csv", out_dir);
+    fp = fopen(path, "w");
+    if (!fp) {
+      fprintf(stderr, "pkm_comparison_bench: cannot write %s\n", path);
+      ok = 0;
+    } else {
+      fprintf(fp, "case,what,median_s_per_sim_s,min_s_per_sim_s,max_constraint_residual\n");
+      for (i = 0; i < n; ++i)
+        fprintf(fp, "%s,\"%s\",%.6e,%.6e,%.6e\n", results[i].name, results[i].what, results[i].median_s,
+                results[i].min_s, results[i].max_c);
+      fclose(fp);
+    }
+  }
+  free(xml);
+  dlclose(fmu.handle);
+  if (!ok) {
+    fprintf(stderr, "pkm_comparison_bench: FAILED\n");
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,222 @@
+"""ctypes binding of this project's C API (fmu_src/capi/pkm.h), for the
+engine comparisons. The library is <build>/fmu_src/libpkm.so; the build
+directory is $PKM_BUILD_DIR (default <repo>/build), as for the FMU checks.
+
+    lib = load()                      # or load(path)
+    with Model(lib) as m:             # spec defaults; Model(lib, g=0.0) etc.
+        m.set_solver(solver=PKM_SOLVER_CVODE, rtol=1e-12, atol=1e-14)
+        m.init_pose(0.0, [0, 0, 0.05, 0])
+        m.advance_fn(1.0, lambda t: (F, wrench))
+        out = m.outputs(F)
+"""
+import ctypes as ct
+import os
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+
+PKM_OK = 0
+PKM_SOLVER_CVODE, PKM_SOLVER_RK4 = 0, 1
+PKM_CVODE_ADAMS, PKM_CVODE_BDF = 0, 1
+PKM_FORM_AUGMENTED, PKM_FORM_NULLSPACE_QR, PKM_FORM_LEG_PARTITIONED = 0, 1, 2
+
+D4 = ct.c_double * 4
+# Every struct the library writes into ends in this reserve, so that fields
+# appended to a pkm.h struct later (filled by the library's own defaults:
+# pkm_default_params, pkm_default_solver_settings) cannot overrun the buffer;
+# the fields before it must be pkm.h's, in order (test_engines_models.py
+# checks them against the header).
+RESERVE = ("_reserved", ct.c_double * 64)
+
+
+class Params(ct.Structure):
+    _fields_ = [("h", ct.c_double), ("l", ct.c_double), ("h_prime", ct.c_double), ("r_b", ct.c_double),
+                ("r_Q", ct.c_double), ("beta", ct.c_double * 4), ("gamma", ct.c_double * 4),
+                ("m_slider", ct.c_double), ("m_rod", ct.c_double), ("I_rod", ct.c_double * 3),
+                ("m_platform", ct.c_double), ("Izz_platform", ct.c_double), ("g", ct.c_double), RESERVE]
+
+
+class SolverSettings(ct.Structure):
+    _fields_ = [("solver", ct.c_int), ("rk4_step", ct.c_double), ("rtol", ct.c_double), ("atol", ct.c_double),
+                ("cvode_method", ct.c_int), ("formulation", ct.c_int), RESERVE]
+
+
+class Outputs(ct.Structure):
+    _fields_ = [("t", ct.c_double), ("pose", ct.c_double * 4), ("velocity", ct.c_double * 4),
+                ("acceleration", ct.c_double * 4), ("rho", ct.c_double * 4), ("drho", ct.c_double * 4),
+                ("theta1", ct.c_double * 4), ("theta2", ct.c_double * 4), ("q", ct.c_double * 16),
+                ("qd", ct.c_double * 16), ("qdd", ct.c_double * 16), ("lambda_", ct.c_double * 12),
+                ("constraint_residual", ct.c_double), ("jacobian_condition", ct.c_double), RESERVE]
+
+
+class InverseResult(ct.Structure):
+    _fields_ = [("F", ct.c_double * 4), ("lambda_", ct.c_double * 12), ("q", ct.c_double * 16),
+                ("qd", ct.c_double * 16), ("qdd", ct.c_double * 16), RESERVE]
+
+
+INPUT_FN = ct.CFUNCTYPE(None, ct.c_void_p, ct.c_double, ct.POINTER(ct.c_double), ct.POINTER(ct.c_double))
+
+
+def library_path(build=None):
+    build = Path(build) if build else Path(os.environ.get("PKM_BUILD_DIR", REPO / "build"))
+    return build.resolve() / "fmu_src" / "libpkm.so"
+
+
+def load(path=None):
+    """Loads libpkm.so and declares the signatures of pkm.h."""
+    lib = ct.CDLL(str(path or library_path()))
+    P, vp, dp, i = ct.POINTER, ct.c_void_p, ct.POINTER(ct.c_double), ct.c_int
+    lib.pkm_default_params.argtypes = [P(Params)]
+    lib.pkm_default_params.restype = None
+    lib.pkm_default_solver_settings.argtypes = [P(SolverSettings)]
+    lib.pkm_default_solver_settings.restype = None
+    lib.pkm_create.argtypes = [P(Params), P(vp), ct.c_char_p, ct.c_size_t]
+    lib.pkm_create.restype = i
+    lib.pkm_destroy.argtypes = [vp]
+    lib.pkm_destroy.restype = None
+    lib.pkm_last_error.argtypes = [vp]
+    lib.pkm_last_error.restype = ct.c_char_p
+    lib.pkm_set_solver.argtypes = [vp, P(SolverSettings)]
+    lib.pkm_set_solver.restype = i
+    lib.pkm_init_pose.argtypes = [vp, ct.c_double, dp, dp]
+    lib.pkm_init_pose.restype = i
+    lib.pkm_inverse_dynamics.argtypes = [vp, dp, dp, dp, dp, P(InverseResult)]
+    lib.pkm_inverse_dynamics.restype = i
+    lib.pkm_advance.argtypes = [vp, ct.c_double, dp, dp]
+    lib.pkm_advance.restype = i
+    lib.pkm_advance_fn.argtypes = [vp, ct.c_double, INPUT_FN, vp, i]
+    lib.pkm_advance_fn.restype = i
+    lib.pkm_get_outputs.argtypes = [vp, dp, dp, P(Outputs)]
+    lib.pkm_get_outputs.restype = i
+    lib.pkm_get_state.argtypes = [vp, dp, dp, dp]
+    lib.pkm_get_state.restype = i
+    return lib
+
+
+def _d4(a):
+    return None if a is None else D4(*[float(v) for v in a])
+
+
+class PkmError(RuntimeError):
+    pass
+
+
+class Model:
+    """One pkm_model handle. Keyword arguments override the default parameters
+    (pkm_default_params), e.g. Model(lib, g=0.0)."""
+
+    def __init__(self, lib, **params):
+        self.lib = lib
+        p = Params()
+        lib.pkm_default_params(ct.byref(p))
+        for k, v in params.items():
+            setattr(p, k, v)
+        self.params = p
+        self.handle = ct.c_void_p()
+        err = ct.create_string_buffer(256)
+        s = lib.pkm_create(ct.byref(p), ct.byref(self.handle), err, 256)
+        if s != PKM_OK:
+            raise PkmError(f"pkm_create: status {s}: {err.value.decode()}")
+        self._callback = None
+
+    def close(self):
+        if self.handle:
+            self.lib.pkm_destroy(self.handle)
+            self.handle = ct.c_void_p()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def _check(self, s, what):
+        if s != PKM_OK:
+            raise PkmError(f"{what}: status {s}: {self.lib.pkm_last_error(self.handle).decode()}")
+
+    def set_solver(self, **settings):
+        s = SolverSettings()
+        self.lib.pkm_default_solver_settings(ct.byref(s))
+        for k, v in settings.items():
+            setattr(s, k, v)
+        self._check(self.lib.pkm_set_solver(self.handle, ct.byref(s)), "pkm_set_solver")
+
+    def init_pose(self, t0, pose, velocity=None):
+        self._check(self.lib.pkm_init_pose(self.handle, t0, _d4(pose), _d4(velocity)), "pkm_init_pose")
+
+    def inverse_dynamics(self, pose, velocity, acceleration, wrench=None):
+        r = InverseResult()
+        self._check(self.lib.pkm_inverse_dynamics(self.handle, _d4(pose), _d4(velocity), _d4(acceleration),
+                                                  _d4(wrench), ct.byref(r)), "pkm_inverse_dynamics")
+        return r
+
+    def advance(self, t_end, F=None, wrench=None):
+        self._check(self.lib.pkm_advance(self.handle, t_end, _d4(F), _d4(wrench)), "pkm_advance")
+
+    def advance_fn(self, t_end, inputs, continuous=True):
+        """inputs(t) -> F[4] (N), or (F, wrench); evaluated at the integrator's own times."""
+
+        def cb(_user, t, F, w):
+            r = inputs(t)
+            f, wr = (r if isinstance(r, tuple) else (r, None))
+            for k in range(4):
+                F[k] = f[k]
+            if wr is not None:
+                for k in range(4):
+                    w[k] = wr[k]
+
+        self._callback = INPUT_FN(cb)  # kept alive for the call
+        self._check(self.lib.pkm_advance_fn(self.handle, t_end, self._callback, None, int(continuous)),
+                    "pkm_advance_fn")
+
+    def outputs(self, F=None, wrench=None):
+        o = Outputs()
+        self._check(self.lib.pkm_get_outputs(self.handle, _d4(F), _d4(wrench), ct.byref(o)), "pkm_get_outputs")
+        return o
+
+
+# --- the layout check against pkm.h ------------------------------------------------------
+_C_TYPES = {"double": (8, 8), "int": (4, 4)}
+
+
+def header_structs(path=REPO / "fmu_src" / "capi" / "pkm.h"):
+    """{struct name: [(field name, offset, size)]} for pkm.h's plain structs of
+    doubles and ints (C layout rules for x86_64), and their sizes."""
+    import re
+    text = re.sub(r"/\*.*?\*/", " ", Path(path).read_text(), flags=re.S)
+    out = {}
+    for body, name in re.findall(r"typedef\s+struct\s*\{(.*?)\}\s*(\w+)\s*;", text, flags=re.S):
+        fields, offset, align_max = [], 0, 1
+        for decl in body.split(";"):
+            decl = decl.strip()
+            if not decl:
+                continue
+            ctype, rest = decl.split(None, 1)
+            size, align = _C_TYPES[ctype]
+            for item in rest.split(","):
+                m = re.fullmatch(r"\s*(\w+)\s*(?:\[(\d+)\])?\s*", item)
+                count = int(m.group(2) or 1)
+                offset = (offset + align - 1) // align * align
+                fields.append((m.group(1), offset, size * count))
+                offset += size * count
+                align_max = max(align_max, align)
+        out[name] = (fields, (offset + align_max - 1) // align_max * align_max)
+    return out
+
+
+def binding_mismatches(path=REPO / "fmu_src" / "capi" / "pkm.h"):
+    """Differences between this binding's structs and pkm.h's (empty: they agree).
+    pkm.h may have appended fields, as long as they fit in the reserve."""
+    structs = header_structs(path)
+    bad = []
+    for cname, cls in (("pkm_params", Params), ("pkm_solver_settings", SolverSettings), ("pkm_outputs", Outputs),
+                       ("pkm_inverse_result", InverseResult)):
+        fields, size = structs[cname]
+        ours = [(n.rstrip("_"), getattr(cls, n).offset, getattr(cls, n).size) for n, _ in cls._fields_
+                if n != "_reserved"]
+        if fields[:len(ours)] != ours:
+            bad.append(f"{cname}: pkm.h {fields[:len(ours)]} != binding {ours}")
+        if size > ct.sizeof(cls):
+            bad.append(f"{cname}: pkm.h's struct ({size} bytes) does not fit the binding's ({ct.sizeof(cls)} bytes)")
+    return bad

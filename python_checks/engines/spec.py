@@ -1,0 +1,112 @@
+"""The mechanism's numbers, copied from /work/shared/MODEL_SPEC.md (the
+authoritative definition), for the independent engine models (Pinocchio,
+MuJoCo). Nothing here is read from this project's code or outputs.
+
+SI units: the spec's Tables II-III are already converted there (m, kg, kg m^2).
+"""
+import math
+
+import numpy as np
+
+# --- Geometry defaults (Table II) -----------------------------------------------
+H = 0.06634  # m, offset of the prismatic joint (d1 = rho + h)
+L = 0.080  # m, rod length (a3)
+H_PRIME = 0.075  # m, d4: Q lies h' along the third revolute axis z3
+R_B = 0.09273  # m, base radius
+R_Q = 0.075  # m, platform radius
+
+# --- Leg placement ------------------------------------------------------------------
+BETA = [(i - 1) * math.pi / 2 for i in range(1, 5)]  # rad
+GAMMA = [math.radians(g) for g in (65.0, -65.0, 65.0, -65.0)]  # rad
+
+# --- Bodies (Table III; U-joint crosses, links 2 and 4, massless) ----------------------
+M_SLIDER = 0.09331  # kg, link 1: translates only
+M_ROD = 0.06371  # kg, link 3
+I_ROD = (3.83e-6, 49.86e-6, 52.64e-6)  # kg m^2, about its COM, DH frame 3 axes (x3, y3, z3)
+M_PLATFORM = 0.45474  # kg
+IZZ_PLATFORM = 2874.21e-6  # kg m^2 (Ixx = Iyy = 0)
+G = 9.81  # m/s^2 along -z_G
+
+# "A check anyone can derive": each actuator's share of the weight at P0.
+STATIC_FORCE_P0 = 2.655616050  # N
+
+# --- Auto-test (paper 5.1) ----------------------------------------------------------------
+T_MOVE = 2.0  # s
+P0 = np.array([0.0, 0.0, 0.05, 0.0])  # x, y, z (m), phi (rad)
+P1 = np.array([0.005, -0.005, 0.07, math.radians(4.0)])
+
+# --- Comparison test (paper 5.2) ------------------------------------------------------------
+CMP_DURATION = 1.5  # s
+CMP_AMPLITUDE = 0.02  # N
+
+
+def blend(tau):
+    """s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5 and its first two derivatives
+    (held at rest outside [0, 1])."""
+    if tau <= 0.0:
+        return 0.0, 0.0, 0.0
+    if tau >= 1.0:
+        return 1.0, 0.0, 0.0
+    s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
+    ds = 30.0 * tau**2 * (1.0 - tau) ** 2
+    dds = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau)
+    return s, ds, dds
+
+
+def autotest_motion(t):
+    """Prescribed platform pose, velocity and acceleration (x, y, z, phi) at t."""
+    s, ds, dds = blend(t / T_MOVE)
+    d = P1 - P0
+    return P0 + d * s, d * ds / T_MOVE, d * dds / T_MOVE**2
+
+
+def comparison_forces(t):
+    """F1..F4 (N) of the comparison test at time t: F1 = -F4 = 0.02 sin(2 pi t / 1.5), F2 = F3 = 0."""
+    f = CMP_AMPLITUDE * math.sin(2.0 * math.pi * t / CMP_DURATION)
+    return np.array([f, 0.0, 0.0, -f])
+
+
+def rz(a):
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def base_point(i):
+    """B_i (leg i = 0..3) in the base frame G."""
+    return R_B * np.array([math.cos(BETA[i]), math.sin(BETA[i]), 0.0])
+
+
+def platform_point(i):
+    """r_Qi (leg i = 0..3) in the platform frame."""
+    a = BETA[i] + GAMMA[i]
+    return R_Q * np.array([math.cos(a), math.sin(a), 0.0])
+
+
+def leg_inverse_kinematics(pose):
+    """The spec's closed-form elbow-down leg inverse kinematics: (rho, theta1,
+    theta2) for each leg at pose (x, y, z, phi), as a 4x3 array."""
+    p = np.asarray(pose[:3], dtype=float)
+    out = np.empty((4, 3))
+    for i in range(4):
+        qt = rz(BETA[i]).T @ (p + rz(pose[3]) @ platform_point(i) - base_point(i))
+        a = math.sqrt(qt[0] ** 2 + qt[1] ** 2 - H_PRIME**2)
+        th1 = math.atan2(qt[1], qt[0]) + math.atan2(H_PRIME, a)
+        th2 = -math.acos(a / L)
+        out[i] = (qt[2] - H - L * math.sin(th2), th1, th2)
+    return out
+
+
+def leg_end_point(i, rho, th1, th2):
+    """Q_i in G from the spec's multiplied-out DH product (for checks)."""
+    c1, s1, c2, s2 = math.cos(th1), math.sin(th1), math.cos(th2), math.sin(th2)
+    pq = np.array([L * c1 * c2 + H_PRIME * s1, L * s1 * c2 - H_PRIME * c1, rho + H + L * s2])
+    return base_point(i) + rz(BETA[i]) @ pq
+
+
+def constraint_residual(q16):
+    """C(q) of Eq. 15 (12 values) for q in the spec's order
+    [rho1, th1_1, th2_1, ..., rho4, th1_4, th2_4, x, y, z, phi]."""
+    q16 = np.asarray(q16, dtype=float)
+    p, phi = q16[12:15], q16[15]
+    return np.concatenate([leg_end_point(i, *q16[3 * i:3 * i + 3]) - p - rz(phi) @ platform_point(i)
+                           for i in range(4)])

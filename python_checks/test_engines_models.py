@@ -1,0 +1,169 @@
+"""The independent engine models (engines/pinocchio_model.py, engines/mujoco_model.py)
+checked against MODEL_SPEC itself, never against this project, so that
+test_engines_inverse.py and test_engines_forward.py compare the project with
+a trustworthy second implementation:
+
+- the leg frames follow the spec's DH table: Pinocchio's Q_i equals the
+  spec's multiplied-out p_Q, the platform anchors are p + Rz(phi) r_Qi, and
+  the closed-form inverse kinematics reproduces the spec's golden poses;
+- the inertia conventions (rod inertia about its centre of mass in DH frame 3
+  axes, slider mass translating only, massless U-joint crosses, platform
+  rotating about z only) and gravity: Pinocchio's mass matrix reproduces the
+  kinetic energy summed body by body from the spec's table, and its gravity
+  vector the gradient of the spec's potential energy;
+- the spec's derivable static check, 2.655616050 N per actuator at P0;
+- MuJoCo's model is the same mechanism: the same sites, mass matrix and bias
+  forces as Pinocchio's tree;
+- Pinocchio's own constraintDynamics gives the same accelerations as the
+  KKT solve used for the reference;
+- and the ctypes binding of this project's C API (engines/pkm_capi.py) has
+  pkm.h's struct layouts.
+"""
+import math
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from engines import mujoco_model, spec
+from engines.pinocchio_model import PinocchioPKM
+
+RNG = np.random.default_rng(20261121)
+
+GOLDEN = [  # MODEL_SPEC "Golden poses": pose, then (rho, theta1, theta2) of legs 1..4
+    ((0.0, 0.0, 0.05, 0.0),
+     [(0.0443193423, 3.2655932943, -0.8606121019), (0.0443193423, -1.3393164414, -0.8606121019),
+      (0.0443193423, 3.2655932943, -0.8606121019), (0.0443193423, -1.3393164414, -0.8606121019)]),
+    ((0.005, -0.005, 0.07, math.radians(4.0)),
+     [(0.0676488698, 3.3244509641, -0.9270633736), (0.0608871697, -1.3561168385, -0.7971100074),
+      (0.0407700625, 3.1413311322, -0.4823651758), (0.0792527515, -1.0390941300, -1.2373176895)]),
+]
+
+
+def random_q():
+    q = np.empty(16)
+    for i in range(4):
+        q[3 * i:3 * i + 3] = (RNG.uniform(0.02, 0.08), RNG.uniform(-math.pi, math.pi), RNG.uniform(-1.4, -0.2))
+    q[12:] = (*RNG.uniform(-0.01, 0.01, 2), RNG.uniform(0.04, 0.08), RNG.uniform(-0.3, 0.3))
+    return q
+
+
+def spec_kinetic_energy(q, v):
+    """T summed body by body from MODEL_SPEC "Bodies" (nothing from Pinocchio)."""
+    T = 0.5 * spec.M_PLATFORM * v[12:15] @ v[12:15] + 0.5 * spec.IZZ_PLATFORM * v[15] ** 2
+    for i in range(4):
+        rho_d, th1, th2 = v[3 * i], q[3 * i + 1], q[3 * i + 2]
+        th1_d, th2_d = v[3 * i + 1], v[3 * i + 2]
+        c1, s1, c2, s2 = math.cos(th1), math.sin(th1), math.cos(th2), math.sin(th2)
+        x3 = np.array([c1 * c2, s1 * c2, s2])
+        z3 = np.array([s1, -c1, 0.0])
+        y3 = np.cross(z3, x3)
+        omega = th1_d * np.array([0.0, 0.0, 1.0]) + th2_d * z3  # leg frame 0_i
+        v_com = np.array([0.0, 0.0, rho_d]) + np.cross(omega, 0.5 * spec.L * x3)
+        R3 = np.column_stack([x3, y3, z3])
+        I_leg = R3 @ np.diag(spec.I_ROD) @ R3.T
+        T += 0.5 * spec.M_SLIDER * rho_d**2 + 0.5 * spec.M_ROD * v_com @ v_com + 0.5 * omega @ I_leg @ omega
+    return T
+
+
+def spec_gravity(q):
+    """dU/dq of U = g (sum_i (m_s rho_i + m_r (rho_i + h + l/2 sin theta2_i)) + m_p z)."""
+    G = np.zeros(16)
+    for i in range(4):
+        G[3 * i] = spec.G * (spec.M_SLIDER + spec.M_ROD)
+        G[3 * i + 2] = spec.G * spec.M_ROD * 0.5 * spec.L * math.cos(q[3 * i + 2])
+    G[14] = spec.G * spec.M_PLATFORM
+    return G
+
+
+@pytest.fixture(scope="module")
+def pm():
+    return PinocchioPKM()
+
+
+def test_leg_frames_follow_the_dh_table(pm):
+    for _ in range(20):
+        q = random_q()
+        pin.framesForwardKinematics(pm.model, pm.data, q)
+        for i in range(4):
+            expected_q = spec.leg_end_point(i, *q[3 * i:3 * i + 3])
+            expected_r = q[12:15] + spec.rz(q[15]) @ spec.platform_point(i)
+            assert np.abs(pm.data.oMf[pm.q_frames[i]].translation - expected_q).max() < 1e-15
+            assert np.abs(pm.data.oMf[pm.r_frames[i]].translation - expected_r).max() < 1e-15
+
+
+def test_golden_poses(pm):
+    for pose, legs in GOLDEN:
+        got = spec.leg_inverse_kinematics(np.array(pose))
+        assert np.abs(got - np.array(legs)).max() < 1e-9, f"inverse kinematics at {pose}"
+        q = pm.q_from_pose(np.array(pose))
+        assert np.linalg.norm(pm.constraints(q)) < 1e-15
+        assert np.linalg.norm(spec.constraint_residual(q)) < 1e-15
+
+
+def test_mass_matrix_is_the_spec_kinetic_energy(pm):
+    """Checks the inertia conventions: 1/2 v^T M v against the bodies of the spec."""
+    for _ in range(20):
+        q, v = random_q(), RNG.normal(size=16)
+        T_pin = 0.5 * v @ pm.mass_matrix(q) @ v
+        T_spec = spec_kinetic_energy(q, v)
+        assert abs(T_pin - T_spec) <= 1e-14 * max(1.0, T_spec), (T_pin, T_spec)
+
+
+def test_gravity_is_the_spec_potential(pm):
+    for _ in range(20):
+        q = random_q()
+        G = pin.computeGeneralizedGravity(pm.model, pm.data, q)
+        assert np.abs(G - spec_gravity(q)).max() < 1e-14
+
+
+def test_static_check(pm):
+    """MODEL_SPEC "A check anyone can derive", from Pinocchio."""
+    F, _, _ = pm.inverse_dynamics(spec.P0, np.zeros(4), np.zeros(4))
+    print(f"\nPinocchio: static forces at P0 {F} N")
+    assert np.abs(F - spec.STATIC_FORCE_P0).max() < 1e-9
+    assert abs(F.sum() - 10.622464200) < 1e-9
+
+
+def test_mujoco_is_the_same_mechanism(pm):
+    """Sites, mass matrix and bias forces (gravity on) of the MJCF against Pinocchio's tree."""
+    model, data = mujoco_model.build(g=spec.G)
+    assert model.nq == 16 and model.nv == 16
+    M = np.zeros((16, 16))
+    for _ in range(20):
+        q, v = random_q(), RNG.normal(size=16)
+        data.qpos[:], data.qvel[:] = q, v
+        mujoco.mj_forward(model, data)
+        for i in range(4):
+            assert np.abs(data.site_xpos[i] - spec.leg_end_point(i, *q[3 * i:3 * i + 3])).max() < 1e-15
+            assert np.abs(data.site_xpos[4 + i] - q[12:15] - spec.rz(q[15]) @ spec.platform_point(i)).max() < 1e-15
+        mujoco.mj_fullM(model, data, M)  # MuJoCo >= 3.6 signature
+        M_pin = pm.mass_matrix(q)
+        # the slider's rotational inertia (1e-9 kg m^2, never used) stays out of M: it only translates
+        assert np.abs(M - M_pin).max() <= 1e-12 * np.abs(M_pin).max()
+        nle = pin.nonLinearEffects(pm.model, pm.data, q, v)
+        assert np.abs(data.qfrc_bias - nle).max() <= 1e-12 * max(1.0, np.abs(nle).max())
+
+
+def test_kkt_equals_pinocchio_constraint_dynamics():
+    pm = PinocchioPKM(g=spec.G)
+    pm.setup_constraint_dynamics()
+    for pose in (spec.P0, spec.P1):
+        q = pm.q_from_pose(pose)
+        v = pm.complete_velocity(q, RNG.normal(scale=0.05, size=4))
+        F = spec.STATIC_FORCE_P0 + RNG.normal(scale=0.1, size=4)
+        a_kkt, lam = pm.forward_dynamics(q, v, F)
+        a_pin = pm.constraint_dynamics(q, v, F)
+        assert np.abs(a_kkt - a_pin).max() <= 1e-10 * np.abs(a_kkt).max()
+        # the accelerations keep the constraints: J a + gamma = 0
+        assert np.abs(pm.jacobian(q) @ a_kkt + pm.bias(q, v)).max() < 1e-12
+
+
+def test_capi_binding_matches_pkm_h():
+    """engines/pkm_capi.py's ctypes structs against fmu_src/capi/pkm.h: the same
+    fields at the same offsets (fields appended to pkm.h later must fit in the
+    binding's reserve)."""
+    from engines import pkm_capi
+    bad = pkm_capi.binding_mismatches()
+    assert not bad, "\n".join(bad)
