@@ -19,7 +19,7 @@ _CHECKS = REPO / "python_checks"
 if str(_CHECKS) not in sys.path:
     sys.path.insert(0, str(_CHECKS))
 
-from fmu_helpers import ACC, F, M_PLATFORM, P0, P1, POSE, T_MOVE, VEL, Fmu, arr  # noqa: E402,F401
+from fmu_helpers import ACC, F, M_PLATFORM, P0, P1, POSE, T_MOVE, VEL, Fmu, arr, blend  # noqa: E402,F401
 
 PLANT_FMU = "PKM4PUU.fmu"
 INVERSE_FMU = "PKM4PUU_Inverse.fmu"
@@ -36,19 +36,6 @@ RK4 = {"solver": 1, "rk4_step": H}
 
 
 # --- the auto-test motion with a free duration T ----------------------------------
-def blend(tau):
-    """s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5 and its first two derivatives in
-    tau, at rest before tau = 0 and after tau = 1 (MODEL_SPEC "Auto-test")."""
-    if tau <= 0.0:
-        return 0.0, 0.0, 0.0
-    if tau >= 1.0:
-        return 1.0, 0.0, 0.0
-    s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
-    ds = 30.0 * tau**2 * (1.0 - tau) ** 2
-    dds = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau)
-    return s, ds, dds
-
-
 def motion(t, T=T_MOVE):
     """Pose, velocity and acceleration (each x, y, z, phi) of the spec's
     rest-to-rest quintic from P0 to P1 done in T seconds (the spec's T is 2 s),

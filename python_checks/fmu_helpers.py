@@ -39,7 +39,7 @@ def arr(name, n):
 F = arr("F", 4)
 
 
-def _blend(tau):
+def blend(tau):
     """s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5 and its first two derivatives,
     held at rest before tau = 0 and after tau = 1 (the motion is rest to rest)."""
     if tau <= 0.0:
@@ -54,17 +54,17 @@ def _blend(tau):
 
 def p(t):
     """Prescribed pose (x, y, z, phi) at time t."""
-    return P0 + (P1 - P0) * _blend(t / T_MOVE)[0]
+    return P0 + (P1 - P0) * blend(t / T_MOVE)[0]
 
 
 def pd(t):
     """Prescribed velocity at time t."""
-    return (P1 - P0) * _blend(t / T_MOVE)[1] / T_MOVE
+    return (P1 - P0) * blend(t / T_MOVE)[1] / T_MOVE
 
 
 def pdd(t):
     """Prescribed acceleration at time t."""
-    return (P1 - P0) * _blend(t / T_MOVE)[2] / T_MOVE**2
+    return (P1 - P0) * blend(t / T_MOVE)[2] / T_MOVE**2
 
 
 class Fmu:

@@ -22,56 +22,16 @@
 #include <gtest/gtest.h>
 
 #include "fmi2FunctionTypes.h"
+#include "fmu_loader.hpp"
 #include "models.hpp"
 
 namespace {
 
-constexpr double kStaticForce = 2.655616050;  // MODEL_SPEC "A check anyone can derive"
-constexpr double kPi = 3.14159265358979323846;
-
-// ---------------------------------------------------------------- the library
-
-struct Library {
-  void* handle = nullptr;
-#define PKM_FMI2_FUNCTIONS(X)                                                                                  \
-  X(fmi2GetTypesPlatform) X(fmi2GetVersion) X(fmi2SetDebugLogging) X(fmi2Instantiate) X(fmi2FreeInstance)      \
-  X(fmi2SetupExperiment) X(fmi2EnterInitializationMode) X(fmi2ExitInitializationMode) X(fmi2Terminate)         \
-  X(fmi2Reset) X(fmi2GetReal) X(fmi2GetInteger) X(fmi2GetBoolean) X(fmi2GetString) X(fmi2SetReal)              \
-  X(fmi2SetInteger) X(fmi2SetBoolean) X(fmi2SetString) X(fmi2GetFMUstate) X(fmi2SetFMUstate)                   \
-  X(fmi2FreeFMUstate) X(fmi2SerializedFMUstateSize) X(fmi2SerializeFMUstate) X(fmi2DeSerializeFMUstate)        \
-  X(fmi2GetDirectionalDerivative) X(fmi2SetRealInputDerivatives) X(fmi2GetRealOutputDerivatives) X(fmi2DoStep) \
-  X(fmi2CancelStep) X(fmi2GetStatus) X(fmi2GetRealStatus) X(fmi2GetIntegerStatus) X(fmi2GetBooleanStatus)      \
-  X(fmi2GetStringStatus)
-#define PKM_DECLARE(name) name##TYPE* name = nullptr;
-  PKM_FMI2_FUNCTIONS(PKM_DECLARE)
-#undef PKM_DECLARE
-  std::string missing;
-
-  explicit Library(const char* path) {
-    handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-    if (!handle) {
-      missing = dlerror();
-      return;
-    }
-#define PKM_LOAD(name)                                                     \
-  name = reinterpret_cast<name##TYPE*>(dlsym(handle, #name));              \
-  if (!name) missing += #name " ";
-    PKM_FMI2_FUNCTIONS(PKM_LOAD)
-#undef PKM_LOAD
-  }
-  ~Library() {
-    if (handle) dlclose(handle);
-  }
-};
-
-Library& plant_library() {
-  static Library lib(PKM_FMU_PLANT_SO);
-  return lib;
-}
-Library& inverse_library() {
-  static Library lib(PKM_FMU_INVERSE_SO);
-  return lib;
-}
+using pkm_test::kPi;
+using pkm_test::kStaticForce;
+using pkm_test::plant_library;
+using pkm_test::inverse_library;
+using Library = pkm_test::FmuLibrary;
 
 // ---------------------------------------------------------------- logging
 

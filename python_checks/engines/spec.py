@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 
+from fmu_helpers import blend  # the spec's quintic s(tau), shared with the FMU checks
+
 # --- Geometry defaults (Table II) -----------------------------------------------
 H = 0.06634  # m, offset of the prismatic joint (d1 = rho + h)
 L = 0.080  # m, rod length (a3)
@@ -38,19 +40,6 @@ P1 = np.array([0.005, -0.005, 0.07, math.radians(4.0)])
 # --- Comparison test (paper 5.2) ------------------------------------------------------------
 CMP_DURATION = 1.5  # s
 CMP_AMPLITUDE = 0.02  # N
-
-
-def blend(tau):
-    """s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5 and its first two derivatives
-    (held at rest outside [0, 1])."""
-    if tau <= 0.0:
-        return 0.0, 0.0, 0.0
-    if tau >= 1.0:
-        return 1.0, 0.0, 0.0
-    s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
-    ds = 30.0 * tau**2 * (1.0 - tau) ** 2
-    dds = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau)
-    return s, ds, dds
 
 
 def autotest_motion(t):
