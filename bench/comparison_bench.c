@@ -52,6 +52,9 @@
 #include <unistd.h>
 
 #include "fmi2FunctionTypes.h"
+
+#define PKM_HARNESS_NAME "pkm_comparison_bench"
+#include "fmu_harness.h"
 #include "pkm.h"
 
 #ifndef PKM_FMU_PLANT_SO
@@ -74,17 +77,6 @@ static void forces(double t, double F[4]) {
   F[1] = 0.0;
   F[2] = 0.0;
   F[3] = -f;
-}
-
-static double now_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int compare_double(const void* a, const void* b) {
-  const double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
 }
 
 typedef struct {
@@ -226,108 +218,7 @@ static int run_capi(const pkm_solver_settings* settings, int one_call, int batch
 
 /* ------------------------------------------------------------- the FMU */
 
-typedef struct {
-  void* handle;
-  fmi2InstantiateTYPE* fmi2Instantiate;
-  fmi2FreeInstanceTYPE* fmi2FreeInstance;
-  fmi2SetupExperimentTYPE* fmi2SetupExperiment;
-  fmi2EnterInitializationModeTYPE* fmi2EnterInitializationMode;
-  fmi2ExitInitializationModeTYPE* fmi2ExitInitializationMode;
-  fmi2TerminateTYPE* fmi2Terminate;
-  fmi2GetRealTYPE* fmi2GetReal;
-  fmi2SetRealTYPE* fmi2SetReal;
-  fmi2SetIntegerTYPE* fmi2SetInteger;
-  fmi2GetFMUstateTYPE* fmi2GetFMUstate;
-  fmi2SetFMUstateTYPE* fmi2SetFMUstate;
-  fmi2FreeFMUstateTYPE* fmi2FreeFMUstate;
-  fmi2DoStepTYPE* fmi2DoStep;
-} Fmu;
 
-/* dlsym returns an object pointer; POSIX guarantees the representation of a
- * function pointer is the same: copy the bytes (as fmu_step_bench.c). */
-static int load_symbol(void* handle, const char* name, void* fn_ptr, size_t fn_size) {
-  void* p = dlsym(handle, name);
-  if (!p || fn_size != sizeof p) {
-    fprintf(stderr, "pkm_comparison_bench: symbol %s not found\n", name);
-    return 0;
-  }
-  memcpy(fn_ptr, &p, fn_size);
-  return 1;
-}
-
-static int load_fmu(const char* path, Fmu* f) {
-  int ok = 1;
-  memset(f, 0, sizeof *f);
-  f->handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-  if (!f->handle) {
-    fprintf(stderr, "pkm_comparison_bench: dlopen(%s): %s\n", path, dlerror());
-    return 0;
-  }
-#define LOAD(name) ok &= load_symbol(f->handle, #name, &f->name, sizeof f->name)
-  LOAD(fmi2Instantiate);
-  LOAD(fmi2FreeInstance);
-  LOAD(fmi2SetupExperiment);
-  LOAD(fmi2EnterInitializationMode);
-  LOAD(fmi2ExitInitializationMode);
-  LOAD(fmi2Terminate);
-  LOAD(fmi2GetReal);
-  LOAD(fmi2SetReal);
-  LOAD(fmi2SetInteger);
-  LOAD(fmi2GetFMUstate);
-  LOAD(fmi2SetFMUstate);
-  LOAD(fmi2FreeFMUstate);
-  LOAD(fmi2DoStep);
-#undef LOAD
-  return ok;
-}
-
-static void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status, fmi2String category,
-                   fmi2String message, ...) {
-  va_list ap;
-  (void)env;
-  (void)category;
-  if (status != fmi2Error && status != fmi2Fatal) return;
-  fprintf(stderr, "[%s] ", instance ? instance : "?");
-  va_start(ap, message);
-  vfprintf(stderr, message ? message : "", ap);
-  va_end(ap);
-  fputc('\n', stderr);
-}
-
-static void* allocate_memory(size_t nobj, size_t size) { return calloc(nobj, size); }
-
-static char* read_text(const char* path) {
-  FILE* fp = fopen(path, "rb");
-  char* text = NULL;
-  long n;
-  if (!fp) return NULL;
-  if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0) {
-    text = malloc((size_t)n + 1);
-    if (text && fread(text, 1, (size_t)n, fp) == (size_t)n) {
-      text[n] = '\0';
-    } else {
-      free(text);
-      text = NULL;
-    }
-  }
-  fclose(fp);
-  return text;
-}
-
-/* The value of attribute `name` inside [begin, end), copied to out. */
-static int attribute(const char* begin, const char* end, const char* name, char* out, size_t size) {
-  char key[64];
-  const char *p, *v, *q;
-  snprintf(key, sizeof key, " %s=\"", name);
-  p = strstr(begin, key);
-  if (!p || p >= end) return 0;
-  v = p + strlen(key);
-  q = strchr(v, '"');
-  if (!q || q >= end || (size_t)(q - v) >= size) return 0;
-  memcpy(out, v, (size_t)(q - v));
-  out[q - v] = '\0';
-  return 1;
-}
 
 static int value_reference(const char* text, const char* name, fmi2ValueReference* vr) {
   const char* p = text;
@@ -446,46 +337,6 @@ done:
 }
 
 /* ------------------------------------------------------------------ main */
-
-static char* default_xml_path(const char* so) {
-  /* <stage>/binaries/<platform>/<id>.so -> <stage>/modelDescription.xml */
-  const char* suffix = "modelDescription.xml";
-  size_t n = strlen(so);
-  int slashes = 0;
-  char* path;
-  while (n > 0 && slashes < 3)
-    if (so[--n] == '/') ++slashes;
-  if (slashes < 3) return NULL;
-  path = malloc(n + 1 + strlen(suffix) + 1);
-  if (!path) return NULL;
-  memcpy(path, so, n + 1);
-  strcpy(path + n + 1, suffix);
-  return path;
-}
-
-static void print_machine(void) {
-  struct utsname u;
-  char line[512], cpu[256] = "unknown";
-  FILE* fp = fopen("/proc/cpuinfo", "r");
-  if (fp) {
-    while (fgets(line, sizeof line, fp)) {
-      if (strncmp(line, "model name", 10) == 0) {
-        const char* v = strchr(line, ':');
-        if (v) {
-          size_t n;
-          v += strspn(v + 1, " \t") + 1;
-          snprintf(cpu, sizeof cpu, "%s", v);
-          n = strlen(cpu);
-          while (n > 0 && (cpu[n - 1] == '\n' || cpu[n - 1] == '\r')) cpu[--n] = '\0';
-        }
-        break;
-      }
-    }
-    fclose(fp);
-  }
-  if (uname(&u) == 0) printf("machine: %s %s %s\n", u.sysname, u.release, u.machine);
-  printf("cpu:     %s; %ld cores online\n", cpu, sysconf(_SC_NPROCESSORS_ONLN));
-}
 
 static void usage(void) {
   fprintf(stderr, "usage: pkm_comparison_bench [--out DIR] [--batches N] [--fmu PKM4PUU.so [--xml FILE]]\n");

@@ -1,0 +1,200 @@
+/* What the C benchmark harnesses share (pkm_fmu_bench, pkm_comparison_bench):
+ * loading a built FMU binary with dlopen, a logger that stays silent unless
+ * the FMU reports an error, reading modelDescription.xml's attributes, the
+ * clock and the machine's description. Static functions, one copy per
+ * harness; define PKM_HARNESS_NAME (the program's name, for messages) first. */
+#ifndef PKM_BENCH_FMU_HARNESS_H
+#define PKM_BENCH_FMU_HARNESS_H
+
+#include <dlfcn.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/utsname.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "fmi2FunctionTypes.h"
+
+#ifndef PKM_HARNESS_NAME
+#error "define PKM_HARNESS_NAME before including fmu_harness.h"
+#endif
+
+typedef struct {
+  void* handle;
+  fmi2InstantiateTYPE* fmi2Instantiate;
+  fmi2FreeInstanceTYPE* fmi2FreeInstance;
+  fmi2SetupExperimentTYPE* fmi2SetupExperiment;
+  fmi2EnterInitializationModeTYPE* fmi2EnterInitializationMode;
+  fmi2ExitInitializationModeTYPE* fmi2ExitInitializationMode;
+  fmi2TerminateTYPE* fmi2Terminate;
+  fmi2GetRealTYPE* fmi2GetReal;
+  fmi2SetRealTYPE* fmi2SetReal;
+  fmi2SetIntegerTYPE* fmi2SetInteger;
+  fmi2GetFMUstateTYPE* fmi2GetFMUstate;
+  fmi2SetFMUstateTYPE* fmi2SetFMUstate;
+  fmi2FreeFMUstateTYPE* fmi2FreeFMUstate;
+  fmi2DoStepTYPE* fmi2DoStep;
+} Fmu;
+
+/* dlsym returns an object pointer; ISO C has no conversion to a function
+ * pointer, POSIX guarantees the representation: copy the bytes. */
+static int load_symbol(void* handle, const char* name, void* fn_ptr, size_t fn_size) {
+  void* p = dlsym(handle, name);
+  if (!p) {
+    fprintf(stderr, PKM_HARNESS_NAME ": symbol %s not found\n", name);
+    return 0;
+  }
+  if (fn_size != sizeof p) {
+    fprintf(stderr, PKM_HARNESS_NAME ": function and object pointers differ in size\n");
+    return 0;
+  }
+  memcpy(fn_ptr, &p, fn_size);
+  return 1;
+}
+
+static int load_fmu(const char* path, Fmu* f) {
+  int ok = 1;
+  memset(f, 0, sizeof *f);
+  f->handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+  if (!f->handle) {
+    fprintf(stderr, PKM_HARNESS_NAME ": dlopen(%s): %s\n", path, dlerror());
+    return 0;
+  }
+#define LOAD(name) ok &= load_symbol(f->handle, #name, &f->name, sizeof f->name)
+  LOAD(fmi2Instantiate);
+  LOAD(fmi2FreeInstance);
+  LOAD(fmi2SetupExperiment);
+  LOAD(fmi2EnterInitializationMode);
+  LOAD(fmi2ExitInitializationMode);
+  LOAD(fmi2Terminate);
+  LOAD(fmi2GetReal);
+  LOAD(fmi2SetReal);
+  LOAD(fmi2SetInteger);
+  LOAD(fmi2GetFMUstate);
+  LOAD(fmi2SetFMUstate);
+  LOAD(fmi2FreeFMUstate);
+  LOAD(fmi2DoStep);
+#undef LOAD
+  return ok;
+}
+
+static const char* status_name(fmi2Status s) {
+  switch (s) {
+    case fmi2OK: return "fmi2OK";
+    case fmi2Warning: return "fmi2Warning";
+    case fmi2Discard: return "fmi2Discard";
+    case fmi2Error: return "fmi2Error";
+    case fmi2Fatal: return "fmi2Fatal";
+    case fmi2Pending: return "fmi2Pending";
+  }
+  return "unknown status";
+}
+
+/* Silent unless the FMU reports an error. */
+static void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status, fmi2String category,
+                   fmi2String message, ...) {
+  va_list ap;
+  (void)env;
+  if (status != fmi2Error && status != fmi2Fatal) return;
+  fprintf(stderr, "[%s] %s %s: ", instance ? instance : "?", status_name(status), category ? category : "");
+  va_start(ap, message);
+  vfprintf(stderr, message ? message : "", ap);
+  va_end(ap);
+  fputc('\n', stderr);
+}
+
+static char* read_text(const char* path) {
+  FILE* fp = fopen(path, "rb");
+  char* text = NULL;
+  long n;
+  if (!fp) return NULL;
+  if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0) {
+    text = malloc((size_t)n + 1);
+    if (text && fread(text, 1, (size_t)n, fp) == (size_t)n) {
+      text[n] = '\0';
+    } else {
+      free(text);
+      text = NULL;
+    }
+  }
+  fclose(fp);
+  return text;
+}
+
+/* The value of attribute `name` ("name=\"") inside [begin, end), copied to out. */
+static int attribute(const char* begin, const char* end, const char* name, char* out, size_t size) {
+  char key[64];
+  const char* p = begin;
+  size_t klen;
+  const char* v;
+  const char* q;
+  snprintf(key, sizeof key, " %s=\"", name);
+  klen = strlen(key);
+  p = strstr(p, key);
+  if (!p || p >= end) return 0;
+  v = p + klen;
+  q = strchr(v, '"');
+  if (!q || q >= end || (size_t)(q - v) >= size) return 0;
+  memcpy(out, v, (size_t)(q - v));
+  out[q - v] = '\0';
+  return 1;
+}
+
+static double now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int compare_double(const void* a, const void* b) {
+  const double x = *(const double*)a, y = *(const double*)b;
+  return (x > y) - (x < y);
+}
+
+static void print_machine(void) {
+  struct utsname u;
+  char line[512], cpu[256] = "unknown";
+  FILE* fp = fopen("/proc/cpuinfo", "r");
+  if (fp) {
+    while (fgets(line, sizeof line, fp)) {
+      if (strncmp(line, "model name", 10) == 0) {
+        const char* v = strchr(line, ':');
+        if (v) {
+          size_t n;
+          v += strspn(v + 1, " \t") + 1;
+          snprintf(cpu, sizeof cpu, "%s", v);
+          n = strlen(cpu);
+          while (n > 0 && (cpu[n - 1] == '\n' || cpu[n - 1] == '\r')) cpu[--n] = '\0';
+        }
+        break;
+      }
+    }
+    fclose(fp);
+  }
+  if (uname(&u) == 0)
+    printf("machine: %s %s %s %s\n", u.sysname, u.release, u.version, u.machine);
+  printf("cpu:     %s; %ld cores online (%ld configured)\n", cpu, sysconf(_SC_NPROCESSORS_ONLN),
+         sysconf(_SC_NPROCESSORS_CONF));
+}
+
+static char* default_xml_path(const char* so) {
+  /* <stage>/binaries/<platform>/<id>.so -> <stage>/modelDescription.xml */
+  const char* suffix = "modelDescription.xml";
+  size_t n = strlen(so);
+  int slashes = 0;
+  char* path;
+  while (n > 0 && slashes < 3)
+    if (so[--n] == '/') ++slashes;
+  if (slashes < 3) return NULL;
+  path = malloc(n + 1 + strlen(suffix) + 1);
+  if (!path) return NULL;
+  memcpy(path, so, n + 1);
+  strcpy(path + n + 1, suffix);
+  return path;
+}
+
+static void* allocate_memory(size_t nobj, size_t size) { return calloc(nobj, size); }
+
+#endif /* PKM_BENCH_FMU_HARNESS_H */
