@@ -6,6 +6,7 @@
 #pragma once
 
 #include <dlfcn.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdarg>
@@ -244,6 +245,24 @@ inline bool have_fmpy() {
   int status = 0;
   capture("'" + python + "' -c 'import fmpy' 2>&1", &status);
   return status == 0;
+}
+
+/// Runs a Python script with PKM_FMU_PYTHON (through a temporary file) and
+/// returns its output (stdout and stderr); *status is the exit status.
+inline std::string run_python(const std::string& script, int* status) {
+  char path[] = "/tmp/pkm_test_python_XXXXXX";
+  const int fd = mkstemp(path);
+  if (fd < 0) {
+    *status = -1;
+    return "mkstemp failed";
+  }
+  const bool written = write(fd, script.data(), script.size()) == static_cast<ssize_t>(script.size());
+  close(fd);
+  std::string out = written ? capture(std::string("'") + PKM_FMU_PYTHON + "' " + path + " 2>&1", status)
+                            : "cannot write the script";
+  if (!written) *status = -1;
+  unlink(path);
+  return out;
 }
 
 }  // namespace pkm_test

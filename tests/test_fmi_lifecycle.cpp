@@ -32,101 +32,20 @@ using pkm_test::kStaticForce;
 using pkm_test::plant_library;
 using pkm_test::inverse_library;
 using Library = pkm_test::FmuLibrary;
-
-// ---------------------------------------------------------------- logging
-
-struct Message {
-  fmi2Status status;
-  std::string category, text;
-};
-
-struct Log {
-  std::vector<Message> messages;
-  bool contains(const std::string& s) const {
-    for (const auto& m : messages)
-      if (m.text.find(s) != std::string::npos) return true;
-    return false;
-  }
-  std::string dump() const {
-    std::string out;
-    for (const auto& m : messages) out += "  [" + m.category + "] " + m.text + "\n";
-    return out;
-  }
-};
-
-void collect(fmi2ComponentEnvironment env, fmi2String, fmi2Status status, fmi2String category, fmi2String message,
-             ...) {
-  static_cast<Log*>(env)->messages.push_back({status, category ? category : "", message ? message : ""});
-}
+using pkm_test::capture;
+using pkm_test::have_fmpy;
 
 // ---------------------------------------------------------------- an instance
 
-fmi2ValueReference vr_of(const pkm_fmi::ModelDefinition& d, const std::string& name) {
-  const pkm_fmi::Variable* v = d.find(name.c_str());
-  if (!v) ADD_FAILURE() << "no variable " << name;
-  return v ? v->vr : 0;
-}
+using pkm_test::Log;
 
-class Instance {
+/// tests/fmu_loader.hpp's instance, with this file's argument order
+/// (logging flag before the instance name).
+class Instance : public pkm_test::FmuInstance {
  public:
   Instance(Library& lib, const pkm_fmi::ModelDefinition& def, const char* guid, bool logging_on = false,
            const char* name = "instance")
-      : lib_(lib), def_(def) {
-    functions_ = fmi2CallbackFunctions{&collect, &std::calloc, &std::free, nullptr, &log};
-    c = lib.fmi2Instantiate(name, fmi2CoSimulation, guid, "file:///nonexistent", &functions_, fmi2False,
-                            logging_on ? fmi2True : fmi2False);
-  }
-  ~Instance() {
-    if (c) lib_.fmi2FreeInstance(c);
-  }
-  Instance(const Instance&) = delete;
-  Instance& operator=(const Instance&) = delete;
-
-  fmi2ValueReference vr(const std::string& name) const { return vr_of(def_, name); }
-
-  fmi2Status set(const std::string& name, double value) {
-    const fmi2ValueReference r = vr(name);
-    return lib_.fmi2SetReal(c, &r, 1, &value);
-  }
-  fmi2Status set_int(const std::string& name, int value) {
-    const fmi2ValueReference r = vr(name);
-    const fmi2Integer v = value;
-    return lib_.fmi2SetInteger(c, &r, 1, &v);
-  }
-  double get(const std::string& name) {
-    const fmi2ValueReference r = vr(name);
-    double v = std::nan("");
-    EXPECT_EQ(lib_.fmi2GetReal(c, &r, 1, &v), fmi2OK) << name << "\n" << log.dump();
-    return v;
-  }
-  fmi2Status set_derivative(const std::string& name, double value) {
-    const fmi2ValueReference r = vr(name);
-    const fmi2Integer order = 1;
-    return lib_.fmi2SetRealInputDerivatives(c, &r, 1, &order, &value);
-  }
-  /// Setup, initialisation mode, exit, at t = 0.
-  void initialize() {
-    ASSERT_EQ(lib_.fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK) << log.dump();
-    ASSERT_EQ(lib_.fmi2EnterInitializationMode(c), fmi2OK) << log.dump();
-    ASSERT_EQ(lib_.fmi2ExitInitializationMode(c), fmi2OK) << log.dump();
-  }
-  /// Every Real output, in table order.
-  std::vector<double> outputs() {
-    std::vector<fmi2ValueReference> vrs;
-    for (std::size_t k = 0; k < def_.n_variables; ++k)
-      if (def_.variables[k].causality == pkm_fmi::Causality::Output) vrs.push_back(def_.variables[k].vr);
-    std::vector<double> v(vrs.size());
-    EXPECT_EQ(lib_.fmi2GetReal(c, vrs.data(), vrs.size(), v.data()), fmi2OK) << log.dump();
-    return v;
-  }
-
-  fmi2Component c = nullptr;
-  Log log;
-
- private:
-  Library& lib_;
-  const pkm_fmi::ModelDefinition& def_;
-  fmi2CallbackFunctions functions_;
+      : FmuInstance(lib, def, guid, name, logging_on) {}
 };
 
 struct Plant : Instance {
@@ -187,7 +106,7 @@ TEST_F(Fmi2, VersionAndPlatform) {
 
 TEST_F(Fmi2, InstantiateChecksGuidAndType) {
   Log log;
-  const fmi2CallbackFunctions f{&collect, &std::calloc, &std::free, nullptr, &log};
+  const fmi2CallbackFunctions f{&pkm_test::collect_log, &std::calloc, &std::free, nullptr, &log};
   EXPECT_EQ(lib.fmi2Instantiate("x", fmi2CoSimulation, "{not-the-guid}", "", &f, fmi2False, fmi2False), nullptr);
   EXPECT_EQ(lib.fmi2Instantiate("x", fmi2ModelExchange, PKM_FMU_PLANT_GUID, "", &f, fmi2False, fmi2False), nullptr);
   EXPECT_EQ(lib.fmi2Instantiate("x", fmi2CoSimulation, PKM_FMU_INVERSE_GUID, "", &f, fmi2False, fmi2False), nullptr);
@@ -758,16 +677,6 @@ TEST_F(Fmi2, InverseStateRoundTrip) {
 
 // ---------------------------------------------------------------- the binaries
 
-std::string capture(const std::string& command, int* status = nullptr) {
-  std::string out;
-  FILE* f = popen(command.c_str(), "r");
-  if (!f) return out;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, f)) out += buf;
-  const int st = pclose(f);
-  if (status) *status = st;
-  return out;
-}
 
 TEST(FmuBinaries, NeedOnlyTheSystemRuntime) {
   // SUNDIALS and the C++ runtime are linked statically (-static-libstdc++
@@ -812,13 +721,6 @@ TEST(FmuBinaries, ExportOnlyTheFmi2Functions) {
   }
 }
 
-bool have_fmpy() {
-  const std::string python = PKM_FMU_PYTHON;
-  if (python.empty()) return false;
-  int status = 0;
-  capture("'" + python + "' -c 'import fmpy' 2>&1", &status);
-  return status == 0;
-}
 
 TEST(FmuArchives, FmpyValidatesThem) {
   if (!have_fmpy()) GTEST_SKIP() << "no Python with fmpy (PKM_FMU_PYTHON)";
@@ -842,14 +744,8 @@ TEST(FmuArchives, FmpySimulatesTheHomePose) {
       "i = fmpy.simulate_fmu('" PKM_FMU_INVERSE_FMU "', stop_time=0.01, step_size=1e-3)\n"
       "ferr = max(abs(i['F[%d]' % k] - F).max() for k in range(1, 5))\n"
       "print('RESULT', r['time'][-1], dev, ferr)\n";
-  char path[] = "/tmp/pkm_fmpy_XXXXXX";
-  const int fd = mkstemp(path);
-  ASSERT_GE(fd, 0);
-  ASSERT_EQ(write(fd, script.data(), script.size()), static_cast<ssize_t>(script.size()));
-  close(fd);
   int status = 0;
-  const std::string out = capture(std::string("'") + PKM_FMU_PYTHON + "' " + path + " 2>&1", &status);
-  unlink(path);
+  const std::string out = pkm_test::run_python(script, &status);
   ASSERT_EQ(status, 0) << out;
   const std::size_t at = out.find("RESULT");
   ASSERT_NE(at, std::string::npos) << out;

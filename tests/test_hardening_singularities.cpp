@@ -247,14 +247,8 @@ TEST(HardeningSingularities, FmpyStopsAtTheLastSuccessfulTime) {
       "        output=['x', 'y', 'z', 'phi', 'rho[4]', 'theta2[4]', 'jacobian_condition'])\n"
       "    finite = all(math.isfinite(v) for row in r for v in row)\n"
       "    print('RESULT', solver, len(r), r['time'][-1], int(finite))\n";
-  char path[] = "/tmp/pkm_hardening_fmpy_XXXXXX";
-  const int fd = mkstemp(path);
-  ASSERT_GE(fd, 0);
-  ASSERT_EQ(write(fd, script.data(), script.size()), static_cast<ssize_t>(script.size()));
-  close(fd);
   int status = 0;
-  const std::string out = capture(std::string("'") + PKM_FMU_PYTHON + "' " + path + " 2>&1", &status);
-  unlink(path);
+  const std::string out = pkm_test::run_python(script, &status);
   ASSERT_EQ(status, 0) << out;
   for (int solver : {0, 1}) {
     const std::string key = "RESULT " + std::to_string(solver) + " ";
