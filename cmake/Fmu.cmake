@@ -1,15 +1,14 @@
-# FMI 2.0 co-simulation FMUs: the FMI headers, a GUID per model description,
-# the FMU shared objects and their .fmu archives.
+# The FMUs: the FMI 2.0 and 3.0 headers, the FMU shared objects and their
+# .fmu archives.
 #
-#   FMI2_HEADERS_DIR  (cache) directory holding fmi2Functions.h. Default:
+#   FMI2_HEADERS_DIR  (cache) directory holding fmi2Functions.h and fmi3Functions.h. Default:
 #                     fmpy's c-code directory, found with the project's
 #                     .venv/bin/python (else python3). The headers are used
 #                     in place, never copied into the repository.
 #   PKM_FMU_PYTHON    (cache) the Python that has fmpy (tests: fmpy validate).
 #
-#   pkm_fmu_guid(<out-var> <modelIdentifier> <modelDescription template>)
-#   pkm_add_fmu(<modelIdentifier> DEFINITION <C++ function> MODEL_DESCRIPTION <template>
-#               GUID <guid> SOURCES <exported-functions .cpp> LIBRARIES <libs...>
+#   pkm_add_fmu(<modelIdentifier> DEFINITION <C++ function> MODEL_DESCRIPTIONS <dir>
+#               SOURCES <front ends .cpp> LIBRARIES <libs...>
 #               VERSION_SCRIPT <map> DOC_TOOL <executable target>)
 include_guard(GLOBAL)
 
@@ -46,7 +45,8 @@ if(NOT FMI2_HEADERS_DIR AND _pkm_fmpy_dir AND EXISTS "${_pkm_fmpy_dir}/fmi2Funct
       "Directory with the FMI 2.0 headers (fmi2Functions.h); default: fmpy's c-code" FORCE)
 endif()
 if(NOT FMI2_HEADERS_DIR OR NOT EXISTS "${FMI2_HEADERS_DIR}/fmi2Functions.h"
-   OR NOT EXISTS "${FMI2_HEADERS_DIR}/fmi2FunctionTypes.h" OR NOT EXISTS "${FMI2_HEADERS_DIR}/fmi2TypesPlatform.h")
+   OR NOT EXISTS "${FMI2_HEADERS_DIR}/fmi2FunctionTypes.h" OR NOT EXISTS "${FMI2_HEADERS_DIR}/fmi2TypesPlatform.h"
+   OR NOT EXISTS "${FMI2_HEADERS_DIR}/fmi3Functions.h")
   message(FATAL_ERROR
     "FMI 2.0 headers not found (FMI2_HEADERS_DIR = '${FMI2_HEADERS_DIR}'). They come from the fmpy package: "
     "run ./scripts/setup.sh to create .venv with python_checks/requirements.txt (fmpy), or install fmpy for "
@@ -60,13 +60,17 @@ if(NOT TARGET pkm_fmi2_headers)
   add_library(pkm::fmi2_headers ALIAS pkm_fmi2_headers)
 endif()
 
-# FMI platform directory of the binaries.
+# FMI platform directories of the binaries: FMI 2.0 (linux64, win64, ...)
+# and FMI 3.0 (x86_64-linux, aarch64-linux, x86_64-windows, ...).
 if(CMAKE_SYSTEM_NAME STREQUAL "Linux")
   set(PKM_FMU_PLATFORM "linux")
+  set(_pkm_fmi3_os "linux")
 elseif(APPLE)
   set(PKM_FMU_PLATFORM "darwin")
+  set(_pkm_fmi3_os "darwin")
 elseif(WIN32)
   set(PKM_FMU_PLATFORM "win")
+  set(_pkm_fmi3_os "windows")
 else()
   message(FATAL_ERROR "FMU: unsupported platform ${CMAKE_SYSTEM_NAME}")
 endif()
@@ -75,34 +79,33 @@ if(CMAKE_SIZEOF_VOID_P EQUAL 8)
 else()
   string(APPEND PKM_FMU_PLATFORM "32")
 endif()
+string(TOLOWER "${CMAKE_SYSTEM_PROCESSOR}" _pkm_cpu)
+if(_pkm_cpu MATCHES "^(x86_64|amd64)$")
+  set(_pkm_cpu "x86_64")
+elseif(_pkm_cpu MATCHES "^(aarch64|arm64)$")
+  set(_pkm_cpu "aarch64")
+endif()
+set(PKM_FMU3_PLATFORM "${_pkm_cpu}-${_pkm_fmi3_os}")
 
-# A name-based (SHA-1) UUID of the model description template: it changes
-# whenever the interface described there changes.
-function(pkm_fmu_guid out_var model_identifier template)
-  file(SHA1 "${template}" _sha)
-  string(UUID _uuid NAMESPACE 6ba7b811-9dad-11d1-80b4-00c04fd430c8 NAME "${model_identifier}:${_sha}" TYPE SHA1)
-  set(${out_var} "{${_uuid}}" PARENT_SCOPE)
-endfunction()
-
-# One FMU: <id>.so (PREFIX "", only fmi2* exported, C++ runtime linked
-# statically), its staging tree ${CMAKE_BINARY_DIR}/fmu/<id>/ and the
-# archive ${CMAKE_BINARY_DIR}/<id>.fmu (target <id>_fmu, part of ALL).
-# Sets <id>_FMU_DIR and <id>_FMU_FILE in the caller's scope.
+# One FMU binary <id> (PREFIX "", only the fmi2* and fmi3* functions
+# exported, the C++ runtime linked statically) and its two archives:
+#   ${CMAKE_BINARY_DIR}/<id>.fmu       FMI 2.0 (Co-Simulation and Model Exchange)
+#   ${CMAKE_BINARY_DIR}/fmi3/<id>.fmu  FMI 3.0 (Co-Simulation and Model Exchange)
+# Each ships the committed model description MODEL_DESCRIPTIONS/fmi<N>/<id>.xml
+# and the documentation page written by DOC_TOOL. Targets <id>_fmu and
+# <id>_fmu3 (part of ALL). Sets <id>_FMU_DIR, <id>_FMU_FILE, <id>_FMU3_DIR
+# and <id>_FMU3_FILE in the caller's scope.
 function(pkm_add_fmu id)
-  cmake_parse_arguments(F "" "DEFINITION;MODEL_DESCRIPTION;GUID;VERSION_SCRIPT;DOC_TOOL" "SOURCES;LIBRARIES" ${ARGN})
-  set(stage "${CMAKE_BINARY_DIR}/fmu/${id}")
-  set(fmu "${CMAKE_BINARY_DIR}/${id}.fmu")
-
-  set(PKM_FMU_GUID "${F_GUID}")
-  configure_file("${F_MODEL_DESCRIPTION}" "${stage}/modelDescription.xml" @ONLY)
-
+  cmake_parse_arguments(F "" "DEFINITION;MODEL_DESCRIPTIONS;VERSION_SCRIPT;DOC_TOOL" "SOURCES;LIBRARIES" ${ARGN})
+  set(binary_name "${id}${CMAKE_SHARED_LIBRARY_SUFFIX}")
   add_library(${id} SHARED ${F_SOURCES})
   target_compile_definitions(${id} PRIVATE PKM_FMI_DEFINITION=${F_DEFINITION})
   target_link_libraries(${id} PRIVATE ${F_LIBRARIES} pkm::fmi2_headers)
   set_target_properties(${id} PROPERTIES
     PREFIX ""
     OUTPUT_NAME "${id}"
-    LIBRARY_OUTPUT_DIRECTORY "${stage}/binaries/${PKM_FMU_PLATFORM}"
+    LIBRARY_OUTPUT_DIRECTORY "${CMAKE_BINARY_DIR}/fmu-binaries"
+    RUNTIME_OUTPUT_DIRECTORY "${CMAKE_BINARY_DIR}/fmu-binaries"
     C_VISIBILITY_PRESET hidden
     CXX_VISIBILITY_PRESET hidden
     VISIBILITY_INLINES_HIDDEN ON
@@ -112,28 +115,43 @@ function(pkm_add_fmu id)
     target_link_options(${id} PRIVATE
       "LINKER:--version-script=${F_VERSION_SCRIPT}" "LINKER:--no-undefined" "LINKER:--exclude-libs,ALL"
       -static-libstdc++ -static-libgcc)
+  elseif(MINGW)
+    target_link_options(${id} PRIVATE -static)
   endif()
 
-  add_custom_command(
-    OUTPUT "${stage}/documentation/index.html"
-    COMMAND ${CMAKE_COMMAND} -E make_directory "${stage}/documentation"
-    COMMAND ${F_DOC_TOOL} ${id} "${stage}/documentation/index.html"
-    DEPENDS ${F_DOC_TOOL}
-    COMMENT "Writing the documentation of ${id}.fmu"
-    VERBATIM)
-
-  add_custom_command(
-    OUTPUT "${fmu}"
-    COMMAND ${CMAKE_COMMAND} -E rm -f "${fmu}"
-    COMMAND ${CMAKE_COMMAND} -E tar cf "${fmu}" --format=zip
-            modelDescription.xml "binaries/${PKM_FMU_PLATFORM}/${id}${CMAKE_SHARED_LIBRARY_SUFFIX}"
-            documentation/index.html
-    WORKING_DIRECTORY "${stage}"
-    DEPENDS ${id} "${stage}/modelDescription.xml" "${stage}/documentation/index.html"
-    COMMENT "Packaging ${id}.fmu"
-    VERBATIM)
-  add_custom_target(${id}_fmu ALL DEPENDS "${fmu}")
-
-  set(${id}_FMU_DIR "${stage}" PARENT_SCOPE)
-  set(${id}_FMU_FILE "${fmu}" PARENT_SCOPE)
+  foreach(version 2 3)
+    if(version EQUAL 2)
+      set(stage "${CMAKE_BINARY_DIR}/fmu/${id}")
+      set(fmu "${CMAKE_BINARY_DIR}/${id}.fmu")
+      set(platform "${PKM_FMU_PLATFORM}")
+      set(target ${id}_fmu)
+    else()
+      set(stage "${CMAKE_BINARY_DIR}/fmu3/${id}")
+      set(fmu "${CMAKE_BINARY_DIR}/fmi3/${id}.fmu")
+      set(platform "${PKM_FMU3_PLATFORM}")
+      set(target ${id}_fmu3)
+    endif()
+    set(md "${F_MODEL_DESCRIPTIONS}/fmi${version}/${id}.xml")
+    add_custom_command(
+      OUTPUT "${fmu}"
+      COMMAND ${CMAKE_COMMAND} -E rm -rf "${stage}" "${fmu}"
+      COMMAND ${CMAKE_COMMAND} -E make_directory "${stage}/binaries/${platform}" "${stage}/documentation"
+              "${CMAKE_BINARY_DIR}/fmi3"
+      COMMAND ${CMAKE_COMMAND} -E copy "${md}" "${stage}/modelDescription.xml"
+      COMMAND ${CMAKE_COMMAND} -E copy "$<TARGET_FILE:${id}>" "${stage}/binaries/${platform}/${binary_name}"
+      COMMAND ${F_DOC_TOOL} ${id} "${stage}/documentation/index.html"
+      COMMAND ${CMAKE_COMMAND} -E chdir "${stage}" ${CMAKE_COMMAND} -E tar cf "${fmu}" --format=zip
+              modelDescription.xml "binaries/${platform}/${binary_name}" documentation/index.html
+      DEPENDS ${id} "${md}" ${F_DOC_TOOL}
+      COMMENT "Packaging ${fmu} (FMI ${version}.0)"
+      VERBATIM)
+    add_custom_target(${target} ALL DEPENDS "${fmu}")
+    if(version EQUAL 2)
+      set(${id}_FMU_DIR "${stage}" PARENT_SCOPE)
+      set(${id}_FMU_FILE "${fmu}" PARENT_SCOPE)
+    else()
+      set(${id}_FMU3_DIR "${stage}" PARENT_SCOPE)
+      set(${id}_FMU3_FILE "${fmu}" PARENT_SCOPE)
+    endif()
+  endforeach()
 endfunction()

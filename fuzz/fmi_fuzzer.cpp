@@ -339,7 +339,7 @@ void boot(FuzzedDataProvider& in, World& w, int i) {
   sl.kind = in.ConsumeIntegralInRange<int>(0, 3) == 0 ? 1 : 0;
   const Api& a = w.api(i);
   ++g_calls;
-  sl.c = a.fmi2Instantiate("fuzz", fmi2CoSimulation, a.def->guid, "", &kCallbacks, fmi2False,
+  sl.c = a.fmi2Instantiate("fuzz", fmi2CoSimulation, a.def->guid().c_str(), "", &kCallbacks, fmi2False,
                            in.ConsumeBool() ? fmi2True : fmi2False);
   if (!sl.c) violation("fmi2Instantiate failed with valid arguments");
   sl.time = in.ConsumeBool() ? 0.0 : in.ConsumeFloatingPointInRange<double>(-10.0, 10.0);
@@ -394,7 +394,8 @@ void one_op(FuzzedDataProvider& in, World& w) {
       const std::string name = in.ConsumeRandomLengthString(16);
       const int guid_kind = in.ConsumeIntegralInRange<int>(0, 3);
       const std::string junk_guid = in.ConsumeRandomLengthString(40);
-      const char* guid = guid_kind == 0 ? nullptr : guid_kind == 1 ? junk_guid.c_str() : b.def->guid;
+      const std::string token = b.def->guid();
+      const char* guid = guid_kind == 0 ? nullptr : guid_kind == 1 ? junk_guid.c_str() : token.c_str();
       int type_bits = in.ConsumeBool() ? 1 : in.ConsumeIntegral<int>();
       fmi2Type type;
       std::memcpy(&type, &type_bits, sizeof type);  // a C importer may pass any int

@@ -20,7 +20,12 @@
 #include <gtest/gtest.h>
 
 #include "fmi2FunctionTypes.h"
+#include "fmi_functions.h"
 #include "models.hpp"
+
+// The instantiation tokens (GUIDs): hashes of the variable tables, as in the model descriptions.
+#define PKM_FMU_PLANT_GUID (pkm_fmi::pkm4puu_definition().guid().c_str())
+#define PKM_FMU_INVERSE_GUID (pkm_fmi::pkm4puu_inverse_definition().guid().c_str())
 
 namespace pkm_test {
 
@@ -29,17 +34,8 @@ constexpr double kPi = 3.14159265358979323846;
 
 struct FmuLibrary {
   void* handle = nullptr;
-#define PKM_TEST_FMI2_FUNCTIONS(X)                                                                             \
-  X(fmi2GetTypesPlatform) X(fmi2GetVersion) X(fmi2SetDebugLogging) X(fmi2Instantiate) X(fmi2FreeInstance)      \
-  X(fmi2SetupExperiment) X(fmi2EnterInitializationMode) X(fmi2ExitInitializationMode) X(fmi2Terminate)         \
-  X(fmi2Reset) X(fmi2GetReal) X(fmi2GetInteger) X(fmi2GetBoolean) X(fmi2GetString) X(fmi2SetReal)              \
-  X(fmi2SetInteger) X(fmi2SetBoolean) X(fmi2SetString) X(fmi2GetFMUstate) X(fmi2SetFMUstate)                   \
-  X(fmi2FreeFMUstate) X(fmi2SerializedFMUstateSize) X(fmi2SerializeFMUstate) X(fmi2DeSerializeFMUstate)        \
-  X(fmi2GetDirectionalDerivative) X(fmi2SetRealInputDerivatives) X(fmi2GetRealOutputDerivatives) X(fmi2DoStep) \
-  X(fmi2CancelStep) X(fmi2GetStatus) X(fmi2GetRealStatus) X(fmi2GetIntegerStatus) X(fmi2GetBooleanStatus)      \
-  X(fmi2GetStringStatus)
 #define PKM_TEST_DECLARE(name) name##TYPE* name = nullptr;
-  PKM_TEST_FMI2_FUNCTIONS(PKM_TEST_DECLARE)
+  PKM_FMI2_FUNCTIONS(PKM_TEST_DECLARE)
 #undef PKM_TEST_DECLARE
   std::string missing;
 
@@ -52,7 +48,7 @@ struct FmuLibrary {
 #define PKM_TEST_LOAD(name)                                   \
   name = reinterpret_cast<name##TYPE*>(dlsym(handle, #name)); \
   if (!name) missing += #name " ";
-    PKM_TEST_FMI2_FUNCTIONS(PKM_TEST_LOAD)
+    PKM_FMI2_FUNCTIONS(PKM_TEST_LOAD)
 #undef PKM_TEST_LOAD
   }
   ~FmuLibrary() {

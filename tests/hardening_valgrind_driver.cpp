@@ -82,7 +82,7 @@ fmi2ValueReference vr(const pkm_fmi::ModelDefinition& d, const std::string& name
 }
 
 fmi2Component instantiate(Fmu& f, const pkm_fmi::ModelDefinition& d, const char* name) {
-  fmi2Component c = f.fmi2Instantiate(name, fmi2CoSimulation, d.guid, "file:///tmp", &kCallbacks, fmi2False, fmi2False);
+  fmi2Component c = f.fmi2Instantiate(name, fmi2CoSimulation, d.guid().c_str(), "file:///tmp", &kCallbacks, fmi2False, fmi2False);
   check(c != nullptr, "fmi2Instantiate");
   if (!c) std::exit(1);
   return c;
@@ -170,7 +170,7 @@ void autotest(Fmu& plant_so, Fmu& inverse_so, int solver, double& max_pos, doubl
 void failure_paths(Fmu& plant_so) {
   const pkm_fmi::ModelDefinition& pd = pkm_fmi::pkm4puu_definition();
   fmi2Component c = instantiate(plant_so, pd, "failing");
-  const fmi2String all[1] = {"logAll"};
+  const fmi2String all[1] = {"logCalls"};
   check(plant_so.fmi2SetDebugLogging(c, fmi2True, 1, all) == fmi2OK, "logging");
   initialize(plant_so, c);
   fmi2ValueReference F[4];

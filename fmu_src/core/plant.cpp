@@ -128,6 +128,31 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
   return Status::Ok;
 }
 
+Status Plant::set_state(const Vec8& y) {
+  if (!initialized_) return Status::NotInitialized;
+  if (!y.allFinite()) return Status::NonFinite;
+  GuardReport report;
+  GuardLimits none;
+  none.max_jacobian_condition = std::numeric_limits<double>::infinity();
+  none.min_leg_measure = 0.0;
+  const Status s = check_configuration(model_, y.head<4>(), none, &report);
+  if (s != Status::Ok) {
+    error_ = describe_configuration_failure(model_, y.head<4>(), none, report);
+    return s;
+  }
+  y_ = y;
+  theta1_stale_ = true;
+  return Status::Ok;
+}
+
+Status Plant::derivative_now(const InputSignal& inputs, Vec8& ydot) const {
+  if (!initialized_) return Status::NotInitialized;
+  Vec4 F;
+  Wrench we;
+  read_inputs(inputs, t_, F, we);
+  return state_derivative(model_, settings_.formulation, y_, generalized_forces(F, we), ydot);
+}
+
 Status Plant::derivative(double t, const Vec8& y, Vec8& ydot) {
   Vec4 F;
   Wrench we;

@@ -88,6 +88,18 @@ class Plant {
   /// (nothing changes) if y lies beyond the singularity limits.
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref);
 
+  // ---- Model Exchange: the importer's integrator owns time and state.
+  /// Sets the time (the state is kept).
+  void set_time(double t) { t_ = t; }
+  /// Sets the state [pose; velocity] reached by the importer's integrator:
+  /// Status::Unreachable (nothing changes, last_error() says which leg) if a
+  /// leg cannot be assembled there, ::NonFinite if y is not finite. The
+  /// singularity limits are not checked here: the event indicators
+  /// (guard_indicators) locate their crossing.
+  Status set_state(const Vec8& y);
+  /// dy/dt at the current time and state for the given inputs.
+  Status derivative_now(const InputSignal& inputs, Vec8& ydot) const;
+
   /// q, qd, qdd and lambda at the current time, for the inputs at that time
   /// (evaluated on demand; theta1 continuous in time). Reading changes nothing.
   Status mechanism(const InputSignal& inputs, MechanismState& out) const;

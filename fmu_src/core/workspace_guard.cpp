@@ -8,6 +8,46 @@
 #include "leg_kinematics.hpp"
 
 namespace pkm {
+namespace {
+
+// Per leg, in the base frame, with d = p + Rz(phi) r_Qi - B_i (the
+// closed-form elbow-down inverse kinematics of leg_kinematics, written
+// without theta1: everything here is invariant under Rz(beta_i)):
+//   A^2 = d_x^2 + d_y^2 - h'^2,  cos theta2 = A / l,  sin theta2 = -sqrt(1 - A^2 / l^2),
+//   rho = d_z - h - l sin theta2, so the actuator Jacobian's row is
+//   d rho / d(x, y, z, phi) = (d_x k, d_y k, 1, k (d_y a_x - d_x a_y)),  k = 1 / (l sin theta2),
+// with a = Rz(phi) r_Qi. Only one square root and one division per leg.
+// Returns the first unreachable leg, or -1 with J (phi column scaled by
+// kConditionLength) and the squared leg measures (cos theta2 sin theta2)^2.
+int actuator_rows(const Model& m, const Pose& pose, Mat4& J, Vec4& measure2) {
+  const Params& p = m.p;
+  const double cphi = std::cos(pose[3]), sphi = std::sin(pose[3]);
+  const double inv_l2 = 1.0 / (p.l * p.l);
+  for (int i = 0; i < kLegs; ++i) {
+    const Vec3& rq = m.r_Q[i];
+    const double ax = cphi * rq.x() - sphi * rq.y(), ay = sphi * rq.x() + cphi * rq.y();
+    const double dx = pose[0] + ax - m.B[i].x(), dy = pose[1] + ay - m.B[i].y();
+    const double A2 = dx * dx + dy * dy - p.h_prime * p.h_prime;
+    const double c2sq = A2 * inv_l2;
+    if (!(c2sq >= 0.0) || !(c2sq <= 1.0)) return i;
+    const double s2sq = 1.0 - c2sq;
+    measure2[i] = c2sq * s2sq;
+    const double k = -1.0 / (p.l * std::sqrt(s2sq));  // 1 / (l sin theta2), elbow-down
+    J(i, 0) = dx * k;
+    J(i, 1) = dy * k;
+    J(i, 2) = 1.0;
+    J(i, 3) = k * (dy * ax - dx * ay) / kConditionLength;
+  }
+  return -1;
+}
+
+double exact_condition(const Mat4& J) {
+  const Eigen::JacobiSVD<Mat4> svd(J);
+  const Vec4 s = svd.singularValues();
+  return (s[3] > 0.0) ? s[0] / s[3] : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
 
 std::string validate(const GuardLimits& g) {
   char buf[200];
@@ -31,41 +71,20 @@ Status check_configuration(const Model& m, const Pose& pose, const GuardLimits& 
   GuardReport& r = report ? *report : local;
   r = GuardReport{};
   if (!pose.allFinite()) return r.status = Status::NonFinite;
-  const Params& p = m.p;
-  const double cphi = std::cos(pose[3]), sphi = std::sin(pose[3]);
-  const double inv_l2 = 1.0 / (p.l * p.l);
   const double min_measure = std::fmax(lim.min_leg_measure, kLegSingularFloor);
-  const double min_measure2 = min_measure * min_measure;
-  // Per leg, in the base frame, with d = p + Rz(phi) r_Qi - B_i (the
-  // closed-form elbow-down inverse kinematics of leg_kinematics, written
-  // without theta1: everything here is invariant under Rz(beta_i)):
-  //   A^2 = d_x^2 + d_y^2 - h'^2,  cos theta2 = A / l,  sin theta2 = -sqrt(1 - A^2 / l^2),
-  //   rho = d_z - h - l sin theta2, so the actuator Jacobian's row is
-  //   d rho / d(x, y, z, phi) = (d_x k, d_y k, 1, k (d_y a_x - d_x a_y)),  k = 1 / (l sin theta2),
-  // with a = Rz(phi) r_Qi. Only one square root and one division per leg.
-  Mat4 J;  // phi column scaled by kConditionLength (MODEL_SPEC)
+  Mat4 J;
+  Vec4 measure2;
+  const int unreachable = actuator_rows(m, pose, J, measure2);
+  if (unreachable >= 0) {
+    r.leg = unreachable;
+    return r.status = Status::Unreachable;
+  }
   for (int i = 0; i < kLegs; ++i) {
-    const Vec3& rq = m.r_Q[i];
-    const double ax = cphi * rq.x() - sphi * rq.y(), ay = sphi * rq.x() + cphi * rq.y();
-    const double dx = pose[0] + ax - m.B[i].x(), dy = pose[1] + ay - m.B[i].y();
-    const double A2 = dx * dx + dy * dy - p.h_prime * p.h_prime;
-    const double c2sq = A2 * inv_l2;
-    if (!(c2sq >= 0.0) || !(c2sq <= 1.0)) {
+    if (!(measure2[i] >= min_measure * min_measure)) {
       r.leg = i;
-      return r.status = Status::Unreachable;
-    }
-    const double s2sq = 1.0 - c2sq;
-    const double measure2 = c2sq * s2sq;  // (cos theta2 sin theta2)^2
-    if (!(measure2 >= min_measure2)) {
-      r.leg = i;
-      r.leg_measure = std::sqrt(measure2);
+      r.leg_measure = std::sqrt(measure2[i]);
       return r.status = Status::Singular;
     }
-    const double k = -1.0 / (p.l * std::sqrt(s2sq));  // 1 / (l sin theta2), elbow-down
-    J(i, 0) = dx * k;
-    J(i, 1) = dy * k;
-    J(i, 2) = 1.0;
-    J(i, 3) = k * (dy * ax - dx * ay) / kConditionLength;
   }
   if (!(lim.max_jacobian_condition < std::numeric_limits<double>::infinity())) return r.status = Status::Ok;
   // Three tiers, cheapest first; each accepts when an upper bound of
@@ -81,9 +100,7 @@ Status check_configuration(const Model& m, const Pose& pose, const GuardLimits& 
   const double bound = J.norm() * Jinv.norm();
   if (bound <= lim.max_jacobian_condition) return r.status = Status::Ok;
   // 3. Near the limit: the exact 2-norm condition number.
-  const Eigen::JacobiSVD<Mat4> svd(J);
-  const Vec4 s = svd.singularValues();
-  const double exact = (s[3] > 0.0) ? s[0] / s[3] : std::numeric_limits<double>::infinity();
+  const double exact = exact_condition(J);
   if (exact <= lim.max_jacobian_condition) return r.status = Status::Ok;
   r.condition = exact;
   return r.status = Status::Singular;
@@ -142,6 +159,18 @@ std::string describe_configuration_failure(const Model& m, const Pose& pose, con
     default:
       return status_name(r.status);
   }
+}
+
+Status guard_indicators(const Model& m, const Pose& pose, const GuardLimits& lim, double z[kGuardIndicators]) {
+  if (!pose.allFinite()) return Status::NonFinite;
+  Mat4 J;
+  Vec4 measure2;
+  if (actuator_rows(m, pose, J, measure2) >= 0) return Status::Unreachable;
+  // 1 / cond is finite everywhere (0 at a parallel singularity), so the
+  // indicator never overflows; it changes sign where cond crosses the limit.
+  z[0] = 1.0 / exact_condition(J) - 1.0 / lim.max_jacobian_condition;
+  for (int i = 0; i < kLegs; ++i) z[1 + i] = std::sqrt(measure2[i]) - lim.min_leg_measure;
+  return Status::Ok;
 }
 
 }  // namespace pkm

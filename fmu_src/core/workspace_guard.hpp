@@ -56,4 +56,11 @@ Status check_configuration(const Model& m, const Pose& pose, const GuardLimits& 
 std::string describe_configuration_failure(const Model& m, const Pose& pose, const GuardLimits& lim,
                                            const GuardReport& report);
 
+/// The guards as event indicators (Model Exchange): positive within the
+/// limits, zero on a limit, negative beyond it. z[0] = 1/cond(J) -
+/// 1/max_jacobian_condition; z[1 + i] = |cos theta2 sin theta2| of leg i -
+/// min_leg_measure. Status::Unreachable (z unchanged) if a leg cannot reach.
+constexpr int kGuardIndicators = 5;
+Status guard_indicators(const Model& m, const Pose& pose, const GuardLimits& lim, double z[kGuardIndicators]);
+
 }  // namespace pkm

@@ -1,116 +1,41 @@
-// The exported FMI 2.0 functions (common and co-simulation) of one FMU: each
-// forwards to pkm_fmi::Instance. Compiled once per FMU, with
-// PKM_FMI_DEFINITION naming the function that returns its ModelDefinition.
-// No exception crosses the C ABI.
+// The FMI 2.0 front end (Co-Simulation and Model Exchange) of one FMU: each
+// exported function checks its handle and forwards to pkm_fmi::Instance.
+// Compiled once per FMU, with PKM_FMI_DEFINITION naming the function that
+// returns its ModelDefinition. No exception crosses the C ABI.
+#include <cstdarg>
 #include <cstring>
 #include <exception>
+#include <string>
 
-#include "fmi2_cs.hpp"
+#include "fmi2Functions.h"
+#include "instance.hpp"
 #include "models.hpp"
 
 #ifndef PKM_FMI_DEFINITION
 #error "PKM_FMI_DEFINITION must name the model's definition, e.g. pkm_fmi::pkm4puu_definition"
 #endif
 
-// In-process builds of both FMUs into one program (the fuzzer, fuzz/): with
-// PKM_FMI_FUNCTION_PREFIX defined, every function below is named
-// <prefix>fmi2Xxx (FMI 2.0's FMI2_FUNCTION_PREFIX convention, which the
-// fmi2Functions.h in use does not implement). The FMU binaries never define it.
+// In-process builds of several FMUs into one program (the fuzzer): every
+// function is named <prefix>fmi2Xxx. fmi2Functions.h fixes fmi2FullName to
+// no prefix; its names expand lazily, so redefining it here renames them.
 #ifdef PKM_FMI_FUNCTION_PREFIX
-#define PKM_FMI_PASTE2(a, b) a##b
-#define PKM_FMI_PASTE(a, b) PKM_FMI_PASTE2(a, b)
-#define PKM_FMI_RENAME(name) PKM_FMI_PASTE(PKM_FMI_FUNCTION_PREFIX, name)
-#undef fmi2GetTypesPlatform
-#define fmi2GetTypesPlatform PKM_FMI_RENAME(fmi2GetTypesPlatform)
-#undef fmi2GetVersion
-#define fmi2GetVersion PKM_FMI_RENAME(fmi2GetVersion)
-#undef fmi2SetDebugLogging
-#define fmi2SetDebugLogging PKM_FMI_RENAME(fmi2SetDebugLogging)
-#undef fmi2Instantiate
-#define fmi2Instantiate PKM_FMI_RENAME(fmi2Instantiate)
-#undef fmi2FreeInstance
-#define fmi2FreeInstance PKM_FMI_RENAME(fmi2FreeInstance)
-#undef fmi2SetupExperiment
-#define fmi2SetupExperiment PKM_FMI_RENAME(fmi2SetupExperiment)
-#undef fmi2EnterInitializationMode
-#define fmi2EnterInitializationMode PKM_FMI_RENAME(fmi2EnterInitializationMode)
-#undef fmi2ExitInitializationMode
-#define fmi2ExitInitializationMode PKM_FMI_RENAME(fmi2ExitInitializationMode)
-#undef fmi2Terminate
-#define fmi2Terminate PKM_FMI_RENAME(fmi2Terminate)
-#undef fmi2Reset
-#define fmi2Reset PKM_FMI_RENAME(fmi2Reset)
-#undef fmi2GetReal
-#define fmi2GetReal PKM_FMI_RENAME(fmi2GetReal)
-#undef fmi2GetInteger
-#define fmi2GetInteger PKM_FMI_RENAME(fmi2GetInteger)
-#undef fmi2GetBoolean
-#define fmi2GetBoolean PKM_FMI_RENAME(fmi2GetBoolean)
-#undef fmi2GetString
-#define fmi2GetString PKM_FMI_RENAME(fmi2GetString)
-#undef fmi2SetReal
-#define fmi2SetReal PKM_FMI_RENAME(fmi2SetReal)
-#undef fmi2SetInteger
-#define fmi2SetInteger PKM_FMI_RENAME(fmi2SetInteger)
-#undef fmi2SetBoolean
-#define fmi2SetBoolean PKM_FMI_RENAME(fmi2SetBoolean)
-#undef fmi2SetString
-#define fmi2SetString PKM_FMI_RENAME(fmi2SetString)
-#undef fmi2GetFMUstate
-#define fmi2GetFMUstate PKM_FMI_RENAME(fmi2GetFMUstate)
-#undef fmi2SetFMUstate
-#define fmi2SetFMUstate PKM_FMI_RENAME(fmi2SetFMUstate)
-#undef fmi2FreeFMUstate
-#define fmi2FreeFMUstate PKM_FMI_RENAME(fmi2FreeFMUstate)
-#undef fmi2SerializedFMUstateSize
-#define fmi2SerializedFMUstateSize PKM_FMI_RENAME(fmi2SerializedFMUstateSize)
-#undef fmi2SerializeFMUstate
-#define fmi2SerializeFMUstate PKM_FMI_RENAME(fmi2SerializeFMUstate)
-#undef fmi2DeSerializeFMUstate
-#define fmi2DeSerializeFMUstate PKM_FMI_RENAME(fmi2DeSerializeFMUstate)
-#undef fmi2GetDirectionalDerivative
-#define fmi2GetDirectionalDerivative PKM_FMI_RENAME(fmi2GetDirectionalDerivative)
-#undef fmi2SetRealInputDerivatives
-#define fmi2SetRealInputDerivatives PKM_FMI_RENAME(fmi2SetRealInputDerivatives)
-#undef fmi2GetRealOutputDerivatives
-#define fmi2GetRealOutputDerivatives PKM_FMI_RENAME(fmi2GetRealOutputDerivatives)
-#undef fmi2DoStep
-#define fmi2DoStep PKM_FMI_RENAME(fmi2DoStep)
-#undef fmi2CancelStep
-#define fmi2CancelStep PKM_FMI_RENAME(fmi2CancelStep)
-#undef fmi2GetStatus
-#define fmi2GetStatus PKM_FMI_RENAME(fmi2GetStatus)
-#undef fmi2GetRealStatus
-#define fmi2GetRealStatus PKM_FMI_RENAME(fmi2GetRealStatus)
-#undef fmi2GetIntegerStatus
-#define fmi2GetIntegerStatus PKM_FMI_RENAME(fmi2GetIntegerStatus)
-#undef fmi2GetBooleanStatus
-#define fmi2GetBooleanStatus PKM_FMI_RENAME(fmi2GetBooleanStatus)
-#undef fmi2GetStringStatus
-#define fmi2GetStringStatus PKM_FMI_RENAME(fmi2GetStringStatus)
+#undef fmi2FullName
+#define PKM_FMI2_PASTE2(a, b) a##b
+#define PKM_FMI2_PASTE(a, b) PKM_FMI2_PASTE2(a, b)
+#define fmi2FullName(name) PKM_FMI2_PASTE(PKM_FMI_FUNCTION_PREFIX, name)
 #endif
 
 using pkm_fmi::Instance;
-
-#if defined(PKM_FMI_FREE_EH_POOL) && defined(__GLIBCXX__)
-namespace __gnu_cxx {
-void __freeres();  // libstdc++ (eh_alloc.cc): frees the exception-handling emergency pool
-}
-namespace {
-// The FMU binary links libstdc++ statically (-static-libstdc++), and with it
-// a private exception-handling emergency pool (72 KiB, malloc'ed when the
-// binary is loaded). Nothing would free it: after dlclose it is lost, once
-// per load (valgrind: "definitely lost"). Free it when the binary unloads
-// (dlclose, or process exit); no code of this binary runs after that.
-__attribute__((destructor)) void free_emergency_pool() { __gnu_cxx::__freeres(); }
-}  // namespace
-#endif
+using pkm_fmi::Status;
 
 namespace {
+
+const pkm_fmi::ModelDefinition& definition() { return PKM_FMI_DEFINITION(); }
+
+fmi2Status to_fmi2(Status s) { return static_cast<fmi2Status>(static_cast<int>(s)); }
 
 // A C importer may pass any int where FMI 2.0 declares an enum (fmi2Type,
-// fmi2StatusKind); a C++ enum object must not hold a value outside its
-// enumerators' range, so such arguments are read as int, never loaded as enums.
+// fmi2StatusKind); such arguments are read as int, never loaded as enums.
 template <class E>
 int as_int(const E& e) {
   static_assert(sizeof(E) == sizeof(int), "FMI 2.0 enums are int-sized");
@@ -119,16 +44,28 @@ int as_int(const E& e) {
   return v;
 }
 
+// fmi2CallbackLogger treats the message as a printf format: '%' is escaped.
+void emit(void* callback, void* env, const char* instance, Status status, const char* category,
+          const char* message) {
+  std::string escaped;
+  for (const char* p = message; *p; ++p) {
+    escaped += *p;
+    if (*p == '%') escaped += '%';
+  }
+  reinterpret_cast<fmi2CallbackLogger>(callback)(env, instance, static_cast<fmi2Status>(static_cast<int>(status)),
+                                                 category, escaped.c_str());
+}
+
 template <class Body>
 fmi2Status call(fmi2Component c, const char* function, Body&& body) {
-  Instance* inst = Instance::from(c);
-  if (!inst) return fmi2Error;  // no instance: nobody to log to
+  Instance* inst = Instance::from(c, definition(), 2);
+  if (!inst) return fmi2Error;  // no instance of this FMU: nobody to log to
   try {
-    return body(*inst);
+    return to_fmi2(body(*inst));
   } catch (const std::exception& e) {
-    return inst->internal_error(function, e.what());
+    return to_fmi2(inst->internal_error(function, e.what()));
   } catch (...) {
-    return inst->internal_error(function, "unknown exception");
+    return to_fmi2(inst->internal_error(function, "unknown exception"));
   }
 }
 
@@ -143,26 +80,44 @@ const char* fmi2GetVersion(void) { return fmi2Version; }
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
                                const fmi2String categories[]) {
   return call(c, "fmi2SetDebugLogging",
-              [&](Instance& i) { return i.set_debug_logging(loggingOn, nCategories, categories); });
+              [&](Instance& i) { return i.set_debug_logging(loggingOn != fmi2False, nCategories, categories); });
 }
 
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
                               fmi2String fmuResourceLocation, const fmi2CallbackFunctions* functions,
                               fmi2Boolean visible, fmi2Boolean loggingOn) {
+  (void)fmuResourceLocation;  // no resources
+  (void)visible;              // no user interface
   try {
-    return Instance::instantiate(PKM_FMI_DEFINITION(), instanceName, as_int(fmuType), fmuGUID, fmuResourceLocation,
-                                 functions, visible, loggingOn);
+    fmi2CallbackLogger logger = functions ? functions->logger : nullptr;
+    pkm_fmi::Logger log(logger ? &emit : nullptr, reinterpret_cast<void*>(logger),
+                        functions ? functions->componentEnvironment : nullptr, instanceName ? instanceName : "",
+                        loggingOn != fmi2False);
+    if (!instanceName) {
+      log.error("fmi2Instantiate: instanceName is NULL");
+      return nullptr;
+    }
+    const int type = as_int(fmuType);
+    if (type != fmi2CoSimulation && type != fmi2ModelExchange) {
+      log.error("fmi2Instantiate: fmuType = %d is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)", type);
+      return nullptr;
+    }
+    return Instance::create(definition(), 2,
+                            type == fmi2CoSimulation ? pkm_fmi::Interface::CoSimulation
+                                                     : pkm_fmi::Interface::ModelExchange,
+                            fmuGUID, std::move(log));
   } catch (...) {
     return nullptr;
   }
 }
 
-void fmi2FreeInstance(fmi2Component c) { delete Instance::from(c); }
+void fmi2FreeInstance(fmi2Component c) { delete Instance::from(c, definition(), 2); }
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
   return call(c, "fmi2SetupExperiment", [&](Instance& i) {
-    return i.setup_experiment(toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime);
+    return i.setup_experiment(toleranceDefined != fmi2False, tolerance, startTime, stopTimeDefined != fmi2False,
+                              stopTime);
   });
 }
 
@@ -187,15 +142,20 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 }
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
-  return call(c, "fmi2GetInteger", [&](Instance& i) { return i.get_integer(vr, nvr, value); });
+  static_assert(sizeof(fmi2Integer) == sizeof(std::int32_t), "fmi2Integer is 32 bits");
+  return call(c, "fmi2GetInteger",
+              [&](Instance& i) { return i.get_integer(vr, nvr, reinterpret_cast<std::int32_t*>(value)); });
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
+  static_assert(sizeof(fmi2Boolean) == sizeof(int), "fmi2Boolean is an int");
   return call(c, "fmi2GetBoolean", [&](Instance& i) { return i.get_boolean(vr, nvr, value); });
 }
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
-  return call(c, "fmi2GetString", [&](Instance& i) { return i.get_string(vr, nvr, value); });
+  (void)value;
+  return call(c, "fmi2GetString",
+              [&](Instance& i) { return i.no_variables_of_type("fmi2GetString", "String", vr, nvr, false); });
 }
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
@@ -203,7 +163,8 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 }
 
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
-  return call(c, "fmi2SetInteger", [&](Instance& i) { return i.set_integer(vr, nvr, value); });
+  return call(c, "fmi2SetInteger",
+              [&](Instance& i) { return i.set_integer(vr, nvr, reinterpret_cast<const std::int32_t*>(value)); });
 }
 
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
@@ -211,7 +172,9 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
-  return call(c, "fmi2SetString", [&](Instance& i) { return i.set_string(vr, nvr, value); });
+  (void)value;
+  return call(c, "fmi2SetString",
+              [&](Instance& i) { return i.no_variables_of_type("fmi2SetString", "String", vr, nvr, true); });
 }
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* FMUstate) {
@@ -232,65 +195,158 @@ fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, si
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size) {
-  return call(c, "fmi2SerializeFMUstate",
-              [&](Instance& i) { return i.serialize_fmu_state(FMUstate, serializedState, size); });
+  return call(c, "fmi2SerializeFMUstate", [&](Instance& i) {
+    return i.serialize_fmu_state(FMUstate, reinterpret_cast<unsigned char*>(serializedState), size);
+  });
 }
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate* FMUstate) {
-  return call(c, "fmi2DeSerializeFMUstate",
-              [&](Instance& i) { return i.deserialize_fmu_state(serializedState, size, FMUstate); });
+  return call(c, "fmi2DeSerializeFMUstate", [&](Instance& i) {
+    return i.deserialize_fmu_state(reinterpret_cast<const unsigned char*>(serializedState), size, FMUstate);
+  });
 }
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
                                         const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
+  (void)vUnknown_ref, (void)nUnknown, (void)vKnown_ref, (void)nKnown, (void)dvKnown, (void)dvUnknown;
   return call(c, "fmi2GetDirectionalDerivative", [&](Instance& i) {
-    return i.get_directional_derivative(vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown);
+    return i.not_supported("fmi2GetDirectionalDerivative", "providesDirectionalDerivative = false");
   });
 }
 
+// ---------------------------------------------------------------- Co-Simulation
+
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
-  return call(c, "fmi2SetRealInputDerivatives",
-              [&](Instance& i) { return i.set_real_input_derivatives(vr, nvr, order, value); });
+  return call(c, "fmi2SetRealInputDerivatives", [&](Instance& i) {
+    return i.set_real_input_derivatives(vr, nvr, reinterpret_cast<const std::int32_t*>(order), value);
+  });
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[]) {
+  (void)vr, (void)nvr, (void)order, (void)value;
   return call(c, "fmi2GetRealOutputDerivatives",
-              [&](Instance& i) { return i.get_real_output_derivatives(vr, nvr, order, value); });
+              [&](Instance& i) { return i.get_real_output_derivatives("fmi2GetRealOutputDerivatives"); });
 }
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
+  (void)noSetFMUStatePriorToCurrentPoint;
   return call(c, "fmi2DoStep", [&](Instance& i) {
-    return i.do_step(currentCommunicationPoint, communicationStepSize, noSetFMUStatePriorToCurrentPoint);
+    return i.do_step(currentCommunicationPoint, communicationStepSize, nullptr, nullptr);
   });
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c) {
-  return call(c, "fmi2CancelStep", [&](Instance& i) { return i.cancel_step(); });
+  return call(c, "fmi2CancelStep", [&](Instance& i) {
+    return i.not_supported("fmi2CancelStep", "fmi2DoStep is synchronous and never pending");
+  });
 }
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status* value) {
-  return call(c, "fmi2GetStatus", [&](Instance& i) { return i.get_status(as_int(s), value); });
+  return call(c, "fmi2GetStatus", [&](Instance& i) {
+    bool unused;
+    const Status st = i.terminated(&unused);  // the state check
+    if (st != Status::OK) return st;
+    if (!value) return i.not_supported("fmi2GetStatus", "value is NULL");
+    if (as_int(s) != fmi2DoStepStatus) return Status::Discard;
+    *value = fmi2OK;  // fmi2DoStep is synchronous: never pending
+    return Status::OK;
+  });
 }
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real* value) {
-  return call(c, "fmi2GetRealStatus", [&](Instance& i) { return i.get_real_status(as_int(s), value); });
+  return call(c, "fmi2GetRealStatus", [&](Instance& i) {
+    if (as_int(s) != fmi2LastSuccessfulTime) return i.not_pending("fmi2GetRealStatus");
+    return i.last_successful_time(value);
+  });
 }
 
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer* value) {
-  return call(c, "fmi2GetIntegerStatus", [&](Instance& i) { return i.get_integer_status(as_int(s), value); });
+  (void)s, (void)value;  // no integer status is defined for FMI 2.0 Co-Simulation
+  return call(c, "fmi2GetIntegerStatus", [&](Instance& i) { return i.not_pending("fmi2GetIntegerStatus"); });
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean* value) {
-  return call(c, "fmi2GetBooleanStatus", [&](Instance& i) { return i.get_boolean_status(as_int(s), value); });
+  return call(c, "fmi2GetBooleanStatus", [&](Instance& i) {
+    if (as_int(s) != fmi2Terminated) return i.not_pending("fmi2GetBooleanStatus");
+    bool t = false;
+    const Status st = i.terminated(value ? &t : nullptr);
+    if (st == Status::OK) *value = t ? fmi2True : fmi2False;
+    return st;
+  });
 }
 
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String* value) {
-  return call(c, "fmi2GetStringStatus", [&](Instance& i) { return i.get_string_status(as_int(s), value); });
+  (void)s, (void)value;  // fmi2PendingStatus: never pending
+  return call(c, "fmi2GetStringStatus", [&](Instance& i) { return i.not_pending("fmi2GetStringStatus"); });
+}
+
+// ---------------------------------------------------------------- Model Exchange
+
+fmi2Status fmi2EnterEventMode(fmi2Component c) {
+  return call(c, "fmi2EnterEventMode", [&](Instance& i) { return i.enter_event_mode(); });
+}
+
+fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo* info) {
+  return call(c, "fmi2NewDiscreteStates", [&](Instance& i) {
+    if (!info) return i.not_supported("fmi2NewDiscreteStates", "fmi2EventInfo is NULL");
+    bool need = false, terminate = false, nominals = false, values = false, next_defined = false;
+    double next = 0.0;
+    const Status s = i.event_update(&need, &terminate, &nominals, &values, &next_defined, &next);
+    if (pkm_fmi::succeeded(s)) {
+      info->newDiscreteStatesNeeded = need ? fmi2True : fmi2False;
+      info->terminateSimulation = terminate ? fmi2True : fmi2False;
+      info->nominalsOfContinuousStatesChanged = nominals ? fmi2True : fmi2False;
+      info->valuesOfContinuousStatesChanged = values ? fmi2True : fmi2False;
+      info->nextEventTimeDefined = next_defined ? fmi2True : fmi2False;
+      info->nextEventTime = next;
+    }
+    return s;
+  });
+}
+
+fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) {
+  return call(c, "fmi2EnterContinuousTimeMode", [&](Instance& i) { return i.enter_continuous_time_mode(); });
+}
+
+fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi2Boolean* enterEventMode, fmi2Boolean* terminateSimulation) {
+  (void)noSetFMUStatePriorToCurrentPoint;
+  return call(c, "fmi2CompletedIntegratorStep", [&](Instance& i) {
+    bool event = false, terminate = false;
+    const Status s = i.completed_integrator_step(&event, &terminate);
+    if (enterEventMode) *enterEventMode = event ? fmi2True : fmi2False;
+    if (terminateSimulation) *terminateSimulation = terminate ? fmi2True : fmi2False;
+    return s;
+  });
+}
+
+fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
+  return call(c, "fmi2SetTime", [&](Instance& i) { return i.set_time(time); });
+}
+
+fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
+  return call(c, "fmi2SetContinuousStates", [&](Instance& i) { return i.set_continuous_states(x, nx); });
+}
+
+fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
+  return call(c, "fmi2GetDerivatives", [&](Instance& i) { return i.get_derivatives(derivatives, nx); });
+}
+
+fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni) {
+  return call(c, "fmi2GetEventIndicators", [&](Instance& i) { return i.get_event_indicators(eventIndicators, ni); });
+}
+
+fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
+  return call(c, "fmi2GetContinuousStates", [&](Instance& i) { return i.get_continuous_states(x, nx); });
+}
+
+fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal[], size_t nx) {
+  return call(c, "fmi2GetNominalsOfContinuousStates", [&](Instance& i) { return i.get_nominals(x_nominal, nx); });
 }
 
 }  // extern "C"

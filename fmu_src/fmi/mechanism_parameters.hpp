@@ -3,7 +3,8 @@
 // pkm::Params, with the core's defaults as start values.
 #pragma once
 
-#include "fmi2_cs.hpp"
+#include "model_data.hpp"
+#include "variables.hpp"
 #include "params.hpp"
 
 namespace pkm_fmi {
@@ -29,15 +30,15 @@ inline constexpr pkm::Params kDefaultParams{};
 #define PKM_FMI_MECHANISM_PARAMETERS                                                                              \
   real_parameter(100, "h", kDefaultParams.h, "m",                                                                 \
                  "Height of the first revolute joint above the slider position: DH d1 = rho + h (Table II)",     \
-                 PKM_FMI_PARAM(h), 0),                                                                            \
-  real_parameter(101, "l", kDefaultParams.l, "m", "Rod length, DH a3 (Table II)", PKM_FMI_PARAM(l), 0),           \
+                 PKM_FMI_PARAM(h), 0, 0.0),                                                                            \
+  real_parameter(101, "l", kDefaultParams.l, "m", "Rod length, DH a3 (Table II)", PKM_FMI_PARAM(l), 0, 0.0),           \
   real_parameter(102, "h_prime", kDefaultParams.h_prime, "m",                                                     \
                  "Offset of the platform joint Q along the third revolute axis, DH d4 (Table II)",                \
-                 PKM_FMI_PARAM(h_prime), 0),                                                                      \
+                 PKM_FMI_PARAM(h_prime), 0, 0.0),                                                                      \
   real_parameter(103, "r_b", kDefaultParams.r_b, "m",                                                             \
-                 "Radius of the circle of the prismatic axes on the base (Table II)", PKM_FMI_PARAM(r_b), 0),     \
+                 "Radius of the circle of the prismatic axes on the base (Table II)", PKM_FMI_PARAM(r_b), 0, 0.0),     \
   real_parameter(104, "r_Q", kDefaultParams.r_Q, "m",                                                             \
-                 "Radius of the circle of the joints Q_i on the platform (Table II)", PKM_FMI_PARAM(r_Q), 0),     \
+                 "Radius of the circle of the joints Q_i on the platform (Table II)", PKM_FMI_PARAM(r_Q), 0, 0.0),     \
   real_parameter(105, "beta[1]", kDefaultParams.beta[0], "rad",                                                   \
                  "Angle of leg 1 on the base: B_1 = r_b (cos beta_1, sin beta_1, 0), leg frame Rz(beta_1)",      \
                  PKM_FMI_PARAM_ARRAY(beta), 0),                                                                   \
@@ -57,20 +58,20 @@ inline constexpr pkm::Params kDefaultParams{};
   real_parameter(112, "gamma[4]", kDefaultParams.gamma[3], "rad", "Platform joint angle offset of leg 4",         \
                  PKM_FMI_PARAM_ARRAY(gamma), 3),                                                                  \
   real_parameter(113, "m_slider", kDefaultParams.m_slider, "kg", "Mass of each slider, link 1 (Table III)",       \
-                 PKM_FMI_PARAM(m_slider), 0),                                                                     \
+                 PKM_FMI_PARAM(m_slider), 0, 0.0),                                                                     \
   real_parameter(114, "m_rod", kDefaultParams.m_rod, "kg", "Mass of each rod, link 3 (Table III)",                \
-                 PKM_FMI_PARAM(m_rod), 0),                                                                        \
+                 PKM_FMI_PARAM(m_rod), 0, 0.0),                                                                        \
   real_parameter(115, "I_rod[1]", kDefaultParams.I_rod[0], "kg.m2",                                               \
                  "Rod inertia about its centre of mass, DH frame 3 axis x3 (along the rod) (Table III)",          \
-                 PKM_FMI_PARAM_ARRAY(I_rod), 0),                                                                  \
+                 PKM_FMI_PARAM_ARRAY(I_rod), 0, 0.0),                                                                  \
   real_parameter(116, "I_rod[2]", kDefaultParams.I_rod[1], "kg.m2",                                               \
-                 "Rod inertia about its centre of mass, DH frame 3 axis y3 (Table III)", PKM_FMI_PARAM_ARRAY(I_rod), 1), \
+                 "Rod inertia about its centre of mass, DH frame 3 axis y3 (Table III)", PKM_FMI_PARAM_ARRAY(I_rod), 1, 0.0), \
   real_parameter(117, "I_rod[3]", kDefaultParams.I_rod[2], "kg.m2",                                               \
-                 "Rod inertia about its centre of mass, DH frame 3 axis z3 (Table III)", PKM_FMI_PARAM_ARRAY(I_rod), 2), \
+                 "Rod inertia about its centre of mass, DH frame 3 axis z3 (Table III)", PKM_FMI_PARAM_ARRAY(I_rod), 2, 0.0), \
   real_parameter(118, "m_platform", kDefaultParams.m_platform, "kg", "Mass of the moving platform (Table III)",   \
-                 PKM_FMI_PARAM(m_platform), 0),                                                                   \
+                 PKM_FMI_PARAM(m_platform), 0, 0.0),                                                                   \
   real_parameter(119, "Izz_platform", kDefaultParams.Izz_platform, "kg.m2",                                       \
-                 "Platform inertia about the vertical axis through P (Table III)", PKM_FMI_PARAM(Izz_platform), 0), \
+                 "Platform inertia about the vertical axis through P (Table III)", PKM_FMI_PARAM(Izz_platform), 0, 0.0), \
   real_parameter(120, "g", kDefaultParams.g, "m/s2",                                                              \
                  "Gravitational acceleration, along -z of the base frame (0 switches gravity off)",               \
                  PKM_FMI_PARAM(g), 0)

@@ -17,6 +17,13 @@
 //
 // Outputs are computed lazily, on the first get after anything changed:
 // the accelerations, hence lambda, depend on the inputs at the current time.
+//
+// Model Exchange: the continuous states are the pose and its velocity (the
+// outputs x..dphi); the importer's integrator sets them and the time, the
+// legs are reconstructed from them (closed form), so the states never leave
+// the constraint manifold. The event indicators are the singularity guards
+// (pkm::guard_indicators); a crossing terminates the simulation with a
+// logged reason, as a discarded step does in Co-Simulation.
 #include <cmath>
 #include <iterator>
 #include <memory>
@@ -25,10 +32,7 @@
 #include "mechanism_parameters.hpp"
 #include "models.hpp"
 #include "plant.hpp"
-
-#ifndef PKM4PUU_GUID
-#error "PKM4PUU_GUID must be defined (the build computes it from modelDescription/PKM4PUU.xml)"
-#endif
+#include "workspace_guard.hpp"
 
 namespace pkm_fmi {
 namespace {
@@ -39,12 +43,12 @@ struct PlantData final : MechanismData {
   // Parameters beyond the mechanism's: initial state and solver settings.
   double pose0[4] = {0.0, 0.0, 0.05, 0.0};
   double vel0[4] = {0.0, 0.0, 0.0, 0.0};
-  fmi2Integer solver = static_cast<fmi2Integer>(kDefaultSolver.solver);
+  std::int32_t solver = static_cast<std::int32_t>(kDefaultSolver.solver);
   double rk4_step = kDefaultSolver.rk4_step;
   double rtol = kDefaultSolver.rtol;
   double atol = kDefaultSolver.atol;
-  fmi2Integer cvode_method = static_cast<fmi2Integer>(kDefaultSolver.cvode_method);
-  fmi2Integer formulation = static_cast<fmi2Integer>(kDefaultSolver.formulation);
+  std::int32_t cvode_method = static_cast<std::int32_t>(kDefaultSolver.cvode_method);
+  std::int32_t formulation = static_cast<std::int32_t>(kDefaultSolver.formulation);
   double max_jacobian_condition = kDefaultSolver.max_jacobian_condition;
   double min_leg_measure = kDefaultSolver.min_leg_measure;
   // Inputs u = [F1..F4, Fe1..Fe3, Me_z] at the current time, and du/dt.
@@ -55,43 +59,57 @@ struct PlantData final : MechanismData {
   double rho[4] = {}, drho[4] = {}, theta1[4] = {}, theta2[4] = {};
   double lambda[12] = {};
   double residual = 0.0, condition = 0.0;
+  double dy[8] = {};  // der(x) .. der(dphi)
+  double z[pkm::kGuardIndicators] = {};  // the event indicators
   // The simulated machine (nullptr before initialisation).
   std::unique_ptr<pkm::Plant> plant;
 
   void reset() override { plant.reset(); }
-  fmi2Status exit_initialization(Context& ctx) override;
-  fmi2Status do_step(Context& ctx, double t, double h, double& t_reached) override;
-  fmi2Status update_outputs(Context& ctx) override;
+  Status exit_initialization(Context& ctx) override;
+  Status do_step(Context& ctx, double t, double h, double& t_reached) override;
+  Status update_outputs(Context& ctx) override;
   void save(StateWriter& w) const override;
   bool load(StateReader& r, Context& ctx) override;
 
+  void set_time(double t) override {
+    if (plant) plant->set_time(t);
+  }
+  Status get_states(Context& ctx, double x[]) override;
+  Status set_states(Context& ctx, const double x[]) override;
+  Status get_derivatives(Context& ctx, double dx[]) override;
+  Status get_event_indicators(Context& ctx, double z[]) override;
+  void get_nominals(double x[]) const override;
+  Status event_update(Context& ctx, bool& terminate) override;
+
   /// A Plant for the current parameters (not yet initialised).
-  fmi2Status make_plant(Context& ctx, const char* function, std::unique_ptr<pkm::Plant>& out) const;
+  Status make_plant(Context& ctx, const char* function, std::unique_ptr<pkm::Plant>& out) const;
   /// make_plant, then the consistent initial state from x0..phi0, dx0..dphi0.
-  fmi2Status build(Context& ctx, const char* function);
+  Status build(Context& ctx, const char* function);
+  /// The plant, built from the current parameters in initialisation mode.
+  Status ready(Context& ctx, const char* function);
   pkm::LinearInputs inputs(double t0) const;
 };
 
-fmi2Status PlantData::make_plant(Context& ctx, const char* function, std::unique_ptr<pkm::Plant>& out) const {
+Status PlantData::make_plant(Context& ctx, const char* function, std::unique_ptr<pkm::Plant>& out) const {
   pkm::Model model;
   std::string why;
   if (pkm::make_model(params, model, &why) != pkm::Status::Ok) {
     ctx.log.error("%s: %s", function, why.c_str());
-    return fmi2Error;
+    return Status::Error;
   }
   if (solver != 0 && solver != 1) {
     ctx.log.error("%s: parameter solver = %d must be 0 (CVODE) or 1 (RK4)", function, static_cast<int>(solver));
-    return fmi2Error;
+    return Status::Error;
   }
   if (cvode_method != 0 && cvode_method != 1) {
     ctx.log.error("%s: parameter cvode_method = %d must be 0 (Adams) or 1 (BDF)", function,
                   static_cast<int>(cvode_method));
-    return fmi2Error;
+    return Status::Error;
   }
   if (formulation < 0 || formulation > 2) {
     ctx.log.error("%s: parameter formulation = %d must be 0 (Eq. 12), 1 (Eq. 13, QR) or 2 (Eq. 13, leg-partitioned)",
                   function, static_cast<int>(formulation));
-    return fmi2Error;
+    return Status::Error;
   }
   pkm::SolverSettings s;
   s.solver = static_cast<pkm::Solver>(solver);
@@ -105,16 +123,16 @@ fmi2Status PlantData::make_plant(Context& ctx, const char* function, std::unique
   auto plant_new = std::make_unique<pkm::Plant>(model);
   if (plant_new->set_solver(s, &why) != pkm::Status::Ok) {
     ctx.log.error("%s: parameter %s", function, why.c_str());
-    return fmi2Error;
+    return Status::Error;
   }
   out = std::move(plant_new);
-  return fmi2OK;
+  return Status::OK;
 }
 
-fmi2Status PlantData::build(Context& ctx, const char* function) {
+Status PlantData::build(Context& ctx, const char* function) {
   std::unique_ptr<pkm::Plant> p;
-  const fmi2Status st = make_plant(ctx, function, p);
-  if (st != fmi2OK) return st;
+  const Status st = make_plant(ctx, function, p);
+  if (st != Status::OK) return st;
   const pkm::Pose pose_0(pose0[0], pose0[1], pose0[2], pose0[3]);
   const pkm::Pose vel_0(vel0[0], vel0[1], vel0[2], vel0[3]);
   const pkm::Status s = p->initialize(ctx.start_time, pose_0, vel_0);
@@ -126,10 +144,10 @@ fmi2Status PlantData::build(Context& ctx, const char* function) {
                   "dy0 = %g, dz0 = %g m/s, dphi0 = %g rad/s) %s: %s: %s",
                   function, pose0[0], pose0[1], pose0[2], pose0[3], vel0[0], vel0[1], vel0[2], vel0[3], what,
                   pkm::status_name(s), p->last_error().c_str());
-    return fmi2Error;
+    return Status::Error;
   }
   plant = std::move(p);
-  return fmi2OK;
+  return Status::OK;
 }
 
 pkm::LinearInputs PlantData::inputs(double t0) const {
@@ -142,12 +160,25 @@ pkm::LinearInputs PlantData::inputs(double t0) const {
   return in;
 }
 
-fmi2Status PlantData::exit_initialization(Context& ctx) { return build(ctx, "fmi2ExitInitializationMode"); }
+Status PlantData::exit_initialization(Context& ctx) { return build(ctx, "ExitInitializationMode"); }
 
-fmi2Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
+Status PlantData::ready(Context& ctx, const char* function) {
+  if (ctx.initialization_mode) {
+    // Initial values for the parameters set so far.
+    const Status st = build(ctx, function);
+    if (st != Status::OK) return st;
+  }
   if (!plant || !plant->initialized()) {
-    ctx.log.error("fmi2DoStep: no state (initialisation did not succeed)");
-    return fmi2Error;
+    ctx.log.error("%s: no state (initialisation did not succeed)", function);
+    return Status::Error;
+  }
+  return Status::OK;
+}
+
+Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
+  if (!plant || !plant->initialized()) {
+    ctx.log.error("DoStep: no state (initialisation did not succeed)");
+    return Status::Error;
   }
   const double t_start = plant->time();
   const double t_end = t + h;
@@ -155,8 +186,8 @@ fmi2Status PlantData::do_step(Context& ctx, double t, double h, double& t_reache
   pkm::LinearInputs in = inputs(t_start);
   const double span = t_end - t_start;
   if (!(in.F0 + in.dF * span).allFinite() || !(in.we0 + in.dwe * span).allFinite()) {
-    ctx.log.error("fmi2DoStep: the inputs extrapolated with their derivatives to t = %.17g are not finite", t_end);
-    return fmi2Error;
+    ctx.log.error("DoStep: the inputs extrapolated with their derivatives to t = %.17g are not finite", t_end);
+    return Status::Error;
   }
   const pkm::Status s = plant->advance(t_end, in.signal(), /*continuous=*/false);
   t_reached = plant->time();
@@ -166,48 +197,42 @@ fmi2Status PlantData::do_step(Context& ctx, double t, double h, double& t_reache
       if (du[k] != 0.0) u[k] += du[k] * (t_reached - t_start);
   switch (s) {
     case pkm::Status::Ok:
-      return fmi2OK;
+      return Status::OK;
     case pkm::Status::SolverFailure:
     case pkm::Status::Unreachable:
     case pkm::Status::Singular:
     case pkm::Status::NotConverged:
       // The plant kept its last good state (RK4: last whole step; CVODE: the
-      // step start), within the singularity limits. fmi2Terminated is set by
-      // the generic layer: a master stops at fmi2LastSuccessfulTime instead
-      // of retrying the same step.
-      ctx.log.discard("fmi2DoStep: integration from t = %.17g to %.17g failed (%s%s%s); the state is kept at "
-                      "t = %.17g (fmi2LastSuccessfulTime), fmi2Terminated = true",
+      // step start), within the singularity limits. The layer sets
+      // terminated: a master stops at the last successful time instead of
+      // retrying the same step.
+      ctx.log.discard("DoStep: integration from t = %.17g to %.17g failed (%s%s%s); the state is kept at "
+                      "t = %.17g (the last successful time), terminated = true",
                       t_start, t_end, pkm::status_name(s), plant->last_error().empty() ? "" : ": ",
                       plant->last_error().c_str(), t_reached);
-      return fmi2Discard;
+      return Status::Discard;
     default:
-      ctx.log.error("fmi2DoStep: integration from t = %.17g to %.17g failed: %s%s%s", t_start, t_end,
+      ctx.log.error("DoStep: integration from t = %.17g to %.17g failed: %s%s%s", t_start, t_end,
                     pkm::status_name(s), plant->last_error().empty() ? "" : ": ", plant->last_error().c_str());
-      return fmi2Error;
+      return Status::Error;
   }
 }
 
-fmi2Status PlantData::update_outputs(Context& ctx) {
-  if (ctx.mode == kInitializationMode) {
-    // Initial values for the parameters set so far.
-    const fmi2Status st = build(ctx, "fmi2GetReal (initialization mode)");
-    if (st != fmi2OK) return st;
-  }
-  if (!plant || !plant->initialized()) {
-    ctx.log.error("fmi2GetReal: outputs not available (initialisation did not succeed)");
-    return fmi2Error;
-  }
+Status PlantData::update_outputs(Context& ctx) {
+  const Status st = ready(ctx, "get");
+  if (st != Status::OK) return st;
   pkm::MechanismState ms;
   const pkm::Status s = plant->mechanism(inputs(plant->time()).signal(), ms);
   if (s != pkm::Status::Ok) {
-    ctx.log.error("fmi2GetReal: the mechanism cannot be evaluated at t = %.17g: %s", plant->time(),
-                  pkm::status_name(s));
-    return fmi2Error;
+    ctx.log.error("get: the mechanism cannot be evaluated at t = %.17g: %s", plant->time(), pkm::status_name(s));
+    return Status::Error;
   }
   const pkm::Vec8& y = plant->state();
   for (int i = 0; i < 4; ++i) {
     pose[i] = y[i];
     vel[i] = y[4 + i];
+    dy[i] = y[4 + i];
+    dy[4 + i] = ms.qdd[12 + i];
     const int o = pkm::leg_offset(i);
     rho[i] = ms.q[o];
     drho[i] = ms.qd[o];
@@ -219,15 +244,96 @@ fmi2Status PlantData::update_outputs(Context& ctx) {
   residual = pkm::constraints(plant->model(), ms.q).norm();
   condition = pkm::actuator_jacobian_condition(plant->model(), ms.q);  // +inf at a singularity, never NaN
   bool finite = std::isfinite(residual) && !std::isnan(condition);
-  for (const double* block : {pose, vel, rho, drho, theta1, theta2})
+  for (const double* block : {pose, vel, rho, drho, theta1, theta2, dy + 4})
     for (int i = 0; i < 4; ++i) finite = finite && std::isfinite(block[i]);
   for (double v : lambda) finite = finite && std::isfinite(v);
+  if (pkm::guard_indicators(plant->model(), y.head<4>(), plant->solver().limits(), z) != pkm::Status::Ok)
+    finite = false;
   if (!finite) {
-    ctx.log.error("fmi2GetReal: non-finite outputs at t = %.17g (singular configuration?)", plant->time());
-    return fmi2Error;
+    ctx.log.error("get: non-finite outputs at t = %.17g (singular configuration?)", plant->time());
+    return Status::Error;
   }
-  return fmi2OK;
+  return Status::OK;
 }
+
+// ---------------------------------------------------------------- Model Exchange
+
+Status PlantData::get_states(Context& ctx, double x[]) {
+  const Status st = ready(ctx, "GetContinuousStates");
+  if (st != Status::OK) return st;
+  for (int k = 0; k < 8; ++k) x[k] = plant->state()[k];
+  return Status::OK;
+}
+
+Status PlantData::set_states(Context& ctx, const double x[]) {
+  const Status st = ready(ctx, "SetContinuousStates");
+  if (st != Status::OK) return st;
+  const pkm::Vec8 y = Eigen::Map<const pkm::Vec8>(x);
+  const pkm::Status s = plant->set_state(y);
+  if (s != pkm::Status::Ok) {
+    ctx.log.discard("SetContinuousStates: the pose x = %.9g m, y = %.9g m, z = %.9g m, phi = %.9g rad at t = %.17g "
+                    "cannot be assembled (%s: %s); the states are unchanged (a smaller step may stay within the "
+                    "workspace)",
+                    x[0], x[1], x[2], x[3], plant->time(), pkm::status_name(s), plant->last_error().c_str());
+    return Status::Discard;
+  }
+  return Status::OK;
+}
+
+Status PlantData::get_derivatives(Context& ctx, double dx[]) {
+  const Status st = ready(ctx, "GetDerivatives");
+  if (st != Status::OK) return st;
+  pkm::Vec8 ydot;
+  const pkm::Status s = plant->derivative_now(inputs(plant->time()).signal(), ydot);
+  if (s != pkm::Status::Ok || !ydot.allFinite()) {
+    ctx.log.error("GetDerivatives: the state derivative at t = %.17g cannot be evaluated: %s", plant->time(),
+                  s != pkm::Status::Ok ? pkm::status_name(s) : "not finite (singular configuration?)");
+    return Status::Error;
+  }
+  for (int k = 0; k < 8; ++k) dx[k] = ydot[k];
+  return Status::OK;
+}
+
+Status PlantData::get_event_indicators(Context& ctx, double z[]) {
+  const Status st = ready(ctx, "GetEventIndicators");
+  if (st != Status::OK) return st;
+  const pkm::Status s = pkm::guard_indicators(plant->model(), plant->state().head<4>(), plant->solver().limits(), z);
+  if (s != pkm::Status::Ok) {
+    ctx.log.error("GetEventIndicators: not defined at t = %.17g: %s", plant->time(), pkm::status_name(s));
+    return Status::Error;
+  }
+  return Status::OK;
+}
+
+void PlantData::get_nominals(double x[]) const {
+  // Pose in m and rad, velocity in m/s and rad/s: the workspace spans
+  // centimetres, so 0.1 keeps an importer's absolute tolerance meaningful.
+  for (int k = 0; k < 8; ++k) x[k] = k == 3 || k == 7 ? 1.0 : 0.1;
+}
+
+Status PlantData::event_update(Context& ctx, bool& terminate) {
+  terminate = false;
+  double z[pkm::kGuardIndicators];
+  const Status st = get_event_indicators(ctx, z);
+  if (st != Status::OK) return st;
+  for (int k = 0; k < pkm::kGuardIndicators; ++k) {
+    if (z[k] > 0.0) continue;
+    terminate = true;
+    if (k == 0) {
+      ctx.log.warning("event at t = %.17g: the actuator Jacobian's condition number reached max_jacobian_condition "
+                      "= %g (parallel-singularity guard); terminateSimulation = true",
+                      plant->time(), plant->solver().max_jacobian_condition);
+    } else {
+      ctx.log.warning("event at t = %.17g: leg %d reached min_leg_measure = %g (leg-singularity guard: rod nearly "
+                      "horizontal or vertical); terminateSimulation = true",
+                      plant->time(), k, plant->solver().min_leg_measure);
+    }
+    return Status::Warning;
+  }
+  return Status::OK;
+}
+
+// ---------------------------------------------------------------- FMU state
 
 void PlantData::save(StateWriter& w) const {
   const bool has = plant && plant->initialized();
@@ -248,10 +354,10 @@ bool PlantData::load(StateReader& r, Context& ctx) {
   r.f64s(ref.data(), ref.data() + 4);
   if (!r.ok()) return false;
   std::unique_ptr<pkm::Plant> p;
-  if (make_plant(ctx, "fmi2SetFMUstate", p) != fmi2OK) return false;
+  if (make_plant(ctx, "SetFMUState", p) != Status::OK) return false;
   const pkm::Status s = p->restore(t, y, ref);
   if (s != pkm::Status::Ok) {
-    ctx.log.error("fmi2SetFMUstate: the saved state at t = %.17g cannot be restored: %s", t, pkm::status_name(s));
+    ctx.log.error("SetFMUState: the saved state at t = %.17g cannot be restored: %s", t, pkm::status_name(s));
     return false;
   }
   plant = std::move(p);
@@ -265,8 +371,12 @@ bool PlantData::load(StateReader& r, Context& ctx) {
 #define PLANT_SCALAR(member) \
   [](ModelData& d, int) -> void* { return &static_cast<PlantData&>(d).member; }
 
+constexpr std::uint8_t kSliders = kOnPositions | kOnHeight;  // rho: the only outputs that follow z
+constexpr std::uint8_t kEverything = kOnPositions | kOnRates | kOnInputs;
+
 // clang-format off
 constexpr Variable kVariables[] = {
+  time_variable(0),
   // Inputs: 1..8.
   real_input(1, "F[1]", 0.0, "N", "Actuator force on the slider of leg 1, along +z", PLANT(u), 0, PLANT(du)),
   real_input(2, "F[2]", 0.0, "N", "Actuator force on the slider of leg 2, along +z", PLANT(u), 1, PLANT(du)),
@@ -276,46 +386,65 @@ constexpr Variable kVariables[] = {
   real_input(6, "Fe[2]", 0.0, "N", "External force on the platform at P, y component (base frame)", PLANT(u), 5, PLANT(du)),
   real_input(7, "Fe[3]", 0.0, "N", "External force on the platform at P, z component (base frame)", PLANT(u), 6, PLANT(du)),
   real_input(8, "Me_z", 0.0, "N.m", "External moment on the platform about z", PLANT(u), 7, PLANT(du)),
-  // Outputs: 10..53.
-  real_output(10, "x", "m", "Platform reference point P (centre of mass), x in the base frame", PLANT(pose), 0),
-  real_output(11, "y", "m", "Platform reference point P (centre of mass), y in the base frame", PLANT(pose), 1),
-  real_output(12, "z", "m", "Platform reference point P (centre of mass), z in the base frame", PLANT(pose), 2),
-  real_output(13, "phi", "rad", "Platform rotation about z of the base frame", PLANT(pose), 3),
-  real_output(14, "dx", "m/s", "Velocity of P, x component", PLANT(vel), 0),
-  real_output(15, "dy", "m/s", "Velocity of P, y component", PLANT(vel), 1),
-  real_output(16, "dz", "m/s", "Velocity of P, z component", PLANT(vel), 2),
-  real_output(17, "dphi", "rad/s", "Platform angular velocity about z", PLANT(vel), 3),
-  real_output(20, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", PLANT(rho), 0),
-  real_output(21, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", PLANT(rho), 1),
-  real_output(22, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", PLANT(rho), 2),
-  real_output(23, "rho[4]", "m", "Actuated prismatic joint of leg 4 (slider position)", PLANT(rho), 3),
-  real_output(24, "drho[1]", "m/s", "Slider velocity of leg 1", PLANT(drho), 0),
-  real_output(25, "drho[2]", "m/s", "Slider velocity of leg 2", PLANT(drho), 1),
-  real_output(26, "drho[3]", "m/s", "Slider velocity of leg 3", PLANT(drho), 2),
-  real_output(27, "drho[4]", "m/s", "Slider velocity of leg 4", PLANT(drho), 3),
-  real_output(28, "theta1[1]", "rad", "First revolute joint of leg 1 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 0),
-  real_output(29, "theta1[2]", "rad", "First revolute joint of leg 2 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 1),
-  real_output(30, "theta1[3]", "rad", "First revolute joint of leg 3 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 2),
-  real_output(31, "theta1[4]", "rad", "First revolute joint of leg 4 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 3),
-  real_output(32, "theta2[1]", "rad", "Second revolute joint of leg 1 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 0),
-  real_output(33, "theta2[2]", "rad", "Second revolute joint of leg 2 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 1),
-  real_output(34, "theta2[3]", "rad", "Second revolute joint of leg 3 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 2),
-  real_output(35, "theta2[4]", "rad", "Second revolute joint of leg 4 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 3),
-  real_output(40, "lambda[1]", "N", "Lagrange multiplier of leg 1's loop closure, x row (Eq. 1)", PLANT(lambda), 0),
-  real_output(41, "lambda[2]", "N", "Lagrange multiplier of leg 1's loop closure, y row (Eq. 1)", PLANT(lambda), 1),
-  real_output(42, "lambda[3]", "N", "Lagrange multiplier of leg 1's loop closure, z row (Eq. 1)", PLANT(lambda), 2),
-  real_output(43, "lambda[4]", "N", "Lagrange multiplier of leg 2's loop closure, x row (Eq. 1)", PLANT(lambda), 3),
-  real_output(44, "lambda[5]", "N", "Lagrange multiplier of leg 2's loop closure, y row (Eq. 1)", PLANT(lambda), 4),
-  real_output(45, "lambda[6]", "N", "Lagrange multiplier of leg 2's loop closure, z row (Eq. 1)", PLANT(lambda), 5),
-  real_output(46, "lambda[7]", "N", "Lagrange multiplier of leg 3's loop closure, x row (Eq. 1)", PLANT(lambda), 6),
-  real_output(47, "lambda[8]", "N", "Lagrange multiplier of leg 3's loop closure, y row (Eq. 1)", PLANT(lambda), 7),
-  real_output(48, "lambda[9]", "N", "Lagrange multiplier of leg 3's loop closure, z row (Eq. 1)", PLANT(lambda), 8),
-  real_output(49, "lambda[10]", "N", "Lagrange multiplier of leg 4's loop closure, x row (Eq. 1)", PLANT(lambda), 9),
-  real_output(50, "lambda[11]", "N", "Lagrange multiplier of leg 4's loop closure, y row (Eq. 1)", PLANT(lambda), 10),
-  real_output(51, "lambda[12]", "N", "Lagrange multiplier of leg 4's loop closure, z row (Eq. 1)", PLANT(lambda), 11),
-  real_output(52, "constraint_residual", "m", "Norm of the loop closures ||C(q)|| (Eq. 15) at the current state", PLANT_SCALAR(residual), 0),
-  real_output(53, "jacobian_condition", "", "Condition number of the 4x4 actuator Jacobian d(rho)/d(x, y, z, phi), its phi column divided by 0.1 m", PLANT_SCALAR(condition), 0),
-  // Parameters: the mechanism (100..120), the initial state (130..137), the solver (140..145).
+  // Outputs: 10..53; x..dphi are the continuous states (Model Exchange).
+  state_output(10, "x", "m", "Platform reference point P (centre of mass), x in the base frame", PLANT(pose), 0, 0, kOnPositions),
+  state_output(11, "y", "m", "Platform reference point P (centre of mass), y in the base frame", PLANT(pose), 1, 1, kOnPositions),
+  state_output(12, "z", "m", "Platform reference point P (centre of mass), z in the base frame", PLANT(pose), 2, 2, kOnHeight),
+  state_output(13, "phi", "rad", "Platform rotation about z of the base frame", PLANT(pose), 3, 3, kOnPositions),
+  state_output(14, "dx", "m/s", "Velocity of P, x component", PLANT(vel), 0, 4, kOnRates),
+  state_output(15, "dy", "m/s", "Velocity of P, y component", PLANT(vel), 1, 5, kOnRates),
+  state_output(16, "dz", "m/s", "Velocity of P, z component", PLANT(vel), 2, 6, kOnHeightRate),
+  state_output(17, "dphi", "rad/s", "Platform angular velocity about z", PLANT(vel), 3, 7, kOnRates),
+  real_output(20, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", PLANT(rho), 0, kSliders),
+  real_output(21, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", PLANT(rho), 1, kSliders),
+  real_output(22, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", PLANT(rho), 2, kSliders),
+  real_output(23, "rho[4]", "m", "Actuated prismatic joint of leg 4 (slider position)", PLANT(rho), 3, kSliders),
+  real_output(24, "drho[1]", "m/s", "Slider velocity of leg 1", PLANT(drho), 0, kOnPositions | kOnRates | kOnHeightRate),
+  real_output(25, "drho[2]", "m/s", "Slider velocity of leg 2", PLANT(drho), 1, kOnPositions | kOnRates | kOnHeightRate),
+  real_output(26, "drho[3]", "m/s", "Slider velocity of leg 3", PLANT(drho), 2, kOnPositions | kOnRates | kOnHeightRate),
+  real_output(27, "drho[4]", "m/s", "Slider velocity of leg 4", PLANT(drho), 3, kOnPositions | kOnRates | kOnHeightRate),
+  real_output(28, "theta1[1]", "rad", "First revolute joint of leg 1 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 0, kOnPositions),
+  real_output(29, "theta1[2]", "rad", "First revolute joint of leg 2 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 1, kOnPositions),
+  real_output(30, "theta1[3]", "rad", "First revolute joint of leg 3 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 2, kOnPositions),
+  real_output(31, "theta1[4]", "rad", "First revolute joint of leg 4 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 3, kOnPositions),
+  real_output(32, "theta2[1]", "rad", "Second revolute joint of leg 1 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 0, kOnPositions),
+  real_output(33, "theta2[2]", "rad", "Second revolute joint of leg 2 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 1, kOnPositions),
+  real_output(34, "theta2[3]", "rad", "Second revolute joint of leg 3 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 2, kOnPositions),
+  real_output(35, "theta2[4]", "rad", "Second revolute joint of leg 4 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 3, kOnPositions),
+  real_output(40, "lambda[1]", "N", "Lagrange multiplier of leg 1's loop closure, x row (Eq. 1)", PLANT(lambda), 0, kEverything),
+  real_output(41, "lambda[2]", "N", "Lagrange multiplier of leg 1's loop closure, y row (Eq. 1)", PLANT(lambda), 1, kEverything),
+  real_output(42, "lambda[3]", "N", "Lagrange multiplier of leg 1's loop closure, z row (Eq. 1)", PLANT(lambda), 2, kEverything),
+  real_output(43, "lambda[4]", "N", "Lagrange multiplier of leg 2's loop closure, x row (Eq. 1)", PLANT(lambda), 3, kEverything),
+  real_output(44, "lambda[5]", "N", "Lagrange multiplier of leg 2's loop closure, y row (Eq. 1)", PLANT(lambda), 4, kEverything),
+  real_output(45, "lambda[6]", "N", "Lagrange multiplier of leg 2's loop closure, z row (Eq. 1)", PLANT(lambda), 5, kEverything),
+  real_output(46, "lambda[7]", "N", "Lagrange multiplier of leg 3's loop closure, x row (Eq. 1)", PLANT(lambda), 6, kEverything),
+  real_output(47, "lambda[8]", "N", "Lagrange multiplier of leg 3's loop closure, y row (Eq. 1)", PLANT(lambda), 7, kEverything),
+  real_output(48, "lambda[9]", "N", "Lagrange multiplier of leg 3's loop closure, z row (Eq. 1)", PLANT(lambda), 8, kEverything),
+  real_output(49, "lambda[10]", "N", "Lagrange multiplier of leg 4's loop closure, x row (Eq. 1)", PLANT(lambda), 9, kEverything),
+  real_output(50, "lambda[11]", "N", "Lagrange multiplier of leg 4's loop closure, y row (Eq. 1)", PLANT(lambda), 10, kEverything),
+  real_output(51, "lambda[12]", "N", "Lagrange multiplier of leg 4's loop closure, z row (Eq. 1)", PLANT(lambda), 11, kEverything),
+  real_output(52, "constraint_residual", "m", "Norm of the loop closures ||C(q)|| (Eq. 15) at the current state", PLANT_SCALAR(residual), 0, kOnPositions),
+  real_output(53, "jacobian_condition", "", "Condition number of the 4x4 actuator Jacobian d(rho)/d(x, y, z, phi), its phi column divided by 0.1 m", PLANT_SCALAR(condition), 0, kOnPositions),
+  // Derivatives of the continuous states: 60..67.
+  state_derivative(60, "der(x)", "m/s", "Derivative of x", PLANT(dy), 0, 0, kOnRates),
+  state_derivative(61, "der(y)", "m/s", "Derivative of y", PLANT(dy), 1, 1, kOnRates),
+  state_derivative(62, "der(z)", "m/s", "Derivative of z", PLANT(dy), 2, 2, kOnRates),
+  state_derivative(63, "der(phi)", "rad/s", "Derivative of phi", PLANT(dy), 3, 3, kOnRates),
+  state_derivative(64, "der(dx)", "m/s2", "Acceleration of P, x component (Eq. 13)", PLANT(dy), 4, 4, kEverything),
+  state_derivative(65, "der(dy)", "m/s2", "Acceleration of P, y component (Eq. 13)", PLANT(dy), 5, 5, kEverything),
+  state_derivative(66, "der(dz)", "m/s2", "Acceleration of P, z component (Eq. 13)", PLANT(dy), 6, 6, kEverything),
+  state_derivative(67, "der(dphi)", "rad/s2", "Angular acceleration of the platform about z (Eq. 13)", PLANT(dy), 7, 7, kEverything),
+  // Event indicators (Model Exchange): 70..74.
+  event_indicator(70, "guard_condition_margin", "",
+                  "1/jacobian_condition - 1/max_jacobian_condition: event indicator of the parallel-singularity guard "
+                  "(positive within it)", PLANT(z), 0, 0, kOnPositions),
+  event_indicator(71, "guard_leg_margin[1]", "",
+                  "|cos(theta2) sin(theta2)| of leg 1 - min_leg_measure: event indicator of the leg-singularity guard "
+                  "(positive within it)", PLANT(z), 1, 1, kOnPositions),
+  event_indicator(72, "guard_leg_margin[2]", "", "The same for leg 2", PLANT(z), 2, 2, kOnPositions),
+  event_indicator(73, "guard_leg_margin[3]", "", "The same for leg 3", PLANT(z), 3, 3, kOnPositions),
+  event_indicator(74, "guard_leg_margin[4]", "", "The same for leg 4", PLANT(z), 4, 4, kOnPositions),
+  // Parameters: the mechanism (100..120), the initial state (130..137), the solver (140..147).
   PKM_FMI_MECHANISM_PARAMETERS,
   real_parameter(130, "x0", 0.0, "m", "Initial x of P", PLANT(pose0), 0),
   real_parameter(131, "y0", 0.0, "m", "Initial y of P", PLANT(pose0), 1),
@@ -326,26 +455,28 @@ constexpr Variable kVariables[] = {
   real_parameter(136, "dz0", 0.0, "m/s", "Initial velocity of P, z component", PLANT(vel0), 2),
   real_parameter(137, "dphi0", 0.0, "rad/s", "Initial platform angular velocity about z", PLANT(vel0), 3),
   integer_parameter(140, "solver", static_cast<int>(kDefaultSolver.solver),
-                    "Integrator: 0 = CVODE (variable step, rtol and atol), 1 = fixed-step RK4 (rk4_step), as in the paper",
-                    PLANT_SCALAR(solver)),
+                    "Co-Simulation integrator: 0 = CVODE (variable step, rtol and atol), 1 = fixed-step RK4 (rk4_step), as in the paper",
+                    PLANT_SCALAR(solver), 0, 1),
   real_parameter(141, "rk4_step", kDefaultSolver.rk4_step, "s",
                  "RK4 step: a communication step is split into whole steps no longer than this", PLANT_SCALAR(rk4_step), 0),
-  real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance", PLANT_SCALAR(rtol), 0),
-  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, and velocity)", PLANT_SCALAR(atol), 0),
+  real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance", PLANT_SCALAR(rtol), 0, 0.0, 1.0),
+  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, and velocity)", PLANT_SCALAR(atol), 0, 0.0),
   integer_parameter(144, "cvode_method", static_cast<int>(kDefaultSolver.cvode_method),
-                    "CVODE method: 0 = Adams-Moulton (non-stiff), 1 = BDF", PLANT_SCALAR(cvode_method)),
+                    "CVODE method: 0 = Adams-Moulton (non-stiff), 1 = BDF", PLANT_SCALAR(cvode_method), 0, 1),
   integer_parameter(145, "formulation", static_cast<int>(kDefaultSolver.formulation),
                     "Forward dynamics: 0 = augmented saddle-point system (Eq. 12), 1 = null-space projection with a QR "
                     "(Eq. 13), 2 = null space from the leg blocks (Eq. 13, leg-partitioned)",
-                    PLANT_SCALAR(formulation)),
+                    PLANT_SCALAR(formulation), 0, 2),
   real_parameter(146, "max_jacobian_condition", kDefaultSolver.max_jacobian_condition, "",
                  "Parallel-singularity guard: a step whose end state has an actuator Jacobian condition number "
-                 "(phi column divided by 0.1 m) above this is discarded (fmi2Discard, state kept); > 1",
-                 PLANT_SCALAR(max_jacobian_condition), 0),
+                 "(phi column divided by 0.1 m) above this is discarded (Co-Simulation: Discard, state kept; Model "
+                 "Exchange: an event indicator, terminateSimulation); > 1",
+                 PLANT_SCALAR(max_jacobian_condition), 0, 1.0),
   real_parameter(147, "min_leg_measure", kDefaultSolver.min_leg_measure, "",
                  "Leg-singularity guard: a step whose end state has |cos(theta2) sin(theta2)| of a leg below this "
-                 "(rod nearly horizontal or vertical) is discarded (fmi2Discard, state kept); in [0, 0.5)",
-                 PLANT_SCALAR(min_leg_measure), 0),
+                 "(rod nearly horizontal or vertical) is discarded (Co-Simulation: Discard, state kept; Model "
+                 "Exchange: an event indicator, terminateSimulation); in [0, 0.5)",
+                 PLANT_SCALAR(min_leg_measure), 0, 0.0, 0.5),
 };
 // clang-format on
 
@@ -358,7 +489,6 @@ std::unique_ptr<ModelData> create() { return std::make_unique<PlantData>(); }
 
 const ModelDefinition kDefinition{
     "PKM4PUU",
-    PKM4PUU_GUID,
     "4-PUU Schoenflies-motion parallel robot: forward dynamics (the plant)",
     "<p>Forward dynamics of the 4-PUU parallel kinematics machine with three translations and one rotation "
     "(3T1R) of M. Ruggiu, P. Rea and E. Ottaviano, <i>Dynamic model of a 3T1R parallel kinematics machine</i>: "
@@ -367,15 +497,24 @@ const ModelDefinition kDefinition{
     "wrench on the platform; outputs are the platform pose and velocity, the joint coordinates of the legs, the "
     "Lagrange multipliers, the constraint residual and the condition number of the actuator Jacobian. The legs "
     "work elbow-down (the platform hangs below the rods).</p>"
-    "<p>Each communication step is integrated by CVODE (default; restarted at every step, so results depend only "
-    "on the state and inputs at the step start) or by fixed-step RK4. The inputs can be interpolated linearly "
-    "within a step (fmi2SetRealInputDerivatives, order 1). A step that cannot be completed, or that ends near a "
-    "leg singularity (min_leg_measure) or a parallel singularity (max_jacobian_condition), returns fmi2Discard "
-    "with the last good state kept at fmi2LastSuccessfulTime and fmi2Terminated = true. FMU states can be saved, "
-    "restored and serialised.</p>",
+    "<p><b>Co-Simulation:</b> each communication step is integrated by CVODE (default; restarted at every step, "
+    "so results depend only on the state and inputs at the step start) or by fixed-step RK4. With FMI 2.0 the "
+    "inputs can be interpolated linearly within a step (fmi2SetRealInputDerivatives, order 1). A step that cannot "
+    "be completed, or that ends near a leg singularity (min_leg_measure) or a parallel singularity "
+    "(max_jacobian_condition), returns Discard with the last good state kept at the last successful time and "
+    "terminated = true. <b>Model Exchange:</b> the continuous states are x, y, z, phi, dx, dy, dz, dphi; the legs "
+    "are reconstructed from them in closed form, so the loop closures hold exactly whatever the importer's "
+    "integrator does. The five event indicators are the singularity guards (1/cond - 1/max_jacobian_condition, "
+    "and |cos theta2 sin theta2| - min_leg_measure per leg); crossing one ends the simulation with a logged "
+    "reason. A pose that no leg can reach is refused by SetContinuousStates with Discard. FMU states can be "
+    "saved, restored and serialised.</p>",
     kVariables,
     std::size(kVariables),
+    /*n_states=*/8,
+    /*n_event_indicators=*/pkm::kGuardIndicators,
     /*can_interpolate_inputs=*/true,
+    /*default_step=*/1e-3,
+    /*default_stop=*/2.0,
     &create,
 };
 

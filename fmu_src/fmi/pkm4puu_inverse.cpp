@@ -23,10 +23,6 @@
 #include "mechanism_parameters.hpp"
 #include "models.hpp"
 
-#ifndef PKM4PUU_INVERSE_GUID
-#error "PKM4PUU_INVERSE_GUID must be defined (the build computes it from modelDescription/PKM4PUU_Inverse.xml)"
-#endif
-
 namespace pkm_fmi {
 namespace {
 
@@ -41,46 +37,46 @@ struct InverseData final : MechanismData {
   std::unique_ptr<pkm::Model> model;
 
   void reset() override { model.reset(); }
-  fmi2Status exit_initialization(Context& ctx) override;
-  fmi2Status do_step(Context&, double t, double h, double& t_reached) override {
+  Status exit_initialization(Context& ctx) override;
+  Status do_step(Context&, double t, double h, double& t_reached) override {
     t_reached = t + h;  // no dynamics: the outputs follow the inputs
-    return fmi2OK;
+    return Status::OK;
   }
-  fmi2Status update_outputs(Context& ctx) override;
+  Status update_outputs(Context& ctx) override;
   void save(StateWriter& w) const override;
   bool load(StateReader& r, Context& ctx) override;
 
-  fmi2Status make(Context& ctx, const char* function, pkm::Model& out) const;
+  Status make(Context& ctx, const char* function, pkm::Model& out) const;
 };
 
-fmi2Status InverseData::make(Context& ctx, const char* function, pkm::Model& out) const {
+Status InverseData::make(Context& ctx, const char* function, pkm::Model& out) const {
   std::string why;
   if (pkm::make_model(params, out, &why) != pkm::Status::Ok) {
     ctx.log.error("%s: %s", function, why.c_str());
-    return fmi2Error;
+    return Status::Error;
   }
-  return fmi2OK;
+  return Status::OK;
 }
 
-fmi2Status InverseData::exit_initialization(Context& ctx) {
+Status InverseData::exit_initialization(Context& ctx) {
   auto m = std::make_unique<pkm::Model>();
-  const fmi2Status st = make(ctx, "fmi2ExitInitializationMode", *m);
-  if (st != fmi2OK) return st;
+  const Status st = make(ctx, "ExitInitializationMode", *m);
+  if (st != Status::OK) return st;
   model = std::move(m);
-  return fmi2OK;
+  return Status::OK;
 }
 
-fmi2Status InverseData::update_outputs(Context& ctx) {
+Status InverseData::update_outputs(Context& ctx) {
   pkm::Model temporary;
   const pkm::Model* m = model.get();
-  if (ctx.mode == kInitializationMode) {
-    const fmi2Status st = make(ctx, "fmi2GetReal (initialization mode)", temporary);
-    if (st != fmi2OK) return st;
+  if (ctx.initialization_mode) {
+    const Status st = make(ctx, "get (initialization mode)", temporary);
+    if (st != Status::OK) return st;
     m = &temporary;
   }
   if (!m) {
-    ctx.log.error("fmi2GetReal: outputs not available (initialisation did not succeed)");
-    return fmi2Error;
+    ctx.log.error("get: outputs not available (initialisation did not succeed)");
+    return Status::Error;
   }
   const pkm::Pose p(pose[0], pose[1], pose[2], pose[3]);
   const pkm::Pose pd(vel[0], vel[1], vel[2], vel[3]);
@@ -89,10 +85,10 @@ fmi2Status InverseData::update_outputs(Context& ctx) {
   pkm::InverseDynamicsResult r;
   const pkm::Status s = pkm::inverse_dynamics(*m, p, pd, pdd, we, r, /*warm_start=*/false);
   if (s != pkm::Status::Ok) {
-    ctx.log.error("fmi2GetReal: inverse dynamics at x = %g m, y = %g m, z = %g m, phi = %g rad failed: %s "
+    ctx.log.error("get: inverse dynamics at x = %g m, y = %g m, z = %g m, phi = %g rad failed: %s "
                   "(outputs not written)",
                   pose[0], pose[1], pose[2], pose[3], pkm::status_name(s));
-    return fmi2Error;
+    return Status::Error;
   }
   for (int i = 0; i < 4; ++i) {
     const int o = pkm::leg_offset(i);
@@ -101,7 +97,7 @@ fmi2Status InverseData::update_outputs(Context& ctx) {
     drho[i] = r.qd[o];
   }
   for (int k = 0; k < 12; ++k) lambda[k] = r.lambda[k];
-  return fmi2OK;
+  return Status::OK;
 }
 
 void InverseData::save(StateWriter& w) const { w.u8(model ? 1 : 0); }
@@ -112,7 +108,7 @@ bool InverseData::load(StateReader& r, Context& ctx) {
   model.reset();
   if (has_model) {
     auto m = std::make_unique<pkm::Model>();
-    if (make(ctx, "fmi2SetFMUstate", *m) != fmi2OK) return false;
+    if (make(ctx, "SetFMUState", *m) != Status::OK) return false;
     model = std::move(m);
   }
   return true;
@@ -123,17 +119,20 @@ bool InverseData::load(StateReader& r, Context& ctx) {
 #define INV(member) \
   [](ModelData& d, int i) -> void* { return &static_cast<InverseData&>(d).member[i]; }
 
+constexpr std::uint8_t kEverything = kOnPositions | kOnRates | kOnInputs;
+
 // clang-format off
 constexpr Variable kVariables[] = {
+  time_variable(0),
   // Inputs: 1..16.
-  real_input(1, "x", 0.0, "m", "Platform reference point P (centre of mass), x in the base frame", INV(pose), 0, nullptr),
-  real_input(2, "y", 0.0, "m", "Platform reference point P (centre of mass), y in the base frame", INV(pose), 1, nullptr),
-  real_input(3, "z", 0.05, "m", "Platform reference point P (centre of mass), z in the base frame (home pose: 0.05 m)", INV(pose), 2, nullptr),
-  real_input(4, "phi", 0.0, "rad", "Platform rotation about z of the base frame", INV(pose), 3, nullptr),
-  real_input(5, "dx", 0.0, "m/s", "Velocity of P, x component", INV(vel), 0, nullptr),
-  real_input(6, "dy", 0.0, "m/s", "Velocity of P, y component", INV(vel), 1, nullptr),
-  real_input(7, "dz", 0.0, "m/s", "Velocity of P, z component", INV(vel), 2, nullptr),
-  real_input(8, "dphi", 0.0, "rad/s", "Platform angular velocity about z", INV(vel), 3, nullptr),
+  real_input(1, "x", 0.0, "m", "Platform reference point P (centre of mass), x in the base frame", INV(pose), 0, nullptr, kOnPositions),
+  real_input(2, "y", 0.0, "m", "Platform reference point P (centre of mass), y in the base frame", INV(pose), 1, nullptr, kOnPositions),
+  real_input(3, "z", 0.05, "m", "Platform reference point P (centre of mass), z in the base frame (home pose: 0.05 m)", INV(pose), 2, nullptr, kOnHeight),
+  real_input(4, "phi", 0.0, "rad", "Platform rotation about z of the base frame", INV(pose), 3, nullptr, kOnPositions),
+  real_input(5, "dx", 0.0, "m/s", "Velocity of P, x component", INV(vel), 0, nullptr, kOnRates),
+  real_input(6, "dy", 0.0, "m/s", "Velocity of P, y component", INV(vel), 1, nullptr, kOnRates),
+  real_input(7, "dz", 0.0, "m/s", "Velocity of P, z component", INV(vel), 2, nullptr, kOnHeightRate),
+  real_input(8, "dphi", 0.0, "rad/s", "Platform angular velocity about z", INV(vel), 3, nullptr, kOnRates),
   real_input(9, "ddx", 0.0, "m/s2", "Acceleration of P, x component", INV(acc), 0, nullptr),
   real_input(10, "ddy", 0.0, "m/s2", "Acceleration of P, y component", INV(acc), 1, nullptr),
   real_input(11, "ddz", 0.0, "m/s2", "Acceleration of P, z component", INV(acc), 2, nullptr),
@@ -143,30 +142,30 @@ constexpr Variable kVariables[] = {
   real_input(15, "Fe[3]", 0.0, "N", "External force on the platform at P, z component (base frame)", INV(wrench), 2, nullptr),
   real_input(16, "Me_z", 0.0, "N.m", "External moment on the platform about z", INV(wrench), 3, nullptr),
   // Outputs: 20..51.
-  real_output(20, "F[1]", "N", "Actuator force on the slider of leg 1, along +z (Eq. 11)", INV(F), 0),
-  real_output(21, "F[2]", "N", "Actuator force on the slider of leg 2, along +z (Eq. 11)", INV(F), 1),
-  real_output(22, "F[3]", "N", "Actuator force on the slider of leg 3, along +z (Eq. 11)", INV(F), 2),
-  real_output(23, "F[4]", "N", "Actuator force on the slider of leg 4, along +z (Eq. 11)", INV(F), 3),
-  real_output(24, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", INV(rho), 0),
-  real_output(25, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", INV(rho), 1),
-  real_output(26, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", INV(rho), 2),
-  real_output(27, "rho[4]", "m", "Actuated prismatic joint of leg 4 (slider position)", INV(rho), 3),
-  real_output(28, "drho[1]", "m/s", "Slider velocity of leg 1", INV(drho), 0),
-  real_output(29, "drho[2]", "m/s", "Slider velocity of leg 2", INV(drho), 1),
-  real_output(30, "drho[3]", "m/s", "Slider velocity of leg 3", INV(drho), 2),
-  real_output(31, "drho[4]", "m/s", "Slider velocity of leg 4", INV(drho), 3),
-  real_output(40, "lambda[1]", "N", "Lagrange multiplier of leg 1's loop closure, x row (Eq. 10)", INV(lambda), 0),
-  real_output(41, "lambda[2]", "N", "Lagrange multiplier of leg 1's loop closure, y row (Eq. 10)", INV(lambda), 1),
-  real_output(42, "lambda[3]", "N", "Lagrange multiplier of leg 1's loop closure, z row (Eq. 10)", INV(lambda), 2),
-  real_output(43, "lambda[4]", "N", "Lagrange multiplier of leg 2's loop closure, x row (Eq. 10)", INV(lambda), 3),
-  real_output(44, "lambda[5]", "N", "Lagrange multiplier of leg 2's loop closure, y row (Eq. 10)", INV(lambda), 4),
-  real_output(45, "lambda[6]", "N", "Lagrange multiplier of leg 2's loop closure, z row (Eq. 10)", INV(lambda), 5),
-  real_output(46, "lambda[7]", "N", "Lagrange multiplier of leg 3's loop closure, x row (Eq. 10)", INV(lambda), 6),
-  real_output(47, "lambda[8]", "N", "Lagrange multiplier of leg 3's loop closure, y row (Eq. 10)", INV(lambda), 7),
-  real_output(48, "lambda[9]", "N", "Lagrange multiplier of leg 3's loop closure, z row (Eq. 10)", INV(lambda), 8),
-  real_output(49, "lambda[10]", "N", "Lagrange multiplier of leg 4's loop closure, x row (Eq. 10)", INV(lambda), 9),
-  real_output(50, "lambda[11]", "N", "Lagrange multiplier of leg 4's loop closure, y row (Eq. 10)", INV(lambda), 10),
-  real_output(51, "lambda[12]", "N", "Lagrange multiplier of leg 4's loop closure, z row (Eq. 10)", INV(lambda), 11),
+  real_output(20, "F[1]", "N", "Actuator force on the slider of leg 1, along +z (Eq. 11)", INV(F), 0, kEverything),
+  real_output(21, "F[2]", "N", "Actuator force on the slider of leg 2, along +z (Eq. 11)", INV(F), 1, kEverything),
+  real_output(22, "F[3]", "N", "Actuator force on the slider of leg 3, along +z (Eq. 11)", INV(F), 2, kEverything),
+  real_output(23, "F[4]", "N", "Actuator force on the slider of leg 4, along +z (Eq. 11)", INV(F), 3, kEverything),
+  real_output(24, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", INV(rho), 0, kOnPositions | kOnHeight),
+  real_output(25, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", INV(rho), 1, kOnPositions | kOnHeight),
+  real_output(26, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", INV(rho), 2, kOnPositions | kOnHeight),
+  real_output(27, "rho[4]", "m", "Actuated prismatic joint of leg 4 (slider position)", INV(rho), 3, kOnPositions | kOnHeight),
+  real_output(28, "drho[1]", "m/s", "Slider velocity of leg 1", INV(drho), 0, kOnPositions | kOnRates | kOnHeightRate),
+  real_output(29, "drho[2]", "m/s", "Slider velocity of leg 2", INV(drho), 1, kOnPositions | kOnRates | kOnHeightRate),
+  real_output(30, "drho[3]", "m/s", "Slider velocity of leg 3", INV(drho), 2, kOnPositions | kOnRates | kOnHeightRate),
+  real_output(31, "drho[4]", "m/s", "Slider velocity of leg 4", INV(drho), 3, kOnPositions | kOnRates | kOnHeightRate),
+  real_output(40, "lambda[1]", "N", "Lagrange multiplier of leg 1's loop closure, x row (Eq. 10)", INV(lambda), 0, kEverything),
+  real_output(41, "lambda[2]", "N", "Lagrange multiplier of leg 1's loop closure, y row (Eq. 10)", INV(lambda), 1, kEverything),
+  real_output(42, "lambda[3]", "N", "Lagrange multiplier of leg 1's loop closure, z row (Eq. 10)", INV(lambda), 2, kEverything),
+  real_output(43, "lambda[4]", "N", "Lagrange multiplier of leg 2's loop closure, x row (Eq. 10)", INV(lambda), 3, kEverything),
+  real_output(44, "lambda[5]", "N", "Lagrange multiplier of leg 2's loop closure, y row (Eq. 10)", INV(lambda), 4, kEverything),
+  real_output(45, "lambda[6]", "N", "Lagrange multiplier of leg 2's loop closure, z row (Eq. 10)", INV(lambda), 5, kEverything),
+  real_output(46, "lambda[7]", "N", "Lagrange multiplier of leg 3's loop closure, x row (Eq. 10)", INV(lambda), 6, kEverything),
+  real_output(47, "lambda[8]", "N", "Lagrange multiplier of leg 3's loop closure, y row (Eq. 10)", INV(lambda), 7, kEverything),
+  real_output(48, "lambda[9]", "N", "Lagrange multiplier of leg 3's loop closure, z row (Eq. 10)", INV(lambda), 8, kEverything),
+  real_output(49, "lambda[10]", "N", "Lagrange multiplier of leg 4's loop closure, x row (Eq. 10)", INV(lambda), 9, kEverything),
+  real_output(50, "lambda[11]", "N", "Lagrange multiplier of leg 4's loop closure, y row (Eq. 10)", INV(lambda), 10, kEverything),
+  real_output(51, "lambda[12]", "N", "Lagrange multiplier of leg 4's loop closure, z row (Eq. 10)", INV(lambda), 11, kEverything),
   // Parameters: the mechanism (100..120).
   PKM_FMI_MECHANISM_PARAMETERS,
 };
@@ -180,20 +179,24 @@ std::unique_ptr<ModelData> create() { return std::make_unique<InverseData>(); }
 
 const ModelDefinition kDefinition{
     "PKM4PUU_Inverse",
-    PKM4PUU_INVERSE_GUID,
     "4-PUU Schoenflies-motion parallel robot: inverse dynamics (computed-force feed-forward)",
     "<p>Inverse dynamics of the 4-PUU parallel kinematics machine with three translations and one rotation "
     "(3T1R) of M. Ruggiu, P. Rea and E. Ottaviano, <i>Dynamic model of a 3T1R parallel kinematics machine</i>. "
     "Given the platform pose, velocity and acceleration and an external wrench, it solves the position, "
     "velocity and acceleration problems of the legs (Eqs. 2-9, elbow-down) and then Eqs. 10-11 for the "
     "Lagrange multipliers and the four actuator forces. The outputs are algebraic functions of the inputs at "
-    "the communication point (direct feedthrough); fmi2DoStep only advances time.</p>"
-    "<p>An unreachable or singular pose makes fmi2GetReal return fmi2Error with a message; no output is "
+    "the current time (direct feedthrough): in Co-Simulation a step only advances time; in Model Exchange it has "
+    "no states and no event indicators.</p>"
+    "<p>An unreachable or singular pose makes the get of an output return Error with a message; no output is "
     "written then. At rest at the home pose (0, 0, 0.05 m, 0) with g = 9.81 m/s2 each actuator carries "
     "2.655616050 N.</p>",
     kVariables,
     std::size(kVariables),
+    /*n_states=*/0,
+    /*n_event_indicators=*/0,
     /*can_interpolate_inputs=*/false,
+    /*default_step=*/1e-3,
+    /*default_stop=*/2.0,
     &create,
 };
 

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <string>
 
+#include "model_description.hpp"
 #include "models.hpp"
 
 namespace {
@@ -27,16 +28,7 @@ std::string escape(const char* s) {
 
 std::string start_text(const pkm_fmi::Variable& v) {
   if (!v.has_start()) return "";
-  char buf[40];
-  if (v.type == pkm_fmi::VarType::Real) {
-    for (int digits = 1; digits <= 17; ++digits) {  // the shortest text that reads back exactly
-      std::snprintf(buf, sizeof buf, "%.*g", digits, v.start);
-      if (std::strtod(buf, nullptr) == v.start) break;
-    }
-  } else {
-    std::snprintf(buf, sizeof buf, "%d", static_cast<int>(v.start));
-  }
-  return buf;
+  return v.type == pkm_fmi::VarType::Real ? pkm_fmi::exact_text(v.start) : std::to_string(static_cast<int>(v.start));
 }
 
 void section(std::ofstream& out, const pkm_fmi::ModelDefinition& def, pkm_fmi::Causality c, const char* title) {
@@ -45,7 +37,7 @@ void section(std::ofstream& out, const pkm_fmi::ModelDefinition& def, pkm_fmi::C
   for (std::size_t i = 0; i < def.n_variables; ++i) {
     const pkm_fmi::Variable& v = def.variables[i];
     if (v.causality != c) continue;
-    out << "<tr><td><code>" << escape(v.name) << "</code></td><td>" << pkm_fmi::xml_name(v.type) << "</td><td>"
+    out << "<tr><td><code>" << escape(v.name) << "</code></td><td>" << pkm_fmi::fmi2_type_name(v.type) << "</td><td>"
         << escape(v.unit) << "</td><td>" << start_text(v) << "</td><td>" << v.vr << "</td><td>"
         << escape(v.description) << "</td></tr>\n";
   }
@@ -74,12 +66,14 @@ int main(int argc, char** argv) {
          "</head>\n<body>\n<h1>"
       << def->identifier << "</h1>\n<p><b>" << escape(def->title) << "</b></p>\n"
       << def->summary
-      << "\n<p>FMI 2.0 Co-Simulation, binaries for linux64. SI units on every variable (m, kg, s, rad, N, N.m). "
-         "Parameters are fixed: they can be set before fmi2ExitInitializationMode only. Arrays follow the "
-         "<code>name[i]</code> convention, 1-based; leg i = 1..4.</p>\n";
+      << "\n<p>FMI 2.0 (Co-Simulation and Model Exchange in one archive) and FMI 3.0 (Co-Simulation and Model "
+         "Exchange), binaries for x86_64 Linux. SI units on every variable (m, kg, s, rad, N, N.m). "
+         "Parameters are fixed: they can be set before ExitInitializationMode only. Arrays follow the "
+         "<code>name[i]</code> convention, 1-based; leg i = 1..4; the FMI 3.0 names are the FMI 2.0 ones.</p>\n";
   section(out, *def, pkm_fmi::Causality::Input, "Inputs");
   section(out, *def, pkm_fmi::Causality::Output, "Outputs");
   section(out, *def, pkm_fmi::Causality::Parameter, "Parameters");
+  section(out, *def, pkm_fmi::Causality::Local, "Local variables (state derivatives, event indicators)");
   out << "</body>\n</html>\n";
   out.close();
   if (!out) {

@@ -1,0 +1,310 @@
+#include "fmu_state.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+#include "fnv1a.hpp"
+#include "instance.hpp"
+#include "state_machine.hpp"
+
+namespace pkm_fmi {
+namespace {
+
+constexpr std::uint64_t kStateTag = 0x53324d464d4b5002ull;  // marks a live SavedState
+constexpr unsigned char kMagic[8] = {'P', 'K', 'M', 'F', 'M', 'U', 'S', 'T'};
+constexpr std::uint32_t kFormatVersion = 2;
+constexpr std::size_t kHeaderSize = 32;
+constexpr std::size_t kTrailerSize = 8;
+
+double read_as_double(ModelData& d, const Variable& v) {
+  void* p = v.value(d, v.index);
+  switch (v.type) {
+    case VarType::Real: return *static_cast<double*>(p);
+    case VarType::Integer: return static_cast<double>(*static_cast<std::int32_t*>(p));
+    case VarType::Boolean: return *static_cast<int*>(p) ? 1.0 : 0.0;
+  }
+  return 0.0;
+}
+
+void write_from_double(ModelData& d, const Variable& v, double x) {
+  void* p = v.value(d, v.index);
+  switch (v.type) {
+    case VarType::Real: *static_cast<double*>(p) = x; break;
+    case VarType::Integer: *static_cast<std::int32_t*>(p) = static_cast<std::int32_t>(x); break;
+    case VarType::Boolean: *static_cast<int*>(p) = x != 0.0 ? 1 : 0; break;
+  }
+}
+
+std::uint32_t stored_count(const ModelDefinition& d) {
+  std::uint32_t n = 0;
+  for (std::size_t i = 0; i < d.n_variables; ++i)
+    n += (d.variables[i].stored_in_state() ? 1u : 0u) + (d.variables[i].derivative ? 1u : 0u);
+  return n;
+}
+
+}  // namespace
+
+SavedState* as_state(void* handle) {
+  auto* p = static_cast<SavedState*>(handle);
+  return (p && p->tag == kStateTag) ? p : nullptr;
+}
+
+SavedState* make_state(Instance* owner) {
+  auto* s = new SavedState{kStateTag, {}, owner};
+  return s;
+}
+
+void destroy_state(SavedState* s) {
+  *static_cast<volatile std::uint64_t*>(&s->tag) = 0;
+  delete s;
+}
+
+SavedState* Instance::new_state() {
+  std::unique_ptr<SavedState> owned(make_state(this));
+  states_.insert(owned.get());  // may throw: then nothing leaks
+  return owned.release();
+}
+
+void Instance::save(std::vector<unsigned char>& out) const {
+  out.clear();
+  StateWriter w(out);
+  for (unsigned char c : kMagic) w.u8(c);
+  w.u32(kFormatVersion);
+  w.u32(0);
+  w.u64(0);  // total size, patched below
+  w.u64(fnv1a(token_.c_str()));
+  // Generic part.
+  w.u32(mode_);
+  w.u8(stop_time_defined_ ? 1 : 0);
+  w.u8(terminated_ ? 1 : 0);
+  w.u8(static_cast<std::uint8_t>(interface_));
+  w.f64(start_time_);
+  w.f64(stop_time_);
+  w.f64(time_);
+  w.f64(last_successful_time_);
+  w.u32(stored_count(def_));
+  for (std::size_t i = 0; i < def_.n_variables; ++i) {
+    const Variable& v = def_.variables[i];
+    if (!v.stored_in_state()) continue;
+    if (v.type == VarType::Real) {
+      w.f64(*static_cast<double*>(v.value(*data_, v.index)));
+    } else {
+      w.i64(static_cast<std::int64_t>(read_as_double(*data_, v)));
+    }
+  }
+  for (std::size_t i = 0; i < def_.n_variables; ++i) {
+    const Variable& v = def_.variables[i];
+    if (v.derivative) w.f64(*static_cast<double*>(v.derivative(*data_, v.index)));
+  }
+  data_->save(w);  // the model's part
+  write_le64(out.data() + 16, out.size() + kTrailerSize);
+  w.u64(fnv1a(out.data(), out.size()));
+}
+
+bool Instance::check_header(const unsigned char* bytes, std::size_t size, const char* function) {
+  if (!bytes || size < kHeaderSize + kTrailerSize || std::memcmp(bytes, kMagic, sizeof kMagic) != 0) {
+    log_.error("%s: not a serialised FMU state of this FMU (size %llu, no magic number)", function,
+               static_cast<unsigned long long>(size));
+    return false;
+  }
+  const std::uint32_t version = read_le32(bytes + 8);
+  if (version != kFormatVersion) {
+    log_.error("%s: FMU state format version %u, this FMU reads version %u", function, version, kFormatVersion);
+    return false;
+  }
+  if (read_le64(bytes + 16) != size) {
+    log_.error("%s: FMU state of %llu bytes says it has %llu", function, static_cast<unsigned long long>(size),
+               static_cast<unsigned long long>(read_le64(bytes + 16)));
+    return false;
+  }
+  if (read_le64(bytes + 24) != fnv1a(token_.c_str())) {
+    log_.error("%s: the FMU state belongs to another FMU (instantiation token differs from %s)", function,
+               token_.c_str());
+    return false;
+  }
+  if (read_le64(bytes + size - kTrailerSize) != fnv1a(bytes, size - kTrailerSize)) {
+    log_.error("%s: FMU state corrupted (checksum mismatch)", function);
+    return false;
+  }
+  return true;
+}
+
+bool Instance::load(const std::vector<unsigned char>& bytes, const char* function) {
+  if (!check_header(bytes.data(), bytes.size(), function)) return false;
+  StateReader r(bytes.data() + kHeaderSize, bytes.size() - kHeaderSize - kTrailerSize);
+  const std::uint32_t mode = r.u32();
+  const bool stop_defined = r.u8() != 0;
+  const bool terminated = r.u8() != 0;
+  const std::uint8_t interface = r.u8();
+  const double start_time = r.f64();
+  const double stop_time = r.f64();
+  const double time = r.f64();
+  const double last_time = r.f64();
+  const std::uint32_t count = r.u32();
+  const std::uint32_t expected = stored_count(def_);
+  if (!r.ok() || count != expected || !(mode & kRestorableModes) || (mode & (mode - 1)) != 0) {
+    log_.error("%s: malformed FMU state (mode %u, %u values where %u expected)", function, mode, count, expected);
+    return false;
+  }
+  if (interface != static_cast<std::uint8_t>(interface_)) {
+    log_.error("%s: the FMU state was saved by a %s instance, this one is %s", function,
+               interface == 0 ? "Model Exchange" : "Co-Simulation", interface_name(interface_));
+    return false;
+  }
+  // Read every value before changing anything.
+  std::vector<double> values;
+  values.reserve(count);
+  for (std::size_t i = 0; i < def_.n_variables; ++i) {
+    const Variable& v = def_.variables[i];
+    if (!v.stored_in_state()) continue;
+    if (v.type == VarType::Real) {
+      values.push_back(r.f64());
+    } else {
+      const std::int64_t x = r.i64();
+      if (x < INT32_MIN || x > INT32_MAX) {
+        log_.error("%s: malformed FMU state (%s = %lld)", function, v.name, static_cast<long long>(x));
+        return false;
+      }
+      values.push_back(static_cast<double>(x));
+    }
+  }
+  for (std::size_t i = 0; i < def_.n_variables; ++i)
+    if (def_.variables[i].derivative) values.push_back(r.f64());
+  if (!r.ok()) {
+    log_.error("%s: malformed FMU state (truncated)", function);
+    return false;
+  }
+  for (double x : values) {
+    if (!std::isfinite(x)) {
+      log_.error("%s: malformed FMU state (a non-finite value)", function);
+      return false;
+    }
+  }
+  // Commit, keeping a copy of the current state to fall back to.
+  std::vector<unsigned char> backup;
+  save(backup);
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < def_.n_variables; ++i) {
+    const Variable& v = def_.variables[i];
+    if (v.stored_in_state()) write_from_double(*data_, v, values[k++]);
+  }
+  for (std::size_t i = 0; i < def_.n_variables; ++i) {
+    const Variable& v = def_.variables[i];
+    if (v.derivative) *static_cast<double*>(v.derivative(*data_, v.index)) = values[k++];
+  }
+  input_derivatives_set_ = true;  // the restored state may carry derivatives
+  mode_ = mode;
+  stop_time_defined_ = stop_defined;
+  terminated_ = terminated;
+  start_time_ = start_time;
+  stop_time_ = stop_time;
+  time_ = time;
+  last_successful_time_ = last_time;
+  outputs_valid_ = false;
+  data_->reset();
+  Context ctx = context();
+  const bool ok = data_->load(r, ctx) && r.ok() && r.at_end();
+  if (ok) return true;
+  log_.error("%s: the FMU state cannot be restored; the previous state is kept", function);
+  if (!load(backup, function)) mode_ = kError;  // cannot happen: the backup was just written
+  return false;
+}
+
+Status Instance::get_fmu_state(void** state) {
+  const char* fn = PKM_FN2(fmi2GetFMUstate, fmi3GetFMUState);
+  if (!allowed(kMaskFmuState, fn)) return Status::Error;
+  if (!state) {
+    log_.error("%s: FMUState is NULL", fn);
+    return Status::Error;
+  }
+  SavedState* s = nullptr;
+  if (*state) {
+    s = as_state(*state);
+    if (!s) {
+      log_.error("%s: *FMUState is neither NULL nor an FMU state of this FMU", fn);
+      return Status::Error;
+    }
+  } else {
+    s = new_state();
+    *state = s;
+  }
+  save(s->bytes);
+  log_.event("%s: state saved at t = %.17g (%llu bytes)", fn, time_,
+             static_cast<unsigned long long>(s->bytes.size()));
+  return Status::OK;
+}
+
+Status Instance::set_fmu_state(void* state) {
+  const char* fn = PKM_FN2(fmi2SetFMUstate, fmi3SetFMUState);
+  if (!allowed(kMaskFmuState, fn)) return Status::Error;
+  SavedState* s = as_state(state);
+  if (!s) {
+    log_.error("%s: not an FMU state of this FMU", fn);
+    return Status::Error;
+  }
+  if (!load(s->bytes, fn)) return Status::Error;
+  log_.event("%s: state restored at t = %.17g (%s)", fn, time_, mode_name(mode_));
+  return Status::OK;
+}
+
+Status Instance::free_fmu_state(void** state) {
+  const char* fn = PKM_FN2(fmi2FreeFMUstate, fmi3FreeFMUState);
+  if (!allowed(kMaskFmuState, fn)) return Status::Error;
+  if (!state || !*state) return Status::OK;
+  SavedState* s = as_state(*state);
+  if (!s) {
+    log_.error("%s: not an FMU state of this FMU", fn);
+    return Status::Error;
+  }
+  if (s->owner) s->owner->forget_state(s);  // freed through another instance of this FMU: its creator forgets it
+  destroy_state(s);
+  *state = nullptr;
+  return Status::OK;
+}
+
+Status Instance::serialized_fmu_state_size(void* state, std::size_t* size) {
+  const char* fn = PKM_FN2(fmi2SerializedFMUstateSize, fmi3SerializedFMUStateSize);
+  if (!allowed(kMaskFmuState, fn)) return Status::Error;
+  SavedState* s = as_state(state);
+  if (!s || !size) {
+    log_.error("%s: %s", fn, size ? "not an FMU state of this FMU" : "size is NULL");
+    return Status::Error;
+  }
+  *size = s->bytes.size();
+  return Status::OK;
+}
+
+Status Instance::serialize_fmu_state(void* state, unsigned char bytes[], std::size_t size) {
+  const char* fn = PKM_FN2(fmi2SerializeFMUstate, fmi3SerializeFMUState);
+  if (!allowed(kMaskFmuState, fn)) return Status::Error;
+  SavedState* s = as_state(state);
+  if (!s || !bytes) {
+    log_.error("%s: %s", fn, bytes ? "not an FMU state of this FMU" : "serializedState is NULL");
+    return Status::Error;
+  }
+  if (size < s->bytes.size()) {
+    log_.error("%s: buffer of %llu bytes, %llu needed (SerializedFMUStateSize)", fn,
+               static_cast<unsigned long long>(size), static_cast<unsigned long long>(s->bytes.size()));
+    return Status::Error;
+  }
+  std::memcpy(bytes, s->bytes.data(), s->bytes.size());
+  return Status::OK;
+}
+
+Status Instance::deserialize_fmu_state(const unsigned char bytes[], std::size_t size, void** state) {
+  const char* fn = PKM_FN2(fmi2DeSerializeFMUstate, fmi3DeserializeFMUState);
+  if (!allowed(kMaskFmuState, fn)) return Status::Error;
+  if (!state) {
+    log_.error("%s: FMUState is NULL", fn);
+    return Status::Error;
+  }
+  if (!check_header(bytes, size, fn)) return Status::Error;
+  std::vector<unsigned char> copy(bytes, bytes + size);
+  SavedState* s = new_state();
+  s->bytes.swap(copy);
+  *state = s;
+  return Status::OK;
+}
+
+}  // namespace pkm_fmi

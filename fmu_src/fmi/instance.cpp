@@ -1,0 +1,214 @@
+#include "instance.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+#include "fmu_state.hpp"
+#include "state_machine.hpp"
+
+namespace pkm_fmi {
+namespace {
+
+constexpr std::uint64_t kInstanceTag2 = 0x49324d464d4b5002ull;  // marks a live FMI 2.0 Instance
+constexpr std::uint64_t kInstanceTag3 = 0x49334d464d4b5002ull;  // marks a live FMI 3.0 Instance
+
+std::uint64_t tag_of(int version) { return version == 2 ? kInstanceTag2 : kInstanceTag3; }
+
+void write_from_double(ModelData& d, const Variable& v, double x) {
+  void* p = v.value(d, v.index);
+  switch (v.type) {
+    case VarType::Real: *static_cast<double*>(p) = x; break;
+    case VarType::Integer: *static_cast<std::int32_t*>(p) = static_cast<std::int32_t>(x); break;
+    case VarType::Boolean: *static_cast<int*>(p) = x != 0.0 ? 1 : 0; break;
+  }
+}
+
+}  // namespace
+
+const char* mode_name(std::uint32_t mode) {
+  switch (mode) {
+    case kInstantiated: return "Instantiated";
+    case kInitializationMode: return "InitializationMode";
+    case kEventMode: return "EventMode";
+    case kContinuousTimeMode: return "ContinuousTimeMode";
+    case kStepMode: return "StepMode";
+    case kStepFailed: return "StepFailed";
+    case kTerminated: return "Terminated";
+    case kError: return "Error";
+    case kFatal: return "Fatal";
+  }
+  return "unknown";
+}
+
+Instance::Instance(const ModelDefinition& def, int fmi_version, Interface interface, Logger log)
+    : tag_(tag_of(fmi_version)), def_(def), token_(def.guid()), version_(fmi_version), interface_(interface), log_(std::move(log)) {}
+
+Instance::~Instance() {
+  // FreeInstance frees everything the instance allocated, including FMU
+  // states the importer did not free.
+  for (SavedState* s : states_) destroy_state(s);
+  *static_cast<volatile std::uint64_t*>(&tag_) = 0;  // a dangling handle is no longer taken for an instance
+}
+
+Instance* Instance::from(void* handle, const ModelDefinition& def, int fmi_version) {
+  auto* i = static_cast<Instance*>(handle);
+  // The definition's address tells this model's instances from another FMU's
+  // (another binary loaded in the same process has its own definitions).
+  return (i && i->tag_ == tag_of(fmi_version) && &i->def_ == &def) ? i : nullptr;
+}
+
+Instance* Instance::create(const ModelDefinition& def, int fmi_version, Interface interface, const char* token,
+                           Logger log) {
+  const char* fn = fmi_version == 2 ? "fmi2Instantiate" : interface == Interface::ModelExchange
+                                                              ? "fmi3InstantiateModelExchange"
+                                                              : "fmi3InstantiateCoSimulation";
+  const std::string expected = def.guid();
+  if (!token || expected != token) {
+    log.error("%s: %s %s does not match this binary's %s (modelDescription.xml from another build?)", fn,
+              fmi_version == 2 ? "GUID" : "instantiationToken", token ? token : "(NULL)", expected.c_str());
+    return nullptr;
+  }
+  std::unique_ptr<Instance> inst(new Instance(def, fmi_version, interface, std::move(log)));
+  inst->data_ = def.create();
+  inst->apply_start_values();
+  inst->data_->reset();
+  inst->log_.call("%s(%s, %s): %s, %s", fn, inst->log_.instance_name().c_str(), token, def.identifier,
+                  interface_name(interface));
+  return inst.release();
+}
+
+Status Instance::internal_error(const char* function, const char* what) {
+  log_.error("%s: internal error: %s", function, what);
+  mode_ = kError;
+  return Status::Error;
+}
+
+Status Instance::not_supported(const char* function, const char* why) {
+  if (!allowed(kAlive, function)) return Status::Error;
+  log_.error("%s: not supported by %s: %s; the call has no effect", function, def_.identifier, why);
+  return Status::Error;
+}
+
+bool Instance::allowed(std::uint32_t mask, const char* function) {
+  if (mode_ & mask) return true;
+  log_.error("%s: not allowed in state %s (illegal call sequence); the call has no effect", function,
+             mode_name(mode_));
+  return false;
+}
+
+bool Instance::require(Interface i, const char* function) {
+  if (interface_ == i) return true;
+  log_.error("%s: a %s function, but this instance was instantiated for %s; the call has no effect", function,
+             interface_name(i), interface_name(interface_));
+  return false;
+}
+
+void Instance::apply_start_values() {
+  for (std::size_t i = 0; i < def_.n_variables; ++i) {
+    const Variable& v = def_.variables[i];
+    if (v.has_start() && v.value) write_from_double(*data_, v, v.start);
+    if (v.derivative) *static_cast<double*>(v.derivative(*data_, v.index)) = 0.0;
+  }
+}
+
+Status Instance::set_debug_logging(bool on, std::size_t n, const char* const categories[]) {
+  const char* fn = PKM_FN(SetDebugLogging);
+  if (!allowed(kMaskSetDebugLogging, fn)) return Status::Error;
+  if (n == 0) {
+    log_.set_default(on);
+    return Status::OK;
+  }
+  if (!categories) {
+    log_.error("%s: categories is NULL", fn);
+    return Status::Error;
+  }
+  // Check every name before changing anything.
+  for (std::size_t k = 0; k < n; ++k) {
+    if (log_category(categories[k]) < 0) {
+      log_.error("%s: unknown log category \"%s\" (known: logEvents, logStatusWarning, logStatusDiscard, "
+                 "logStatusError, logStatusFatal, logCalls); nothing changed",
+                 fn, categories[k] ? categories[k] : "(NULL)");
+      return Status::Error;
+    }
+  }
+  for (std::size_t k = 0; k < n; ++k) log_.enable(static_cast<LogCategory>(log_category(categories[k])), on);
+  return Status::OK;
+}
+
+Status Instance::setup_experiment(bool tolerance_defined, double tolerance, double start_time,
+                                  bool stop_time_defined, double stop_time) {
+  const char* fn = version_ == 2 ? "fmi2SetupExperiment" : "fmi3EnterInitializationMode";
+  if (!allowed(kMaskSetupExperiment, fn)) return Status::Error;
+  log_.call("%s(toleranceDefined = %d, tolerance = %g, startTime = %.17g, stopTimeDefined = %d, stopTime = %.17g)",
+            fn, tolerance_defined, tolerance, start_time, stop_time_defined, stop_time);
+  if (!std::isfinite(start_time)) {
+    log_.error("%s: startTime = %g is not finite", fn, start_time);
+    return Status::Error;
+  }
+  if (stop_time_defined && !(stop_time >= start_time)) {
+    log_.error("%s: stopTime = %.17g lies before startTime = %.17g", fn, stop_time, start_time);
+    return Status::Error;
+  }
+  if (tolerance_defined)
+    log_.event("%s: tolerance %g not used (the parameters rtol and atol set CVODE's accuracy)", fn,
+               tolerance);
+  start_time_ = start_time;
+  stop_time_defined_ = stop_time_defined;
+  stop_time_ = stop_time_defined_ ? stop_time : 0.0;
+  time_ = last_successful_time_ = start_time;
+  return Status::OK;
+}
+
+Status Instance::enter_initialization_mode() {
+  const char* fn = PKM_FN(EnterInitializationMode);
+  if (!allowed(kMaskEnterInitialization, fn)) return Status::Error;
+  mode_ = kInitializationMode;
+  time_ = last_successful_time_ = start_time_;
+  outputs_valid_ = false;
+  data_->set_time(start_time_);
+  log_.event("%s: initialization mode at t = %.17g", fn, start_time_);
+  return Status::OK;
+}
+
+Status Instance::exit_initialization_mode() {
+  const char* fn = PKM_FN(ExitInitializationMode);
+  if (!allowed(kMaskExitInitialization, fn)) return Status::Error;
+  Context ctx = context();
+  const Status s = data_->exit_initialization(ctx);
+  outputs_valid_ = false;
+  if (succeeded(s)) {
+    mode_ = interface_ == Interface::CoSimulation ? kStepMode : kEventMode;
+    time_ = last_successful_time_ = start_time_;
+    terminated_ = false;
+    log_.event("%s: initialised at t = %.17g, now in %s", fn, start_time_, mode_name(mode_));
+    return s;
+  }
+  mode_ = s == Status::Fatal ? kFatal : kError;
+  return s == Status::Fatal ? Status::Fatal : Status::Error;
+}
+
+Status Instance::terminate() {
+  const char* fn = PKM_FN(Terminate);
+  if (!allowed(kMaskTerminate, fn)) return Status::Error;
+  mode_ = kTerminated;
+  log_.event("%s at t = %.17g", fn, time_);
+  return Status::OK;
+}
+
+Status Instance::reset() {
+  const char* fn = PKM_FN(Reset);
+  if (!allowed(kMaskReset, fn)) return Status::Error;
+  apply_start_values();
+  data_->reset();
+  input_derivatives_set_ = false;
+  mode_ = kInstantiated;
+  start_time_ = stop_time_ = time_ = last_successful_time_ = 0.0;
+  stop_time_defined_ = false;
+  terminated_ = false;
+  outputs_valid_ = false;
+  log_.event("%s: back to the instantiated state with the start values", fn);
+  return Status::OK;
+}
+
+}  // namespace pkm_fmi

@@ -1,0 +1,179 @@
+// One FMU instance, whatever the FMI version: the state machine, and every
+// FMI function as a method over the model's table and hooks. The thin front
+// ends (fmi2_functions.cpp, fmi3_functions.cpp) translate the C calls.
+//
+// Error policy: a call with wrong arguments or in the wrong state returns
+// Error with a logged message and has no effect (the instance stays as it
+// was). A failure of the model itself (initialisation impossible, a step
+// failed beyond recovery) returns Error and puts the instance in the Error
+// state: then only get, reset, free and the FMU state functions are allowed
+// (SetFMUState may return to a saved good state). A step that cannot be
+// completed returns Discard with the state kept at the last good time.
+//
+// Implementation, one concern per file: instance.cpp (creation, state
+// machine, initialisation, termination, reset, logging setup),
+// variable_access.cpp (get/set), fmu_state.cpp (FMU states and their
+// serialisation), stepping.cpp (Co-Simulation), model_exchange.cpp.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <unordered_set>
+#include <vector>
+
+#include "fmi_status.hpp"
+#include "logger.hpp"
+#include "model_data.hpp"
+#include "variables.hpp"
+
+/// The name of an FMI function in this instance's version, for messages
+/// (inside Instance methods): PKM_FN(DoStep) is "fmi2DoStep" or "fmi3DoStep".
+#define PKM_FN(name) (version_ == 2 ? "fmi2" #name : "fmi3" #name)
+/// Where the two versions spell a name differently: PKM_FN2(fmi2GetFMUstate, fmi3GetFMUState).
+#define PKM_FN2(name2, name3) (version_ == 2 ? #name2 : #name3)
+
+namespace pkm_fmi {
+
+/// The states of the FMI 2.0 and 3.0 state machines that this FMU enters
+/// (bit masks). CS: StepComplete (2.0) = Step Mode (3.0).
+enum Mode : std::uint32_t {
+  kInstantiated = 1u << 0,
+  kInitializationMode = 1u << 1,
+  kEventMode = 1u << 2,           // Model Exchange
+  kContinuousTimeMode = 1u << 3,  // Model Exchange
+  kStepMode = 1u << 4,            // Co-Simulation
+  kStepFailed = 1u << 5,          // Co-Simulation, after a Discard
+  kTerminated = 1u << 6,
+  kError = 1u << 7,
+  kFatal = 1u << 8,
+};
+const char* mode_name(std::uint32_t mode);
+
+struct SavedState;  // fmu_state.cpp
+
+class Instance {
+ public:
+  /// nullptr on failure (the reason logged through `log`).
+  static Instance* create(const ModelDefinition& def, int fmi_version, Interface interface, const char* token,
+                          Logger log);
+  /// The instance behind a handle, nullptr if it is not a live instance of
+  /// this model created through this FMI version.
+  static Instance* from(void* handle, const ModelDefinition& def, int fmi_version);
+  ~Instance();
+  Instance(const Instance&) = delete;
+  Instance& operator=(const Instance&) = delete;
+
+  // ---- lifecycle (instance.cpp)
+  Status set_debug_logging(bool on, std::size_t n, const char* const categories[]);
+  /// FMI 2.0's fmi2SetupExperiment; FMI 3.0 passes the same to enter_initialization_mode.
+  Status setup_experiment(bool tolerance_defined, double tolerance, double start_time, bool stop_time_defined,
+                          double stop_time);
+  Status enter_initialization_mode();
+  Status exit_initialization_mode();
+  Status terminate();
+  Status reset();
+
+  // ---- variables (variable_access.cpp)
+  Status get_real(const std::uint32_t vr[], std::size_t n, double value[]);
+  Status get_integer(const std::uint32_t vr[], std::size_t n, std::int32_t value[]);
+  Status get_boolean(const std::uint32_t vr[], std::size_t n, int value[]);
+  Status set_real(const std::uint32_t vr[], std::size_t n, const double value[]);
+  Status set_integer(const std::uint32_t vr[], std::size_t n, const std::int32_t value[]);
+  Status set_boolean(const std::uint32_t vr[], std::size_t n, const int value[]);
+  /// A getter or setter of a type this model has no variables of.
+  Status no_variables_of_type(const char* function, const char* type, const std::uint32_t vr[], std::size_t n,
+                              bool setter);
+
+  // ---- FMU states (fmu_state.cpp)
+  Status get_fmu_state(void** state);
+  Status set_fmu_state(void* state);
+  Status free_fmu_state(void** state);
+  Status serialized_fmu_state_size(void* state, std::size_t* size);
+  Status serialize_fmu_state(void* state, unsigned char bytes[], std::size_t size);
+  Status deserialize_fmu_state(const unsigned char bytes[], std::size_t size, void** state);
+
+  // ---- Co-Simulation (stepping.cpp)
+  Status set_real_input_derivatives(const std::uint32_t vr[], std::size_t n, const std::int32_t order[],
+                                    const double value[]);
+  Status get_real_output_derivatives(const char* function);
+  Status do_step(double t, double h, bool* terminate, double* last_successful_time);
+  Status last_successful_time(double* t);
+  Status terminated(bool* t);
+  Status not_pending(const char* function);
+
+  // ---- Model Exchange (model_exchange.cpp)
+  Status enter_event_mode();
+  Status event_update(bool* discrete_states_need_update, bool* terminate, bool* nominals_changed,
+                      bool* values_changed, bool* next_event_time_defined, double* next_event_time);
+  Status enter_continuous_time_mode();
+  Status completed_integrator_step(bool* enter_event_mode, bool* terminate);
+  Status set_time(double t);
+  Status set_continuous_states(const double x[], std::size_t n);
+  Status get_continuous_states(double x[], std::size_t n);
+  Status get_derivatives(double dx[], std::size_t n);
+  Status get_event_indicators(double z[], std::size_t n);
+  Status get_nominals(double x[], std::size_t n);
+  Status get_number_of(const char* what, std::size_t count, std::size_t* n);
+
+  // ---- not provided
+  Status not_supported(const char* function, const char* why);
+
+  /// Turns an exception escaping a method into Error (never across the C ABI).
+  Status internal_error(const char* function, const char* what);
+
+  const ModelDefinition& definition() const { return def_; }
+  std::uint32_t mode() const { return mode_; }
+  Interface interface() const { return interface_; }
+  double time() const { return time_; }
+  Logger& logger() { return log_; }
+  /// "fmi2" or "fmi3": the prefix of function names in messages.
+  const char* prefix() const { return version_ == 2 ? "fmi2" : "fmi3"; }
+  int version() const { return version_; }
+
+ private:
+  Instance(const ModelDefinition& def, int fmi_version, Interface interface, Logger log);
+
+  bool allowed(std::uint32_t mask, const char* function);
+  bool require(Interface i, const char* function);
+  Context context() {
+    return Context{log_, interface_, mode_ == kInitializationMode, start_time_};
+  }
+  void apply_start_values();
+  Status ensure_outputs(const char* function);
+  template <class T>
+  Status get_values(const char* function, VarType type, const std::uint32_t vr[], std::size_t n, T value[]);
+  template <class T>
+  Status set_values(const char* function, VarType type, const std::uint32_t vr[], std::size_t n, const T value[]);
+  const Variable* lookup(const char* function, VarType type, std::uint32_t vr);
+
+  SavedState* new_state();
+  void save(std::vector<unsigned char>& out) const;
+  bool check_header(const unsigned char* bytes, std::size_t size, const char* function);
+  bool load(const std::vector<unsigned char>& bytes, const char* function);
+
+  std::uint64_t tag_;  // identifies a live Instance of this version behind a handle
+  const ModelDefinition& def_;
+  std::string token_;  // def_.guid()
+  int version_;
+  Interface interface_;
+  Logger log_;
+  std::unique_ptr<ModelData> data_;
+  std::uint32_t mode_ = kInstantiated;
+  double start_time_ = 0.0;
+  double stop_time_ = 0.0;
+  bool stop_time_defined_ = false;
+  double time_ = 0.0;                   // current time (CS: communication point)
+  double last_successful_time_ = 0.0;   // CS
+  bool terminated_ = false;             // CS: set after a discarded step
+  bool outputs_valid_ = false;          // computed variables up to date
+  bool input_derivatives_set_ = false;  // SetRealInputDerivatives was used (or a state restored)
+  std::unordered_set<SavedState*> states_;  // FMU states this instance created and nobody freed yet
+
+ public:
+  /// Forgets a state freed through any instance (FreeFMUState).
+  void forget_state(SavedState* s) { states_.erase(s); }
+};
+
+}  // namespace pkm_fmi

@@ -1,0 +1,75 @@
+#include "logger.hpp"
+
+#include <cstdio>
+#include <cstring>
+#include <utility>
+
+namespace pkm_fmi {
+
+int log_category(const char* name) {
+  if (!name) return -1;
+  for (int c = 0; c < kLogCategoryCount; ++c)
+    if (std::strcmp(name, kLogCategoryNames[c]) == 0) return c;
+  return -1;
+}
+
+Logger::Logger(LogEmitter emit, void* callback, void* env, std::string instance_name, bool logging_on)
+    : emit_(emit), callback_(emit ? callback : nullptr), env_(env), name_(std::move(instance_name)) {
+  set_default(logging_on);
+}
+
+void Logger::set_default(bool logging_on) {
+  for (bool& b : on_) b = false;
+  enable(LogCategory::StatusWarning, true);
+  enable(LogCategory::StatusDiscard, true);
+  enable(LogCategory::StatusError, true);
+  enable(LogCategory::StatusFatal, true);
+  enable(LogCategory::Events, logging_on);
+}
+
+void Logger::vlog(Status status, LogCategory c, const char* fmt, va_list args) {
+  if (!enabled(c)) return;
+  char small[512];
+  va_list copy;
+  va_copy(copy, args);
+  const int n = std::vsnprintf(small, sizeof small, fmt, copy);
+  va_end(copy);
+  std::string text;
+  if (n < 0) {
+    text = fmt;
+  } else if (static_cast<std::size_t>(n) < sizeof small) {
+    text.assign(small, static_cast<std::size_t>(n));
+  } else {
+    text.resize(static_cast<std::size_t>(n) + 1);
+    std::vsnprintf(&text[0], text.size(), fmt, args);
+    text.resize(static_cast<std::size_t>(n));
+  }
+  emit_(callback_, env_, name_.c_str(), status, kLogCategoryNames[static_cast<unsigned>(c)], text.c_str());
+}
+
+#define PKM_FMI_LOG_AS(method, status, category) \
+  void Logger::method(const char* fmt, ...) {    \
+    va_list args;                                \
+    va_start(args, fmt);                         \
+    vlog(status, category, fmt, args);           \
+    va_end(args);                                \
+  }
+PKM_FMI_LOG_AS(error, Status::Error, LogCategory::StatusError)
+PKM_FMI_LOG_AS(warning, Status::Warning, LogCategory::StatusWarning)
+PKM_FMI_LOG_AS(discard, Status::Discard, LogCategory::StatusDiscard)
+PKM_FMI_LOG_AS(fatal, Status::Fatal, LogCategory::StatusFatal)
+PKM_FMI_LOG_AS(event, Status::OK, LogCategory::Events)
+PKM_FMI_LOG_AS(call, Status::OK, LogCategory::Calls)
+#undef PKM_FMI_LOG_AS
+
+void Logger::status(Status s, const char* fmt, ...) {
+  static constexpr LogCategory kCategory[] = {LogCategory::Events, LogCategory::StatusWarning,
+                                              LogCategory::StatusDiscard, LogCategory::StatusError,
+                                              LogCategory::StatusFatal};
+  va_list args;
+  va_start(args, fmt);
+  vlog(s, kCategory[static_cast<int>(s)], fmt, args);
+  va_end(args);
+}
+
+}  // namespace pkm_fmi

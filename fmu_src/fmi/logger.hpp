@@ -1,0 +1,86 @@
+// Messages to the importer's logger callback, filtered by log category.
+//
+// Categories (declared in every modelDescription.xml, in this order):
+//   logEvents         mode changes, stop contacts, guard crossings (status OK)
+//   logStatusWarning  the reason of every Warning
+//   logStatusDiscard  the reason of every Discard
+//   logStatusError    the reason of every Error
+//   logStatusFatal    the reason of every Fatal
+//   logCalls          every FMI call with its arguments (verbose; only when named)
+//
+// One rule for instantiation and fmiXSetDebugLogging:
+//   - logging off (loggingOn = false, or SetDebugLogging(false) with no
+//     category named): the four logStatus* categories only, so that a status
+//     other than OK always comes with its reason;
+//   - logging on with no category named (loggingOn = true, or
+//     SetDebugLogging(true) with no category named): those and logEvents;
+//   - categories named: exactly those are switched on or off, the others
+//     keep their setting. logCalls is on only when named.
+#pragma once
+
+#include <cstdarg>
+#include <string>
+
+#include "fmi_status.hpp"
+
+namespace pkm_fmi {
+
+enum class LogCategory : unsigned { Events, StatusWarning, StatusDiscard, StatusError, StatusFatal, Calls };
+constexpr int kLogCategoryCount = 6;
+inline constexpr const char* kLogCategoryNames[kLogCategoryCount] = {
+    "logEvents", "logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal", "logCalls"};
+inline constexpr const char* kLogCategoryDescriptions[kLogCategoryCount] = {
+    "Mode changes, end-stop contacts and singularity-guard crossings",
+    "Reasons of the status Warning",
+    "Reasons of the status Discard (a step or state that could not be used)",
+    "Reasons of the status Error",
+    "Reasons of the status Fatal",
+    "Every call of an FMI function with its arguments (verbose; enabled only by naming it)"};
+
+/// The category of a name, -1 if unknown.
+int log_category(const char* name);
+
+#if defined(__MINGW32__)
+#define PKM_FMI_PRINTF(fmt, args) __attribute__((format(__MINGW_PRINTF_FORMAT, fmt, args)))
+#elif defined(__GNUC__)
+#define PKM_FMI_PRINTF(fmt, args) __attribute__((format(printf, fmt, args)))
+#else
+#define PKM_FMI_PRINTF(fmt, args)
+#endif
+
+/// Hands one formatted message to the importer (the FMI version's callback).
+using LogEmitter = void (*)(void* callback, void* env, const char* instance, Status status, const char* category,
+                            const char* message);
+
+class Logger {
+ public:
+  Logger() = default;
+  Logger(LogEmitter emit, void* callback, void* env, std::string instance_name, bool logging_on);
+
+  bool enabled(LogCategory c) const { return callback_ && on_[static_cast<unsigned>(c)]; }
+  /// The default set of categories for logging on or off (see above).
+  void set_default(bool logging_on);
+  void enable(LogCategory c, bool on) { on_[static_cast<unsigned>(c)] = on; }
+
+  void error(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);
+  void warning(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);
+  void discard(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);
+  void fatal(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);
+  void event(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);
+  void call(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);  // logCalls
+  /// A message with the status's own category.
+  void status(Status s, const char* fmt, ...) PKM_FMI_PRINTF(3, 4);
+
+  const std::string& instance_name() const { return name_; }
+
+ private:
+  void vlog(Status status, LogCategory c, const char* fmt, va_list args);
+
+  LogEmitter emit_ = nullptr;
+  void* callback_ = nullptr;
+  void* env_ = nullptr;
+  std::string name_;
+  bool on_[kLogCategoryCount] = {};
+};
+
+}  // namespace pkm_fmi

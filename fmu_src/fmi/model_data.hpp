@@ -1,0 +1,64 @@
+// The contract between the generic FMI layer and a model (Reference-FMUs'
+// model.h, in C++): the per-instance data the variable table points into,
+// and the hooks the FMI functions call. A model knows nothing of FMI
+// versions; the layer knows nothing of mechanics.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "fmi_status.hpp"
+#include "logger.hpp"
+#include "state_bytes.hpp"
+
+namespace pkm_fmi {
+
+/// What a hook may see of its instance.
+struct Context {
+  Logger& log;
+  Interface interface;
+  bool initialization_mode;  // between Enter- and ExitInitializationMode
+  double start_time;
+};
+
+/// Per-instance data of a model. Start values are written through the
+/// table by the layer; parameters, inputs and input derivatives are saved in
+/// FMU states by the layer too.
+class ModelData {
+ public:
+  virtual ~ModelData() = default;
+  /// After instantiation and reset, once the start values are written:
+  /// forget everything derived (solvers, caches).
+  virtual void reset() = 0;
+  /// ExitInitializationMode: build the model from the parameters and set the
+  /// initial state at ctx.start_time. Error with a logged message if impossible.
+  virtual Status exit_initialization(Context& ctx) = 0;
+  /// Writes every computed variable for the current time, state, parameters
+  /// and inputs. Called lazily, before a get that needs them.
+  virtual Status update_outputs(Context& ctx) = 0;
+  /// The model's state beyond the table's values.
+  virtual void save(StateWriter& w) const = 0;
+  /// Reads what save() wrote, after the table's values were restored; false
+  /// (with a logged message) if the state cannot be used.
+  virtual bool load(StateReader& r, Context& ctx) = 0;
+
+  // ---- Co-Simulation
+  /// From t to t + h (t is the current time). On return t_reached is the last
+  /// time the state is valid for: t + h for OK, the last good point for Discard.
+  virtual Status do_step(Context& ctx, double t, double h, double& t_reached) = 0;
+
+  // ---- Model Exchange (models without states keep the defaults)
+  virtual void set_time(double t) { (void)t; }
+  virtual Status get_states(Context& ctx, double x[]) { (void)ctx, (void)x; return Status::OK; }
+  /// New states from the importer's integrator: Discard (state unchanged,
+  /// reason logged) if they cannot be used.
+  virtual Status set_states(Context& ctx, const double x[]) { (void)ctx, (void)x; return Status::OK; }
+  virtual Status get_derivatives(Context& ctx, double dx[]) { (void)ctx, (void)dx; return Status::OK; }
+  virtual Status get_event_indicators(Context& ctx, double z[]) { (void)ctx, (void)z; return Status::OK; }
+  virtual void get_nominals(double x[]) const { (void)x; }
+  /// Event mode: the discrete reaction to what the indicators located.
+  /// terminate = true asks the importer to stop (with a logged reason).
+  virtual Status event_update(Context& ctx, bool& terminate) { (void)ctx; terminate = false; return Status::OK; }
+};
+
+}  // namespace pkm_fmi

@@ -1,0 +1,265 @@
+#include "model_description.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <set>
+
+#include "logger.hpp"
+
+namespace pkm_fmi {
+namespace {
+
+std::string escape(const char* s) {
+  std::string out;
+  for (; *s; ++s) {
+    switch (*s) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += *s;
+    }
+  }
+  return out;
+}
+
+// SI base-unit exponents of every unit the tables use.
+struct UnitInfo {
+  const char* name;
+  int kg, m, s, rad;
+};
+constexpr UnitInfo kUnits[] = {
+    {"s", 0, 0, 1, 0},      {"m", 0, 1, 0, 0},       {"m/s", 0, 1, -1, 0},   {"m/s2", 0, 1, -2, 0},
+    {"rad", 0, 0, 0, 1},    {"rad/s", 0, 0, -1, 1},  {"rad/s2", 0, 0, -2, 1}, {"kg", 1, 0, 0, 0},
+    {"kg.m2", 1, 2, 0, 0},  {"N", 1, 1, -2, 0},      {"N.m", 1, 2, -2, 0},   {"N.s/m", 1, 0, -1, 0},
+    {"N/m", 1, 0, -2, 0},   {"J", 1, 2, -2, 0},      {"W", 1, 2, -3, 0},
+};
+
+std::string unit_definitions(const ModelDefinition& d) {
+  std::set<std::string> used;
+  for (std::size_t i = 0; i < d.n_variables; ++i)
+    if (*d.variables[i].unit) used.insert(d.variables[i].unit);
+  std::string out = "  <UnitDefinitions>\n";
+  for (const UnitInfo& u : kUnits) {
+    if (!used.count(u.name)) continue;
+    used.erase(u.name);
+    out += "    <Unit name=\"" + std::string(u.name) + "\">\n      <BaseUnit";
+    if (u.kg) out += " kg=\"" + std::to_string(u.kg) + "\"";
+    if (u.m) out += " m=\"" + std::to_string(u.m) + "\"";
+    if (u.s) out += " s=\"" + std::to_string(u.s) + "\"";
+    if (u.rad) out += " rad=\"" + std::to_string(u.rad) + "\"";
+    out += "/>\n    </Unit>\n";
+  }
+  if (!used.empty()) {
+    std::fprintf(stderr, "model description: unit %s has no UnitDefinition (add it to kUnits)\n",
+                 used.begin()->c_str());
+    std::abort();  // a build tool's programming error, never reached in an FMU
+  }
+  return out + "  </UnitDefinitions>\n";
+}
+
+std::string log_categories() {
+  std::string out = "  <LogCategories>\n";
+  for (int c = 0; c < kLogCategoryCount; ++c)
+    out += "    <Category name=\"" + std::string(kLogCategoryNames[c]) + "\" description=\"" +
+           escape(kLogCategoryDescriptions[c]) + "\"/>\n";
+  return out + "  </LogCategories>\n";
+}
+
+std::string default_experiment(const ModelDefinition& d) {
+  return "  <DefaultExperiment startTime=\"0\" stopTime=\"" + exact_text(d.default_stop) + "\" stepSize=\"" +
+         exact_text(d.default_step) + "\"/>\n";
+}
+
+const char* kGenerationTool = "PKM4PUU model-description generator (fmu_src/fmi/model_description.cpp)";
+
+bool is_state(const Variable& v) { return v.state >= 0; }
+
+const Variable* state_variable(const ModelDefinition& d, int k) {
+  for (std::size_t i = 0; i < d.n_variables; ++i)
+    if (d.variables[i].state == k) return &d.variables[i];
+  return nullptr;
+}
+
+// Attributes common to both versions' variable elements.
+std::string variable_attributes(const Variable& v) {
+  std::string a = " name=\"" + escape(v.name) + "\" valueReference=\"" + std::to_string(v.vr) + "\"";
+  if (*v.description) a += " description=\"" + escape(v.description) + "\"";
+  a += " causality=\"" + std::string(xml_name(v.causality)) + "\" variability=\"" + xml_name(v.variability) + "\"";
+  if (v.initial != Initial::None) a += " initial=\"" + std::string(xml_name(v.initial)) + "\"";
+  return a;
+}
+
+// Type attributes (unit, min, max, start, derivative) in the order FMI 3.0 lists them.
+std::string type_attributes(const ModelDefinition& d, const Variable& v, int version,
+                            const std::map<std::uint32_t, int>& index) {
+  std::string a;
+  if (*v.unit) a += " unit=\"" + std::string(v.unit) + "\"";
+  if (v.type == VarType::Integer) {
+    if (std::isfinite(v.min)) a += " min=\"" + std::to_string(static_cast<long long>(v.min)) + "\"";
+    if (std::isfinite(v.max)) a += " max=\"" + std::to_string(static_cast<long long>(v.max)) + "\"";
+  } else {
+    if (std::isfinite(v.min)) a += " min=\"" + exact_text(v.min) + "\"";
+    if (std::isfinite(v.max)) a += " max=\"" + exact_text(v.max) + "\"";
+  }
+  if (v.has_start()) {
+    if (v.type == VarType::Real)
+      a += " start=\"" + exact_text(v.start) + "\"";
+    else if (v.type == VarType::Integer)
+      a += " start=\"" + std::to_string(static_cast<long long>(v.start)) + "\"";
+    else
+      a += std::string(" start=\"") + (v.start != 0.0 ? "true" : "false") + "\"";
+  }
+  if (v.state_of >= 0) {
+    const Variable* x = state_variable(d, v.state_of);
+    a += " derivative=\"" + std::to_string(version == 2 ? index.at(x->vr) : static_cast<int>(x->vr)) + "\"";
+  }
+  return a;
+}
+
+std::string unknown_dependencies(const ModelDefinition& d, const Variable& v, int version,
+                                 const std::map<std::uint32_t, int>& index) {
+  const Dependencies deps = dependencies_of(d, v);
+  std::string list, kinds;
+  for (std::size_t k = 0; k < deps.knowns.size(); ++k) {
+    if (k) {
+      list += ' ';
+      kinds += ' ';
+    }
+    list += std::to_string(version == 2 ? index.at(deps.knowns[k]) : static_cast<int>(deps.knowns[k]));
+    kinds += deps.constant ? "constant" : "dependent";
+  }
+  std::string a = " dependencies=\"" + list + "\"";
+  if (!deps.knowns.empty()) a += " dependenciesKind=\"" + kinds + "\"";
+  return a;
+}
+
+std::string fmi2(const ModelDefinition& d) {
+  std::map<std::uint32_t, int> index;  // value reference -> 1-based ScalarVariable index
+  for (std::size_t i = 0; i < d.n_variables; ++i) index[d.variables[i].vr] = static_cast<int>(i + 1);
+  std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  x += "<fmiModelDescription\n  fmiVersion=\"2.0\"\n  modelName=\"" + std::string(d.identifier) + "\"\n  guid=\"" +
+       d.guid() + "\"\n  description=\"" + escape(d.title) + "\"\n  generationTool=\"" + kGenerationTool +
+       "\"\n  variableNamingConvention=\"structured\"\n  numberOfEventIndicators=\"" +
+       std::to_string(d.n_event_indicators) + "\">\n";
+  x += "  <ModelExchange\n    modelIdentifier=\"" + std::string(d.identifier) +
+       "\"\n    completedIntegratorStepNotNeeded=\"true\"\n    canGetAndSetFMUstate=\"true\"\n"
+       "    canSerializeFMUstate=\"true\"/>\n";
+  x += "  <CoSimulation\n    modelIdentifier=\"" + std::string(d.identifier) +
+       "\"\n    canHandleVariableCommunicationStepSize=\"true\"\n    canInterpolateInputs=\"" +
+       (d.can_interpolate_inputs ? "true" : "false") +
+       "\"\n    maxOutputDerivativeOrder=\"0\"\n    canGetAndSetFMUstate=\"true\"\n    canSerializeFMUstate=\"true\"/>\n";
+  x += unit_definitions(d) + log_categories() + default_experiment(d);
+  x += "  <ModelVariables>\n";
+  for (std::size_t i = 0; i < d.n_variables; ++i) {
+    const Variable& v = d.variables[i];
+    x += "    <!-- index " + std::to_string(i + 1) + " -->\n";
+    x += "    <ScalarVariable" + variable_attributes(v) + ">\n      <" + fmi2_type_name(v.type) +
+         type_attributes(d, v, 2, index) + "/>\n    </ScalarVariable>\n";
+  }
+  x += "  </ModelVariables>\n  <ModelStructure>\n";
+  std::string outputs, derivatives, initial;
+  for (std::size_t i = 0; i < d.n_variables; ++i) {
+    const Variable& v = d.variables[i];
+    const std::string idx = std::to_string(i + 1);
+    if (v.causality == Causality::Output)
+      outputs += "      <Unknown index=\"" + idx + "\"" + unknown_dependencies(d, v, 2, index) + "/>\n";
+    if (v.state_of >= 0)
+      derivatives += "      <Unknown index=\"" + idx + "\"" + unknown_dependencies(d, v, 2, index) + "/>\n";
+    if ((v.causality == Causality::Output && v.initial != Initial::Exact) || v.state_of >= 0 ||
+        (is_state(v) && v.initial != Initial::Exact) || v.causality == Causality::CalculatedParameter)
+      initial += "      <Unknown index=\"" + idx + "\"/>\n";
+  }
+  if (!outputs.empty()) x += "    <Outputs>\n" + outputs + "    </Outputs>\n";
+  if (!derivatives.empty()) x += "    <Derivatives>\n" + derivatives + "    </Derivatives>\n";
+  if (!initial.empty()) x += "    <InitialUnknowns>\n" + initial + "    </InitialUnknowns>\n";
+  x += "  </ModelStructure>\n</fmiModelDescription>\n";
+  return x;
+}
+
+std::string fmi3(const ModelDefinition& d) {
+  const std::map<std::uint32_t, int> none;
+  std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  x += "<fmiModelDescription\n  fmiVersion=\"3.0\"\n  modelName=\"" + std::string(d.identifier) +
+       "\"\n  instantiationToken=\"" + d.guid() + "\"\n  description=\"" + escape(d.title) +
+       "\"\n  generationTool=\"" + kGenerationTool + "\"\n  variableNamingConvention=\"structured\">\n";
+  x += "  <ModelExchange\n    modelIdentifier=\"" + std::string(d.identifier) +
+       "\"\n    canGetAndSetFMUState=\"true\"\n    canSerializeFMUState=\"true\"\n"
+       "    needsCompletedIntegratorStep=\"false\"/>\n";
+  x += "  <CoSimulation\n    modelIdentifier=\"" + std::string(d.identifier) +
+       "\"\n    canGetAndSetFMUState=\"true\"\n    canSerializeFMUState=\"true\"\n"
+       "    canHandleVariableCommunicationStepSize=\"true\"/>\n";
+  x += unit_definitions(d) + log_categories() + default_experiment(d);
+  x += "  <ModelVariables>\n";
+  for (std::size_t i = 0; i < d.n_variables; ++i) {
+    const Variable& v = d.variables[i];
+    x += "    <" + std::string(fmi3_type_name(v.type)) + variable_attributes(v) + type_attributes(d, v, 3, none) +
+         "/>\n";
+  }
+  x += "  </ModelVariables>\n  <ModelStructure>\n";
+  for (std::size_t i = 0; i < d.n_variables; ++i) {
+    const Variable& v = d.variables[i];
+    if (v.causality == Causality::Output)
+      x += "    <Output valueReference=\"" + std::to_string(v.vr) + "\"" + unknown_dependencies(d, v, 3, none) +
+           "/>\n";
+  }
+  for (std::size_t i = 0; i < d.n_variables; ++i) {
+    const Variable& v = d.variables[i];
+    if (v.state_of >= 0)
+      x += "    <ContinuousStateDerivative valueReference=\"" + std::to_string(v.vr) + "\"" +
+           unknown_dependencies(d, v, 3, none) + "/>\n";
+  }
+  for (std::size_t i = 0; i < d.n_variables; ++i) {
+    const Variable& v = d.variables[i];
+    if ((v.causality == Causality::Output && v.initial != Initial::Exact) || v.state_of >= 0 ||
+        v.causality == Causality::CalculatedParameter)
+      x += "    <InitialUnknown valueReference=\"" + std::to_string(v.vr) + "\"/>\n";
+  }
+  for (std::size_t i = 0; i < d.n_variables; ++i) {
+    const Variable& v = d.variables[i];
+    if (v.indicator >= 0) x += "    <EventIndicator valueReference=\"" + std::to_string(v.vr) + "\"/>\n";
+  }
+  x += "  </ModelStructure>\n</fmiModelDescription>\n";
+  return x;
+}
+
+}  // namespace
+
+std::string exact_text(double v) {
+  char buf[40];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  return buf;
+}
+
+Dependencies dependencies_of(const ModelDefinition& d, const Variable& v) {
+  Dependencies deps;
+  const int half = static_cast<int>(d.n_states / 2);
+  if (v.depends & kOnOwnState) {
+    deps.knowns.push_back(v.vr);
+    deps.constant = true;
+    return deps;
+  }
+  for (std::size_t i = 0; i < d.n_variables; ++i) {
+    const Variable& k = d.variables[i];
+    const bool known = k.state >= 0 || k.causality == Causality::Input;
+    if (known && (k.kind & v.depends) != 0) deps.knowns.push_back(k.vr);
+  }
+  // der(position) = rate: each depends on its own rate state only, with factor 1.
+  if (v.state_of >= 0 && v.state_of < half) {
+    deps.knowns.assign(1, state_variable(d, v.state_of + half)->vr);
+    deps.constant = true;
+  }
+  return deps;
+}
+
+std::string model_description_xml(const ModelDefinition& def, int fmi_version) {
+  return fmi_version == 2 ? fmi2(def) : fmi3(def);
+}
+
+}  // namespace pkm_fmi

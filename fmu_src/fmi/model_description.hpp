@@ -1,0 +1,28 @@
+// modelDescription.xml of a model, generated from its variable table: FMI
+// 2.0 (Co-Simulation and Model Exchange in one file) and FMI 3.0. The
+// committed copies under modelDescription/ are these files; a test fails
+// when a regeneration differs.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "variables.hpp"
+
+namespace pkm_fmi {
+
+/// The model description for FMI version 2 or 3.
+std::string model_description_xml(const ModelDefinition& def, int fmi_version);
+
+/// The value references a computed variable depends on (ModelStructure),
+/// in table order, and whether every factor is constant (dependenciesKind).
+struct Dependencies {
+  std::vector<std::uint32_t> knowns;
+  bool constant = false;
+};
+Dependencies dependencies_of(const ModelDefinition& def, const Variable& v);
+
+/// The shortest decimal text that reads back as exactly x.
+std::string exact_text(double x);
+
+}  // namespace pkm_fmi

@@ -1,0 +1,140 @@
+// Model Exchange: the importer integrates the continuous states; the model
+// gives their derivatives and its event indicators.
+#include <cmath>
+
+#include "instance.hpp"
+#include "state_machine.hpp"
+
+namespace pkm_fmi {
+
+Status Instance::enter_event_mode() {
+  const char* fn = PKM_FN(EnterEventMode);
+  if (!allowed(kMaskEnterEventMode, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  mode_ = kEventMode;
+  log_.event("%s at t = %.17g", fn, time_);
+  return Status::OK;
+}
+
+Status Instance::event_update(bool* discrete_states_need_update, bool* terminate, bool* nominals_changed,
+                              bool* values_changed, bool* next_event_time_defined, double* next_event_time) {
+  const char* fn = PKM_FN2(fmi2NewDiscreteStates, fmi3UpdateDiscreteStates);
+  if (!allowed(kMaskEventUpdate, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  Context ctx = context();
+  bool stop = false;
+  const Status s = data_->event_update(ctx, stop);
+  outputs_valid_ = false;
+  if (discrete_states_need_update) *discrete_states_need_update = false;
+  if (terminate) *terminate = stop;
+  if (nominals_changed) *nominals_changed = false;
+  if (values_changed) *values_changed = false;
+  if (next_event_time_defined) *next_event_time_defined = false;
+  if (next_event_time) *next_event_time = 0.0;
+  if (s == Status::Error) mode_ = kError;
+  if (s == Status::Fatal) mode_ = kFatal;
+  return s;
+}
+
+Status Instance::enter_continuous_time_mode() {
+  const char* fn = PKM_FN(EnterContinuousTimeMode);
+  if (!allowed(kMaskEnterContinuousTime, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  mode_ = kContinuousTimeMode;
+  return Status::OK;
+}
+
+Status Instance::completed_integrator_step(bool* enter_event_mode, bool* terminate) {
+  const char* fn = PKM_FN(CompletedIntegratorStep);
+  if (!allowed(kMaskCompletedStep, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  if (enter_event_mode) *enter_event_mode = false;  // no step events: the indicators locate every event
+  if (terminate) *terminate = false;
+  return Status::OK;
+}
+
+Status Instance::set_time(double t) {
+  const char* fn = PKM_FN(SetTime);
+  if (!allowed(kMaskSetTime, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  if (!std::isfinite(t)) {
+    log_.error("%s: time = %g is not finite; the call has no effect", fn, t);
+    return Status::Error;
+  }
+  time_ = t;
+  data_->set_time(t);
+  outputs_valid_ = false;
+  return Status::OK;
+}
+
+namespace {
+bool right_count(Logger& log, const char* fn, const char* what, std::size_t given, std::size_t expected,
+                 const void* array) {
+  if (given != expected) {
+    log.error("%s: %llu %s given, this FMU has %llu; the call has no effect", fn,
+              static_cast<unsigned long long>(given), what, static_cast<unsigned long long>(expected));
+    return false;
+  }
+  if (!array && given > 0) {
+    log.error("%s: NULL array", fn);
+    return false;
+  }
+  return true;
+}
+}  // namespace
+
+Status Instance::set_continuous_states(const double x[], std::size_t n) {
+  const char* fn = PKM_FN(SetContinuousStates);
+  if (!allowed(kMaskSetStates, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  if (!right_count(log_, fn, "states", n, def_.n_states, x)) return Status::Error;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!std::isfinite(x[k])) {
+      log_.error("%s: state %llu = %g is not finite; the states are unchanged", fn, static_cast<unsigned long long>(k),
+                 x[k]);
+      return Status::Error;
+    }
+  }
+  Context ctx = context();
+  const Status s = data_->set_states(ctx, x);
+  outputs_valid_ = false;
+  return s;
+}
+
+Status Instance::get_continuous_states(double x[], std::size_t n) {
+  const char* fn = PKM_FN(GetContinuousStates);
+  if (!allowed(kMaskGetStates, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  if (!right_count(log_, fn, "states", n, def_.n_states, x)) return Status::Error;
+  Context ctx = context();
+  return data_->get_states(ctx, x);
+}
+
+Status Instance::get_derivatives(double dx[], std::size_t n) {
+  const char* fn = PKM_FN2(fmi2GetDerivatives, fmi3GetContinuousStateDerivatives);
+  if (!allowed(kMaskGetStates, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  if (!right_count(log_, fn, "derivatives", n, def_.n_states, dx)) return Status::Error;
+  Context ctx = context();
+  return data_->get_derivatives(ctx, dx);
+}
+
+Status Instance::get_event_indicators(double z[], std::size_t n) {
+  const char* fn = PKM_FN(GetEventIndicators);
+  if (!allowed(kMaskGetStates, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  if (!right_count(log_, fn, "event indicators", n, def_.n_event_indicators, z)) return Status::Error;
+  Context ctx = context();
+  return data_->get_event_indicators(ctx, z);
+}
+
+Status Instance::get_nominals(double x[], std::size_t n) {
+  const char* fn = PKM_FN2(fmi2GetNominalsOfContinuousStates, fmi3GetNominalsOfContinuousStates);
+  if (!allowed(kMaskGetStates | kInstantiated, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  if (!right_count(log_, fn, "nominals", n, def_.n_states, x)) return Status::Error;
+  data_->get_nominals(x);
+  return Status::OK;
+}
+
+Status Instance::get_number_of(const char* what, std::size_t count, std::size_t* n) {
+  if (!allowed(kAlive, what)) return Status::Error;
+  if (!n) {
+    log_.error("%s: NULL argument", what);
+    return Status::Error;
+  }
+  *n = count;
+  return Status::OK;
+}
+
+}  // namespace pkm_fmi

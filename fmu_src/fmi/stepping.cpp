@@ -1,0 +1,154 @@
+// Co-Simulation: communication steps, input interpolation, step status.
+#include <algorithm>
+#include <cmath>
+
+#include "instance.hpp"
+#include "state_machine.hpp"
+
+namespace pkm_fmi {
+
+Status Instance::set_real_input_derivatives(const std::uint32_t vr[], std::size_t n, const std::int32_t order[],
+                                            const double value[]) {
+  static const char* const fn = "fmi2SetRealInputDerivatives";
+  if (!allowed(kMaskInputDerivatives, fn) || !require(Interface::CoSimulation, fn)) return Status::Error;
+  if (!def_.can_interpolate_inputs) {
+    log_.error("%s: %s does not interpolate inputs (canInterpolateInputs = false)", fn, def_.identifier);
+    return Status::Error;
+  }
+  if (n == 0) return Status::OK;
+  if (!vr || !order || !value) {
+    log_.error("%s: NULL argument", fn);
+    return Status::Error;
+  }
+  bool higher = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Variable* v = lookup(fn, VarType::Real, vr[k]);
+    if (!v) return Status::Error;
+    if (!v->derivative) {
+      log_.error("%s: %s is not a continuous Real input", fn, v->name);
+      return Status::Error;
+    }
+    if (order[k] < 1) {
+      log_.error("%s: derivative order %d of %s must be at least 1", fn, static_cast<int>(order[k]), v->name);
+      return Status::Error;
+    }
+    if (!std::isfinite(value[k])) {
+      log_.error("%s: derivative of %s = %g is not finite; rejected", fn, v->name, value[k]);
+      return Status::Error;
+    }
+    higher = higher || order[k] > 1;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    if (order[k] != 1) continue;
+    const Variable* v = def_.find(vr[k]);
+    *static_cast<double*>(v->derivative(*data_, v->index)) = value[k];
+    input_derivatives_set_ = true;
+    if (log_.enabled(LogCategory::Calls)) log_.call("%s: d%s/dt = %.17g", fn, v->name, value[k]);
+  }
+  if (higher) {
+    log_.warning("%s: derivatives of order 2 and higher ignored (inputs are interpolated linearly)", fn);
+    return Status::Warning;
+  }
+  return Status::OK;
+}
+
+Status Instance::get_real_output_derivatives(const char* function) {
+  if (!allowed(kMaskOutputDerivatives, function)) return Status::Error;
+  log_.error("%s: not provided (maxOutputDerivativeOrder = 0)", function);
+  return Status::Error;
+}
+
+Status Instance::do_step(double t, double h, bool* terminate, double* last_successful) {
+  const char* fn = PKM_FN(DoStep);
+  if (!allowed(kMaskDoStep, fn) || !require(Interface::CoSimulation, fn)) return Status::Error;
+  if (log_.enabled(LogCategory::Calls)) log_.call("%s(%.17g, %.17g)", fn, t, h);
+  if (!std::isfinite(h) || !(h > 0.0)) {
+    log_.error("%s: communicationStepSize = %g must be positive and finite; the call has no effect", fn, h);
+    return Status::Error;
+  }
+  const double tolerance = 1e-9 * std::max(1.0, std::abs(time_));
+  if (!std::isfinite(t) || std::abs(t - time_) > tolerance) {
+    log_.error("%s: currentCommunicationPoint = %.17g differs from the FMU's time %.17g; the call has no effect",
+               fn, t, time_);
+    return Status::Error;
+  }
+  if (!std::isfinite(t + h)) {
+    log_.error("%s: currentCommunicationPoint + communicationStepSize = %g is not finite; the call has no effect",
+               fn, t + h);
+    return Status::Error;
+  }
+  // Inputs interpolated with their derivatives must stay finite over the step
+  // (only once a derivative was ever set: the loop is not free).
+  for (std::size_t i = 0; input_derivatives_set_ && i < def_.n_variables; ++i) {
+    const Variable& v = def_.variables[i];
+    if (!v.derivative) continue;
+    const double u = *static_cast<double*>(v.value(*data_, v.index));
+    const double du = *static_cast<double*>(v.derivative(*data_, v.index));
+    if (!std::isfinite(u + du * h)) {
+      log_.error("%s: input %s extrapolated with its derivative %g to t = %.17g is not finite; the call has no "
+                 "effect",
+                 fn, v.name, du, t + h);
+      return Status::Error;
+    }
+  }
+  // Computing past a defined stopTime is an error (fmi2SetupExperiment, fmi3EnterInitializationMode).
+  if (stop_time_defined_ && t + h > stop_time_ + 1e-9 * std::max(1.0, std::abs(stop_time_))) {
+    log_.error("%s: the step to t = %.17g would pass stopTime = %.17g; the call has no effect", fn, t + h,
+               stop_time_);
+    return Status::Error;
+  }
+  Context ctx = context();
+  double reached = time_;
+  const Status s = data_->do_step(ctx, t, h, reached);
+  outputs_valid_ = false;
+  switch (s) {
+    case Status::OK:
+    case Status::Warning:
+      time_ = last_successful_time_ = t + h;
+      break;
+    case Status::Discard:
+      time_ = last_successful_time_ = reached;
+      terminated_ = true;
+      mode_ = kStepFailed;
+      break;
+    case Status::Fatal:
+      mode_ = kFatal;
+      break;
+    case Status::Error:
+      last_successful_time_ = reached;
+      mode_ = kError;
+      break;
+  }
+  if (terminate) *terminate = terminated_;
+  if (last_successful) *last_successful = last_successful_time_;
+  return s;
+}
+
+Status Instance::last_successful_time(double* t) {
+  const char* fn = "fmi2GetRealStatus";
+  if (!allowed(kMaskStatus, fn)) return Status::Error;
+  if (!t) {
+    log_.error("%s: value is NULL", fn);
+    return Status::Error;
+  }
+  *t = last_successful_time_;
+  return Status::OK;
+}
+
+Status Instance::terminated(bool* t) {
+  const char* fn = "fmi2GetBooleanStatus";
+  if (!allowed(kMaskStatus, fn)) return Status::Error;
+  if (!t) {
+    log_.error("%s: value is NULL", fn);
+    return Status::Error;
+  }
+  *t = terminated_;
+  return Status::OK;
+}
+
+Status Instance::not_pending(const char* function) {
+  if (!allowed(kMaskStatus, function)) return Status::Error;
+  return Status::Discard;  // fmi2DoStep is synchronous: no status of a pending step
+}
+
+}  // namespace pkm_fmi

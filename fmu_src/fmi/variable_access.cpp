@@ -1,0 +1,138 @@
+// Get and set through the variable table.
+#include <cmath>
+#include <type_traits>
+
+#include "instance.hpp"
+#include "state_machine.hpp"
+
+namespace pkm_fmi {
+
+const Variable* Instance::lookup(const char* function, VarType type, std::uint32_t vr) {
+  const Variable* v = def_.find(vr);
+  if (!v || v->type != type || (!v->value && v->causality != Causality::Independent)) {
+    log_.error("%s: unknown value reference %u (no %s variable has it)", function, static_cast<unsigned>(vr),
+               version_ == 2 ? fmi2_type_name(type) : fmi3_type_name(type));
+    return nullptr;
+  }
+  return v;
+}
+
+Status Instance::ensure_outputs(const char* function) {
+  if (outputs_valid_) return Status::OK;
+  Context ctx = context();
+  const Status s = data_->update_outputs(ctx);
+  if (succeeded(s)) {
+    outputs_valid_ = true;
+  } else {
+    log_.call("%s: outputs not available", function);
+  }
+  return s;
+}
+
+template <class T>
+Status Instance::get_values(const char* function, VarType type, const std::uint32_t vr[], std::size_t n,
+                            T value[]) {
+  if (!allowed(kMaskGet, function)) return Status::Error;
+  if (n == 0) return Status::OK;
+  if (!vr || !value) {
+    log_.error("%s: NULL value reference or value array", function);
+    return Status::Error;
+  }
+  bool computed = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Variable* v = lookup(function, type, vr[k]);
+    if (!v) return Status::Error;
+    computed = computed || v->computed();
+  }
+  Status s = Status::OK;
+  if (computed) {
+    s = ensure_outputs(function);
+    if (!succeeded(s)) return s;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    const Variable* v = def_.find(vr[k]);
+    value[k] = v->causality == Causality::Independent ? static_cast<T>(time_) : *static_cast<T*>(v->value(*data_, v->index));
+  }
+  return s;
+}
+
+template <class T>
+Status Instance::set_values(const char* function, VarType type, const std::uint32_t vr[], std::size_t n,
+                            const T value[]) {
+  if (!allowed(kMaskSet, function)) return Status::Error;
+  if (n == 0) return Status::OK;
+  if (!vr || !value) {
+    log_.error("%s: NULL value reference or value array", function);
+    return Status::Error;
+  }
+  // Check everything first: a rejected call changes nothing.
+  for (std::size_t k = 0; k < n; ++k) {
+    const Variable* v = lookup(function, type, vr[k]);
+    if (!v) return Status::Error;
+    if (!v->stored_in_state() || v->variability == Variability::Constant || !v->value) {
+      log_.error("%s: %s (value reference %u) is a %s %s variable and cannot be set", function, v->name,
+                 static_cast<unsigned>(v->vr), xml_name(v->variability), xml_name(v->causality));
+      return Status::Error;
+    }
+    if (v->causality == Causality::Parameter && v->variability == Variability::Fixed &&
+        !(mode_ & (kInstantiated | kInitializationMode))) {
+      log_.error("%s: %s is a fixed parameter: it can only be set before %s", function, v->name,
+                 PKM_FN(ExitInitializationMode));
+      return Status::Error;
+    }
+    const double x = static_cast<double>(value[k]);
+    if (std::is_floating_point<T>::value && !std::isfinite(x)) {
+      log_.error("%s: %s = %g is not finite; value rejected", function, v->name, x);
+      return Status::Error;
+    }
+    if (!(x >= v->min && x <= v->max)) {
+      log_.error("%s: %s = %.17g lies outside its range [%.17g, %.17g]%s%s; value rejected", function, v->name, x,
+                 v->min, v->max, *v->unit ? " " : "", v->unit);
+      return Status::Error;
+    }
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    const Variable* v = def_.find(vr[k]);
+    void* p = v->value(*data_, v->index);
+    if (type == VarType::Boolean) {
+      *static_cast<T*>(p) = value[k] != 0 ? 1 : 0;
+    } else {
+      *static_cast<T*>(p) = value[k];
+    }
+    // A derivative refers to the value it was given with.
+    if (v->derivative) *static_cast<double*>(v->derivative(*data_, v->index)) = 0.0;
+    if (log_.enabled(LogCategory::Calls)) log_.call("%s: %s = %.17g", function, v->name, static_cast<double>(value[k]));
+  }
+  outputs_valid_ = false;
+  return Status::OK;
+}
+
+Status Instance::get_real(const std::uint32_t vr[], std::size_t n, double value[]) {
+  return get_values(PKM_FN2(fmi2GetReal, fmi3GetFloat64), VarType::Real, vr, n, value);
+}
+Status Instance::get_integer(const std::uint32_t vr[], std::size_t n, std::int32_t value[]) {
+  return get_values(PKM_FN2(fmi2GetInteger, fmi3GetInt32), VarType::Integer, vr, n, value);
+}
+Status Instance::get_boolean(const std::uint32_t vr[], std::size_t n, int value[]) {
+  return get_values(PKM_FN(GetBoolean), VarType::Boolean, vr, n, value);
+}
+Status Instance::set_real(const std::uint32_t vr[], std::size_t n, const double value[]) {
+  return set_values(PKM_FN2(fmi2SetReal, fmi3SetFloat64), VarType::Real, vr, n, value);
+}
+Status Instance::set_integer(const std::uint32_t vr[], std::size_t n, const std::int32_t value[]) {
+  return set_values(PKM_FN2(fmi2SetInteger, fmi3SetInt32), VarType::Integer, vr, n, value);
+}
+Status Instance::set_boolean(const std::uint32_t vr[], std::size_t n, const int value[]) {
+  return set_values(PKM_FN(SetBoolean), VarType::Boolean, vr, n, value);
+}
+
+Status Instance::no_variables_of_type(const char* function, const char* type, const std::uint32_t vr[],
+                                      std::size_t n, bool setter) {
+  if (!allowed(setter ? kMaskSet : kMaskGet, function)) return Status::Error;
+  if (n == 0) return Status::OK;
+  log_.error("%s: unknown value reference %u (this FMU has no %s variables)", function,
+             vr ? static_cast<unsigned>(vr[0]) : 0u, type);
+  return Status::Error;
+}
+
+}  // namespace pkm_fmi

@@ -1,0 +1,176 @@
+// One model's interface as a table: every variable of modelDescription.xml
+// (FMI 2.0 and 3.0 are generated from it, model_description.cpp), how to
+// reach its value in an instance's data, and what it depends on
+// (ModelStructure). A ModelDefinition bundles the table with the model's
+// identity and capabilities.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+
+namespace pkm_fmi {
+
+class ModelData;
+
+enum class VarType : std::uint8_t { Real, Integer, Boolean };
+enum class Causality : std::uint8_t { Parameter, CalculatedParameter, Input, Output, Local, Independent };
+enum class Variability : std::uint8_t { Constant, Fixed, Tunable, Discrete, Continuous };
+enum class Initial : std::uint8_t { None, Exact, Approx, Calculated };
+
+/// The modelDescription.xml spelling ("parameter", "fixed", "exact"; "" for Initial::None).
+const char* xml_name(Causality c);
+const char* xml_name(Variability v);
+const char* xml_name(Initial i);
+/// FMI 2.0 element names ("Real", "Integer", "Boolean").
+const char* fmi2_type_name(VarType t);
+/// FMI 3.0 element names ("Float64", "Int32", "Boolean").
+const char* fmi3_type_name(VarType t);
+
+/// Where a variable lives in an instance's data: returns a pointer to a
+/// double (Real), std::int32_t (Integer) or int (Boolean, 0 or 1). `index` is the
+/// variable's element index (arrays), 0 for scalars.
+using Ref = void* (*)(ModelData& data, int index);
+
+/// What a computed variable depends on, for ModelStructure (bit set), and
+/// for an input what kind of known it is. The continuous states split into
+/// a position half (pose) and a rate half (velocity); inputs are position-,
+/// rate- or force-like (kOnInputs). A computed variable depends on every
+/// state and input whose kind it names.
+enum Depends : std::uint8_t {
+  kDependsNothing = 0,
+  kOnPositions = 1u << 0,  // position states and pose inputs
+  kOnRates = 1u << 1,      // rate states and velocity inputs
+  kOnInputs = 1u << 2,     // force-like inputs (forces, wrenches, accelerations)
+  kOnOwnState = 1u << 3,   // outputs that are a state: that state only
+  kOnHeight = 1u << 4,     // the vertical position (state or input): the machine is otherwise invariant to it
+  kOnHeightRate = 1u << 5, // its rate: only the slider velocities follow it
+};
+
+/// One row of a model's variable table: everything modelDescription.xml
+/// says about a variable, plus how to reach its value.
+struct Variable {
+  std::uint32_t vr;
+  const char* name;
+  VarType type;
+  Causality causality;
+  Variability variability;
+  Initial initial;  // Initial::None: attribute absent (inputs, independent)
+  double start;     // meaningful iff has_start()
+  const char* unit;  // "" = no unit attribute
+  const char* description;
+  Ref value;
+  int index;
+  Ref derivative;   // first derivative of a continuous Real input (CS input interpolation), nullptr if none
+  double min;       // -inf = no min attribute
+  double max;       // +inf = no max attribute
+  std::uint8_t depends;  // Depends bits (outputs, locals)
+  int state_of;     // der(x) rows: index of the state x in the model's states; -1 otherwise
+  int state;        // rows that are continuous states: their index in the states; -1 otherwise
+  int indicator = -1;  // rows that are event indicators (Model Exchange): their index; -1 otherwise
+  std::uint8_t kind = kDependsNothing;  // inputs and states: which Depends bit names them
+
+  constexpr bool has_start() const {
+    return causality == Causality::Input || initial == Initial::Exact || initial == Initial::Approx;
+  }
+  /// Values the model computes (read through ModelData::update_outputs).
+  constexpr bool computed() const {
+    return causality == Causality::Output || causality == Causality::Local ||
+           causality == Causality::CalculatedParameter;
+  }
+  /// Values an FMU state carries (the rest is recomputed).
+  constexpr bool stored_in_state() const {
+    return causality == Causality::Parameter || causality == Causality::Input;
+  }
+};
+
+constexpr double kNoMin = -std::numeric_limits<double>::infinity();
+constexpr double kNoMax = std::numeric_limits<double>::infinity();
+
+/// Table rows of the usual kinds.
+/// A continuous Real input; `kind` says what it is for ModelStructure
+/// (kOnInputs: a force-like input; kOnPositions, kOnRates: a pose or velocity).
+constexpr Variable real_input(std::uint32_t vr, const char* name, double start, const char* unit,
+                              const char* description, Ref value, int index, Ref derivative,
+                              std::uint8_t kind = kOnInputs) {
+  return {vr,    name,  VarType::Real, Causality::Input, Variability::Continuous, Initial::None, start, unit,
+          description, value, index, derivative, kNoMin, kNoMax, kDependsNothing, -1, -1, -1, kind};
+}
+/// A continuous Real output computed by the model (initial calculated, no start).
+constexpr Variable real_output(std::uint32_t vr, const char* name, const char* unit, const char* description,
+                               Ref value, int index, std::uint8_t depends) {
+  return {vr,    name,  VarType::Real, Causality::Output, Variability::Continuous, Initial::Calculated, 0.0, unit,
+          description, value, index, nullptr, kNoMin, kNoMax, depends, -1, -1};
+}
+/// A Real output that is continuous state number `state` (pose, velocity)
+/// of the given kind (kOnPositions, kOnHeight or kOnRates).
+constexpr Variable state_output(std::uint32_t vr, const char* name, const char* unit, const char* description,
+                                Ref value, int index, int state, std::uint8_t kind) {
+  return {vr,    name,  VarType::Real, Causality::Output, Variability::Continuous, Initial::Calculated, 0.0, unit,
+          description, value, index, nullptr, kNoMin, kNoMax, kOnOwnState, -1, state, -1, kind};
+}
+/// der(x) of continuous state number `state_of` (a local variable).
+constexpr Variable state_derivative(std::uint32_t vr, const char* name, const char* unit, const char* description,
+                                    Ref value, int index, int state_of, std::uint8_t depends) {
+  return {vr,    name,  VarType::Real, Causality::Local, Variability::Continuous, Initial::Calculated, 0.0, unit,
+          description, value, index, nullptr, kNoMin, kNoMax, depends, state_of, -1};
+}
+/// Event indicator number `k` (a local variable, Model Exchange).
+constexpr Variable event_indicator(std::uint32_t vr, const char* name, const char* unit, const char* description,
+                                   Ref value, int index, int k, std::uint8_t depends) {
+  return {vr,    name,  VarType::Real, Causality::Local, Variability::Continuous, Initial::Calculated, 0.0, unit,
+          description, value, index, nullptr, kNoMin, kNoMax, depends, -1, -1, k};
+}
+/// A fixed Real parameter (initial exact): settable before initialisation ends; [min, max] checked.
+constexpr Variable real_parameter(std::uint32_t vr, const char* name, double start, const char* unit,
+                                  const char* description, Ref value, int index, double min = kNoMin,
+                                  double max = kNoMax) {
+  return {vr,    name,  VarType::Real, Causality::Parameter, Variability::Fixed, Initial::Exact, start, unit,
+          description, value, index, nullptr, min, max, kDependsNothing, -1, -1};
+}
+/// A fixed Integer parameter (initial exact) with its range.
+constexpr Variable integer_parameter(std::uint32_t vr, const char* name, int start, const char* description,
+                                     Ref value, int min, int max) {
+  return {vr,    name,  VarType::Integer, Causality::Parameter, Variability::Fixed, Initial::Exact,
+          static_cast<double>(start), "", description, value, 0, nullptr, static_cast<double>(min),
+          static_cast<double>(max), kDependsNothing, -1, -1};
+}
+/// The independent variable (time).
+constexpr Variable time_variable(std::uint32_t vr) {
+  return {vr,      "time",  VarType::Real, Causality::Independent, Variability::Continuous, Initial::None, 0.0, "s",
+          "Simulation time", nullptr, 0, nullptr, kNoMin, kNoMax, kDependsNothing, -1, -1};
+}
+
+/// Everything immutable about one FMU, shared by all its instances.
+struct ModelDefinition {
+  const char* identifier;     // modelIdentifier (= modelName)
+  const char* title;          // one line: the modelDescription's description
+  const char* summary;        // a paragraph of HTML, for the documentation
+  const Variable* variables;  // sorted by value reference, unique
+  std::size_t n_variables;
+  std::size_t n_states;            // continuous states (Model Exchange)
+  std::size_t n_event_indicators;  // Model Exchange
+  bool can_interpolate_inputs;     // FMI 2.0 CS: fmi2SetRealInputDerivatives
+  double default_step;             // DefaultExperiment stepSize
+  double default_stop;             // DefaultExperiment stopTime
+  std::unique_ptr<ModelData> (*create)();
+
+  /// The variable with this value reference, nullptr if none.
+  const Variable* find(std::uint32_t vr) const;
+  const Variable* find(const char* name) const;
+  /// The instantiation token (FMI 3.0) = GUID (FMI 2.0): a hash of the
+  /// table, so that it changes whenever the interface does. Computed on each
+  /// call (the definition holds nothing mutable; instances keep a copy).
+  std::string guid() const;
+};
+
+/// True if the table is sorted by strictly increasing value reference.
+constexpr bool sorted_by_vr(const Variable* v, std::size_t n) {
+  for (std::size_t i = 1; i < n; ++i)
+    if (!(v[i - 1].vr < v[i].vr)) return false;
+  return true;
+}
+
+}  // namespace pkm_fmi
