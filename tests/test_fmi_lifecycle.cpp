@@ -108,12 +108,19 @@ TEST_F(Fmi2, InstantiateChecksGuidAndType) {
   Log log;
   const fmi2CallbackFunctions f{&pkm_test::collect_log, &std::calloc, &std::free, nullptr, &log};
   EXPECT_EQ(lib.fmi2Instantiate("x", fmi2CoSimulation, "{not-the-guid}", "", &f, fmi2False, fmi2False), nullptr);
-  EXPECT_EQ(lib.fmi2Instantiate("x", fmi2ModelExchange, PKM_FMU_PLANT_GUID, "", &f, fmi2False, fmi2False), nullptr);
+  EXPECT_EQ(lib.fmi2Instantiate("x", static_cast<fmi2Type>(7), PKM_FMU_PLANT_GUID, "", &f, fmi2False, fmi2False),
+            nullptr);
   EXPECT_EQ(lib.fmi2Instantiate("x", fmi2CoSimulation, PKM_FMU_INVERSE_GUID, "", &f, fmi2False, fmi2False), nullptr);
   ASSERT_EQ(log.messages.size(), 3u);
   for (const auto& m : log.messages) EXPECT_EQ(m.status, fmi2Error);
   EXPECT_TRUE(log.contains("GUID"));
-  EXPECT_TRUE(log.contains("co-simulation"));
+  EXPECT_TRUE(log.contains("fmuType = 7"));
+  // Both interfaces of the one binary.
+  for (fmi2Type type : {fmi2ModelExchange, fmi2CoSimulation}) {
+    fmi2Component c = lib.fmi2Instantiate("x", type, PKM_FMU_PLANT_GUID, "", &f, fmi2False, fmi2False);
+    EXPECT_NE(c, nullptr) << log.dump();
+    lib.fmi2FreeInstance(c);
+  }
 }
 
 TEST_F(Fmi2, HoldsTheHomePoseWithTheStaticForces) {
@@ -244,7 +251,11 @@ TEST_F(Fmi2, UnknownValueReferencesAreErrors) {
 TEST_F(Fmi2, InvalidParametersAndUnreachablePosesFailInitialisation) {
   {
     Plant p;
-    ASSERT_EQ(p.set("r_b", -1.0), fmi2OK);
+    // Outside the modelDescription's range: refused when set, the start value kept.
+    EXPECT_EQ(p.set("r_b", -1.0), fmi2Error);
+    EXPECT_TRUE(p.log.contains("r_b = -1 lies outside its range [0, inf] m")) << p.log.dump();
+    // Within the range but not usable (r_b must be positive): refused at initialisation.
+    ASSERT_EQ(p.set("r_b", 0.0), fmi2OK);
     ASSERT_EQ(lib.fmi2EnterInitializationMode(p.c), fmi2OK);
     EXPECT_EQ(lib.fmi2ExitInitializationMode(p.c), fmi2Error);
     EXPECT_TRUE(p.log.contains("r_b")) << p.log.dump();
@@ -261,10 +272,8 @@ TEST_F(Fmi2, InvalidParametersAndUnreachablePosesFailInitialisation) {
   }
   {
     Plant p;
-    ASSERT_EQ(p.set_int("formulation", 7), fmi2OK);
-    ASSERT_EQ(lib.fmi2EnterInitializationMode(p.c), fmi2OK);
-    EXPECT_EQ(lib.fmi2ExitInitializationMode(p.c), fmi2Error);
-    EXPECT_TRUE(p.log.contains("formulation")) << p.log.dump();
+    EXPECT_EQ(p.set_int("formulation", 7), fmi2Error);  // outside [0, 2]: refused when set
+    EXPECT_TRUE(p.log.contains("formulation = 7 lies outside its range [0, 2]")) << p.log.dump();
   }
   {
     Plant p;
@@ -565,15 +574,28 @@ TEST_F(Fmi2, DebugLoggingIsFilteredByCategory) {
   const fmi2String bogus[] = {"logNothing"};
   EXPECT_EQ(lib.fmi2SetDebugLogging(p.c, fmi2True, 1, bogus), fmi2Error);
   EXPECT_EQ(p.log.messages.back().category, "logStatusError");
-  // Everything off: not even errors.
+  // Logging off, no category named: as loggingOn = false at instantiation,
+  // the reasons of a status other than OK still come, events do not.
   ASSERT_EQ(lib.fmi2SetDebugLogging(p.c, fmi2False, 0, nullptr), fmi2OK);
   const std::size_t n = p.log.messages.size();
   EXPECT_EQ(lib.fmi2DoStep(p.c, 0.0, 1e-3, fmi2True), fmi2Error);
-  EXPECT_EQ(p.log.messages.size(), n);
-  // logAll: every call.
+  ASSERT_EQ(p.log.messages.size(), n + 1);
+  EXPECT_EQ(p.log.messages.back().category, "logStatusError");
+  // Only the named category switches: logStatusError off silences errors.
+  const fmi2String errors[] = {"logStatusError"};
+  ASSERT_EQ(lib.fmi2SetDebugLogging(p.c, fmi2False, 1, errors), fmi2OK);
+  EXPECT_EQ(lib.fmi2DoStep(p.c, 0.0, 1e-3, fmi2True), fmi2Error);
+  EXPECT_EQ(p.log.messages.size(), n + 1);
+  // Logging on, no category named: events (mode changes), but no call trace.
   Plant q(/*logging_on=*/true);
   q.initialize();
   EXPECT_TRUE(q.log.contains("fmi2ExitInitializationMode")) << q.log.dump();
+  for (const auto& m : q.log.messages) EXPECT_NE(m.category, "logCalls") << q.log.dump();
+  // logCalls, named: every call.
+  const fmi2String calls[] = {"logCalls"};
+  ASSERT_EQ(lib.fmi2SetDebugLogging(q.c, fmi2True, 1, calls), fmi2OK);
+  ASSERT_EQ(lib.fmi2DoStep(q.c, 0.0, 1e-3, fmi2True), fmi2OK);
+  EXPECT_EQ(q.log.messages.back().category, "logCalls");
 }
 
 TEST_F(Fmi2, NothingIsWrittenToStdoutOrStderr) {
@@ -704,20 +726,22 @@ TEST(FmuBinaries, NeedOnlyTheSystemRuntime) {
   }
 }
 
-TEST(FmuBinaries, ExportOnlyTheFmi2Functions) {
+TEST(FmuBinaries, ExportExactlyTheListedFmiFunctions) {
+  std::set<std::string> listed;
+#define PKM_TEST_NAME(name) listed.insert(#name);
+  PKM_FMI2_FUNCTIONS(PKM_TEST_NAME)
+  PKM_FMI3_FUNCTIONS(PKM_TEST_NAME)
+#undef PKM_TEST_NAME
   for (const char* so : {PKM_FMU_PLANT_SO, PKM_FMU_INVERSE_SO}) {
     int status = 0;
     const std::string out = capture(std::string("nm -D --defined-only '") + so + "' 2>&1", &status);
     if (status != 0) GTEST_SKIP() << "nm not available: " << out;
     std::istringstream lines(out);
     std::string line;
-    int n = 0;
-    while (std::getline(lines, line)) {
-      const std::string symbol = line.substr(line.rfind(' ') + 1);
-      EXPECT_EQ(symbol.rfind("fmi2", 0), 0u) << so << " exports " << symbol;
-      ++n;
-    }
-    EXPECT_EQ(n, 34) << out;  // the common and co-simulation functions of FMI 2.0
+    std::set<std::string> exported;
+    while (std::getline(lines, line)) exported.insert(line.substr(line.rfind(' ') + 1));
+    EXPECT_EQ(exported, listed) << so;  // fmu_src/fmi/fmi_functions.h: 44 of FMI 2.0, 75 of FMI 3.0
+    EXPECT_EQ(exported.size(), 119u);
   }
 }
 

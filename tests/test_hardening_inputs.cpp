@@ -203,9 +203,25 @@ TEST(HardeningParameters, OutOfRangeParametersFailInitialisationAndResetRecovers
       {"formulation", 3, "formulation = 3 must be 0", true},
       {"formulation", -2, "formulation = -2 must be 0", true},
   };
+  int refused_when_set = 0;
   for (const BadParameter& c : cases) {
     SCOPED_TRACE(std::string(c.name) + " = " + text(c.value));
     PlantFmu p;
+    // Outside the modelDescription's [min, max] (the table's): refused when
+    // set, with the range in the message, and the start value kept.
+    const pkm_fmi::Variable* v = p.def.find(c.name);
+    ASSERT_NE(v, nullptr);
+    if (!(c.value >= v->min && c.value <= v->max)) {
+      ++refused_when_set;
+      EXPECT_EQ(c.integer ? p.set_int(c.name, static_cast<int>(c.value)) : p.set(c.name, c.value), fmi2Error);
+      EXPECT_TRUE(p.log.last().find(std::string(c.name) + " = ") != std::string::npos &&
+                  p.log.last().find("lies outside its range") != std::string::npos)
+          << p.log.dump();
+      p.initialize();
+      if (!c.integer) EXPECT_EQ(p.get(c.name), v->start);
+      ASSERT_EQ(p.step(0.0, 1e-3), fmi2OK) << p.log.dump();
+      continue;
+    }
     if (c.integer) {
       ASSERT_EQ(p.set_int(c.name, static_cast<int>(c.value)), fmi2OK);
     } else {
@@ -228,10 +244,13 @@ TEST(HardeningParameters, OutOfRangeParametersFailInitialisationAndResetRecovers
     EXPECT_EQ(canary, 12345.0);
     expect_usable_after_reset(p);
   }
+  EXPECT_GT(refused_when_set, 10);
   table_row("out-of-range parameter before initialisation: each of h, l, h_prime, r_b, r_Q, m_slider, m_rod, "
             "m_platform, Izz_platform, I_rod[1..3] = 0 or < 0; I_rod violating the triangle inequality; rk4_step, "
             "atol <= 0; rtol outside (0, 1); max_jacobian_condition <= 1; min_leg_measure outside [0, 0.5); "
             "solver, cvode_method, formulation out of range (" + std::to_string(std::size(cases)) + " cases)",
+            "outside the modelDescription's min/max: fmi2SetReal/SetInteger fmi2Error \"<name> = <value> lies outside "
+            "its range [min, max]\", start value kept; within it but invalid (e.g. 0 where positive is required): "
             "fmi2GetReal in initialisation mode and fmi2ExitInitializationMode: fmi2Error, \"parameter <name> = "
             "<value> must ...\"; then Error state (fmi2DoStep, fmi2GetReal: fmi2Error, nothing written)",
             "nothing to lose yet; fmi2Reset, then default parameters initialise and step");
