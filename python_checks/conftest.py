@@ -49,3 +49,15 @@ def results_dir() -> Path:
 def pkm_library() -> Path:
     """fmu_src/libpkm.so, the plain C API (pkm.h)."""
     return _require_fmu("fmu_src/libpkm.so")
+
+
+@pytest.fixture(scope="session")
+def plant_fmu3() -> Path:
+    """fmi3/PKM4PUU.fmu, the plant as FMI 3.0 (Co-Simulation and Model Exchange)."""
+    return _require_fmu("fmi3/PKM4PUU.fmu")
+
+
+@pytest.fixture(scope="session")
+def inverse_fmu3() -> Path:
+    """fmi3/PKM4PUU_Inverse.fmu, the inverse dynamics as FMI 3.0."""
+    return _require_fmu("fmi3/PKM4PUU_Inverse.fmu")

@@ -1,4 +1,5 @@
 // What an FMU binary needs beyond its FMI functions.
+#include <cstddef>  // defines __GLIBCXX__ with libstdc++
 #if defined(PKM_FMI_FREE_EH_POOL) && defined(__GLIBCXX__)
 namespace __gnu_cxx {
 void __freeres();  // libstdc++ (eh_alloc.cc): frees the exception-handling emergency pool
