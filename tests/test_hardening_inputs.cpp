@@ -218,7 +218,9 @@ TEST(HardeningParameters, OutOfRangeParametersFailInitialisationAndResetRecovers
                   p.log.last().find("lies outside its range") != std::string::npos)
           << p.log.dump();
       p.initialize();
-      if (!c.integer) EXPECT_EQ(p.get(c.name), v->start);
+      if (!c.integer) {
+        EXPECT_EQ(p.get(c.name), v->start);
+      }
       ASSERT_EQ(p.step(0.0, 1e-3), fmi2OK) << p.log.dump();
       continue;
     }

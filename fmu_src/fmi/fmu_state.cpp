@@ -27,15 +27,6 @@ double read_as_double(ModelData& d, const Variable& v) {
   return 0.0;
 }
 
-void write_from_double(ModelData& d, const Variable& v, double x) {
-  void* p = v.value(d, v.index);
-  switch (v.type) {
-    case VarType::Real: *static_cast<double*>(p) = x; break;
-    case VarType::Integer: *static_cast<std::int32_t*>(p) = static_cast<std::int32_t>(x); break;
-    case VarType::Boolean: *static_cast<int*>(p) = x != 0.0 ? 1 : 0; break;
-  }
-}
-
 std::uint32_t stored_count(const ModelDefinition& d) {
   std::uint32_t n = 0;
   for (std::size_t i = 0; i < d.n_variables; ++i)
@@ -44,6 +35,15 @@ std::uint32_t stored_count(const ModelDefinition& d) {
 }
 
 }  // namespace
+
+void write_from_double(ModelData& d, const Variable& v, double x) {
+  void* p = v.value(d, v.index);
+  switch (v.type) {
+    case VarType::Real: *static_cast<double*>(p) = x; break;
+    case VarType::Integer: *static_cast<std::int32_t*>(p) = static_cast<std::int32_t>(x); break;
+    case VarType::Boolean: *static_cast<int*>(p) = x != 0.0 ? 1 : 0; break;
+  }
+}
 
 SavedState* as_state(void* handle) {
   auto* p = static_cast<SavedState*>(handle);

@@ -24,6 +24,11 @@ struct SavedState {
   Instance* owner = nullptr;  // FreeInstance frees the states it created
 };
 
+class ModelData;
+struct Variable;
+/// Writes a variable's value given as a double (start values, FMU states).
+void write_from_double(ModelData& d, const Variable& v, double x);
+
 /// The state behind a handle, nullptr if it is not a live one.
 SavedState* as_state(void* handle);
 SavedState* make_state(Instance* owner);

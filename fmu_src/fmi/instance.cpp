@@ -15,15 +15,6 @@ constexpr std::uint64_t kInstanceTag3 = 0x49334d464d4b5002ull;  // marks a live 
 
 std::uint64_t tag_of(int version) { return version == 2 ? kInstanceTag2 : kInstanceTag3; }
 
-void write_from_double(ModelData& d, const Variable& v, double x) {
-  void* p = v.value(d, v.index);
-  switch (v.type) {
-    case VarType::Real: *static_cast<double*>(p) = x; break;
-    case VarType::Integer: *static_cast<std::int32_t*>(p) = static_cast<std::int32_t>(x); break;
-    case VarType::Boolean: *static_cast<int*>(p) = x != 0.0 ? 1 : 0; break;
-  }
-}
-
 }  // namespace
 
 const char* mode_name(std::uint32_t mode) {

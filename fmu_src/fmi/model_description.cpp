@@ -12,20 +12,6 @@
 namespace pkm_fmi {
 namespace {
 
-std::string escape(const char* s) {
-  std::string out;
-  for (; *s; ++s) {
-    switch (*s) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += *s;
-    }
-  }
-  return out;
-}
-
 // SI base-unit exponents of every unit the tables use.
 struct UnitInfo {
   const char* name;
@@ -65,7 +51,7 @@ std::string log_categories() {
   std::string out = "  <LogCategories>\n";
   for (int c = 0; c < kLogCategoryCount; ++c)
     out += "    <Category name=\"" + std::string(kLogCategoryNames[c]) + "\" description=\"" +
-           escape(kLogCategoryDescriptions[c]) + "\"/>\n";
+           xml_escape(kLogCategoryDescriptions[c]) + "\"/>\n";
   return out + "  </LogCategories>\n";
 }
 
@@ -86,8 +72,8 @@ const Variable* state_variable(const ModelDefinition& d, int k) {
 
 // Attributes common to both versions' variable elements.
 std::string variable_attributes(const Variable& v) {
-  std::string a = " name=\"" + escape(v.name) + "\" valueReference=\"" + std::to_string(v.vr) + "\"";
-  if (*v.description) a += " description=\"" + escape(v.description) + "\"";
+  std::string a = " name=\"" + xml_escape(v.name) + "\" valueReference=\"" + std::to_string(v.vr) + "\"";
+  if (*v.description) a += " description=\"" + xml_escape(v.description) + "\"";
   a += " causality=\"" + std::string(xml_name(v.causality)) + "\" variability=\"" + xml_name(v.variability) + "\"";
   if (v.initial != Initial::None) a += " initial=\"" + std::string(xml_name(v.initial)) + "\"";
   return a;
@@ -142,7 +128,7 @@ std::string fmi2(const ModelDefinition& d) {
   for (std::size_t i = 0; i < d.n_variables; ++i) index[d.variables[i].vr] = static_cast<int>(i + 1);
   std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   x += "<fmiModelDescription\n  fmiVersion=\"2.0\"\n  modelName=\"" + std::string(d.identifier) + "\"\n  guid=\"" +
-       d.guid() + "\"\n  description=\"" + escape(d.title) + "\"\n  generationTool=\"" + kGenerationTool +
+       d.guid() + "\"\n  description=\"" + xml_escape(d.title) + "\"\n  generationTool=\"" + kGenerationTool +
        "\"\n  variableNamingConvention=\"structured\"\n  numberOfEventIndicators=\"" +
        std::to_string(d.n_event_indicators) + "\">\n";
   x += "  <ModelExchange\n    modelIdentifier=\"" + std::string(d.identifier) +
@@ -184,7 +170,7 @@ std::string fmi3(const ModelDefinition& d) {
   const std::map<std::uint32_t, int> none;
   std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   x += "<fmiModelDescription\n  fmiVersion=\"3.0\"\n  modelName=\"" + std::string(d.identifier) +
-       "\"\n  instantiationToken=\"" + d.guid() + "\"\n  description=\"" + escape(d.title) +
+       "\"\n  instantiationToken=\"" + d.guid() + "\"\n  description=\"" + xml_escape(d.title) +
        "\"\n  generationTool=\"" + kGenerationTool + "\"\n  variableNamingConvention=\"structured\">\n";
   x += "  <ModelExchange\n    modelIdentifier=\"" + std::string(d.identifier) +
        "\"\n    canGetAndSetFMUState=\"true\"\n    canSerializeFMUState=\"true\"\n"
@@ -227,6 +213,20 @@ std::string fmi3(const ModelDefinition& d) {
 }
 
 }  // namespace
+
+std::string xml_escape(const char* s) {
+  std::string out;
+  for (; *s; ++s) {
+    switch (*s) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += *s;
+    }
+  }
+  return out;
+}
 
 std::string exact_text(double v) {
   char buf[40];

@@ -25,4 +25,7 @@ Dependencies dependencies_of(const ModelDefinition& def, const Variable& v);
 /// The shortest decimal text that reads back as exactly x.
 std::string exact_text(double x);
 
+/// Text with <, >, & and " escaped (XML attributes, HTML).
+std::string xml_escape(const char* s);
+
 }  // namespace pkm_fmi

@@ -12,20 +12,6 @@
 
 namespace {
 
-std::string escape(const char* s) {
-  std::string out;
-  for (; *s; ++s) {
-    switch (*s) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += *s;
-    }
-  }
-  return out;
-}
-
 std::string start_text(const pkm_fmi::Variable& v) {
   if (!v.has_start()) return "";
   return v.type == pkm_fmi::VarType::Real ? pkm_fmi::exact_text(v.start) : std::to_string(static_cast<int>(v.start));
@@ -37,9 +23,9 @@ void section(std::ofstream& out, const pkm_fmi::ModelDefinition& def, pkm_fmi::C
   for (std::size_t i = 0; i < def.n_variables; ++i) {
     const pkm_fmi::Variable& v = def.variables[i];
     if (v.causality != c) continue;
-    out << "<tr><td><code>" << escape(v.name) << "</code></td><td>" << pkm_fmi::fmi2_type_name(v.type) << "</td><td>"
-        << escape(v.unit) << "</td><td>" << start_text(v) << "</td><td>" << v.vr << "</td><td>"
-        << escape(v.description) << "</td></tr>\n";
+    out << "<tr><td><code>" << pkm_fmi::xml_escape(v.name) << "</code></td><td>" << pkm_fmi::fmi2_type_name(v.type) << "</td><td>"
+        << pkm_fmi::xml_escape(v.unit) << "</td><td>" << start_text(v) << "</td><td>" << v.vr << "</td><td>"
+        << pkm_fmi::xml_escape(v.description) << "</td></tr>\n";
   }
   out << "</table>\n";
 }
@@ -64,7 +50,7 @@ int main(int argc, char** argv) {
       << "</title>\n<style>body{font-family:sans-serif;max-width:60em;margin:auto}"
          "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:2px 6px;text-align:left}</style>\n"
          "</head>\n<body>\n<h1>"
-      << def->identifier << "</h1>\n<p><b>" << escape(def->title) << "</b></p>\n"
+      << def->identifier << "</h1>\n<p><b>" << pkm_fmi::xml_escape(def->title) << "</b></p>\n"
       << def->summary
       << "\n<p>FMI 2.0 (Co-Simulation and Model Exchange in one archive) and FMI 3.0 (Co-Simulation and Model "
          "Exchange), binaries for x86_64 Linux. SI units on every variable (m, kg, s, rad, N, N.m). "
