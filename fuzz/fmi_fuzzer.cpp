@@ -35,18 +35,11 @@
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include "fmi2FunctionTypes.h"
+#include "fmi_functions.h"
 #include "models.hpp"
 
-// The two in-process FMUs' exported functions.
-#define PKM_FUZZ_FMI2_FUNCTIONS(X)                                                                             \
-  X(fmi2GetTypesPlatform) X(fmi2GetVersion) X(fmi2SetDebugLogging) X(fmi2Instantiate) X(fmi2FreeInstance)      \
-  X(fmi2SetupExperiment) X(fmi2EnterInitializationMode) X(fmi2ExitInitializationMode) X(fmi2Terminate)         \
-  X(fmi2Reset) X(fmi2GetReal) X(fmi2GetInteger) X(fmi2GetBoolean) X(fmi2GetString) X(fmi2SetReal)              \
-  X(fmi2SetInteger) X(fmi2SetBoolean) X(fmi2SetString) X(fmi2GetFMUstate) X(fmi2SetFMUstate)                   \
-  X(fmi2FreeFMUstate) X(fmi2SerializedFMUstateSize) X(fmi2SerializeFMUstate) X(fmi2DeSerializeFMUstate)        \
-  X(fmi2GetDirectionalDerivative) X(fmi2SetRealInputDerivatives) X(fmi2GetRealOutputDerivatives) X(fmi2DoStep) \
-  X(fmi2CancelStep) X(fmi2GetStatus) X(fmi2GetRealStatus) X(fmi2GetIntegerStatus) X(fmi2GetBooleanStatus)      \
-  X(fmi2GetStringStatus)
+// The two in-process FMUs' exported FMI 2.0 functions: fmi_functions.h.
+#define PKM_FUZZ_FMI2_FUNCTIONS PKM_FMI2_FUNCTIONS
 
 extern "C" {
 #define PKM_FUZZ_DECLARE(name) name##TYPE PKM4PUU_##name; name##TYPE PKM4PUU_Inverse_##name;
