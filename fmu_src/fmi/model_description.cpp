@@ -12,26 +12,46 @@
 namespace pkm_fmi {
 namespace {
 
-// SI base-unit exponents of every unit the tables use.
+// SI base-unit exponents of every unit the tables use, and the quantity it
+// measures here (the name of its FMI 3.0 type, after Modelica.Units.SI).
 struct UnitInfo {
   const char* name;
   int kg, m, s, rad;
+  const char* quantity;
 };
 constexpr UnitInfo kUnits[] = {
-    {"s", 0, 0, 1, 0},      {"m", 0, 1, 0, 0},       {"m/s", 0, 1, -1, 0},   {"m/s2", 0, 1, -2, 0},
-    {"rad", 0, 0, 0, 1},    {"rad/s", 0, 0, -1, 1},  {"rad/s2", 0, 0, -2, 1}, {"kg", 1, 0, 0, 0},
-    {"kg.m2", 1, 2, 0, 0},  {"N", 1, 1, -2, 0},      {"N.m", 1, 2, -2, 0},   {"N.s/m", 1, 0, -1, 0},
-    {"N/m", 1, 0, -2, 0},   {"J", 1, 2, -2, 0},      {"W", 1, 2, -3, 0},
+    {"s", 0, 0, 1, 0, "Time"},
+    {"m", 0, 1, 0, 0, "Length"},
+    {"m/s", 0, 1, -1, 0, "Velocity"},
+    {"m/s2", 0, 1, -2, 0, "Acceleration"},
+    {"rad", 0, 0, 0, 1, "Angle"},
+    {"rad/s", 0, 0, -1, 1, "AngularVelocity"},
+    {"rad/s2", 0, 0, -2, 1, "AngularAcceleration"},
+    {"kg", 1, 0, 0, 0, "Mass"},
+    {"kg.m2", 1, 2, 0, 0, "MomentOfInertia"},
+    {"N", 1, 1, -2, 0, "Force"},
+    {"N.m", 1, 2, -2, 0, "Torque"},
+    {"N.s/m", 1, 0, -1, 0, "TranslationalDampingConstant"},
+    {"N/m", 1, 0, -2, 0, "TranslationalSpringConstant"},
+    {"J", 1, 2, -2, 0, "Energy"},
+    {"W", 1, 2, -3, 0, "Power"},
 };
+
+const UnitInfo& unit_info(const char* unit) {
+  for (const UnitInfo& u : kUnits)
+    if (std::strcmp(u.name, unit) == 0) return u;
+  std::fprintf(stderr, "model description: unit %s has no UnitDefinition (add it to kUnits)\n", unit);
+  std::abort();  // a build tool's programming error, never reached in an FMU
+}
 
 std::string unit_definitions(const ModelDefinition& d) {
   std::set<std::string> used;
   for (std::size_t i = 0; i < d.n_variables; ++i)
     if (*d.variables[i].unit) used.insert(d.variables[i].unit);
+  for (const std::string& u : used) unit_info(u.c_str());
   std::string out = "  <UnitDefinitions>\n";
   for (const UnitInfo& u : kUnits) {
     if (!used.count(u.name)) continue;
-    used.erase(u.name);
     out += "    <Unit name=\"" + std::string(u.name) + "\">\n      <BaseUnit";
     if (u.kg) out += " kg=\"" + std::to_string(u.kg) + "\"";
     if (u.m) out += " m=\"" + std::to_string(u.m) + "\"";
@@ -39,12 +59,23 @@ std::string unit_definitions(const ModelDefinition& d) {
     if (u.rad) out += " rad=\"" + std::to_string(u.rad) + "\"";
     out += "/>\n    </Unit>\n";
   }
-  if (!used.empty()) {
-    std::fprintf(stderr, "model description: unit %s has no UnitDefinition (add it to kUnits)\n",
-                 used.begin()->c_str());
-    std::abort();  // a build tool's programming error, never reached in an FMU
-  }
   return out + "  </UnitDefinitions>\n";
+}
+
+// FMI 3.0: one Float64Type per unit, named for its quantity; the variables
+// name it as declaredType. (FMI 3.0 also allows a unit attribute on each
+// variable; some importers, e.g. the Rust fmi-schema 0.8 behind fmi-sim,
+// read units only through types, as the Reference FMUs declare them.)
+std::string type_definitions(const ModelDefinition& d) {
+  std::set<std::string> used;
+  for (std::size_t i = 0; i < d.n_variables; ++i)
+    if (*d.variables[i].unit) used.insert(d.variables[i].unit);
+  std::string out = "  <TypeDefinitions>\n";
+  for (const UnitInfo& u : kUnits)
+    if (used.count(u.name))
+      out += "    <Float64Type name=\"" + std::string(u.quantity) + "\" quantity=\"" + u.quantity + "\" unit=\"" +
+             u.name + "\"/>\n";
+  return out + "  </TypeDefinitions>\n";
 }
 
 std::string log_categories() {
@@ -79,11 +110,12 @@ std::string variable_attributes(const Variable& v) {
   return a;
 }
 
-// Type attributes (unit, min, max, start, derivative) in the order FMI 3.0 lists them.
+// Type attributes (unit or declared type, min, max, start, derivative).
 std::string type_attributes(const ModelDefinition& d, const Variable& v, int version,
                             const std::map<std::uint32_t, int>& index) {
   std::string a;
-  if (*v.unit) a += " unit=\"" + std::string(v.unit) + "\"";
+  if (*v.unit && version == 2) a += " unit=\"" + std::string(v.unit) + "\"";
+  if (*v.unit && version == 3) a += " declaredType=\"" + std::string(unit_info(v.unit).quantity) + "\"";
   if (v.type == VarType::Integer) {
     if (std::isfinite(v.min)) a += " min=\"" + std::to_string(static_cast<long long>(v.min)) + "\"";
     if (std::isfinite(v.max)) a += " max=\"" + std::to_string(static_cast<long long>(v.max)) + "\"";
@@ -178,7 +210,7 @@ std::string fmi3(const ModelDefinition& d) {
   x += "  <CoSimulation\n    modelIdentifier=\"" + std::string(d.identifier) +
        "\"\n    canGetAndSetFMUState=\"true\"\n    canSerializeFMUState=\"true\"\n"
        "    canHandleVariableCommunicationStepSize=\"true\"/>\n";
-  x += unit_definitions(d) + log_categories() + default_experiment(d);
+  x += unit_definitions(d) + type_definitions(d) + log_categories() + default_experiment(d);
   x += "  <ModelVariables>\n";
   for (std::size_t i = 0; i < d.n_variables; ++i) {
     const Variable& v = d.variables[i];
