@@ -110,10 +110,10 @@ inline fmi2ValueReference vr_of(const pkm_fmi::ModelDefinition& d, const std::st
 class FmuInstance {
  public:
   FmuInstance(FmuLibrary& lib, const pkm_fmi::ModelDefinition& def, const char* guid, const char* name = "instance",
-              bool logging_on = false)
+              bool logging_on = false, fmi2Type type = fmi2CoSimulation)
       : lib(lib), def(def) {
     functions_ = fmi2CallbackFunctions{&collect_log, &std::calloc, &std::free, nullptr, &log};
-    c = lib.fmi2Instantiate(name, fmi2CoSimulation, guid, "file:///nonexistent", &functions_, fmi2False,
+    c = lib.fmi2Instantiate(name, type, guid, "file:///nonexistent", &functions_, fmi2False,
                             logging_on ? fmi2True : fmi2False);
   }
   ~FmuInstance() {
@@ -201,8 +201,8 @@ class FmuInstance {
 };
 
 struct PlantFmu : FmuInstance {
-  explicit PlantFmu(const char* name = "plant", bool logging_on = false)
-      : FmuInstance(plant_library(), pkm_fmi::pkm4puu_definition(), PKM_FMU_PLANT_GUID, name, logging_on) {}
+  explicit PlantFmu(const char* name = "plant", bool logging_on = false, fmi2Type type = fmi2CoSimulation)
+      : FmuInstance(plant_library(), pkm_fmi::pkm4puu_definition(), PKM_FMU_PLANT_GUID, name, logging_on, type) {}
 };
 
 struct InverseFmu : FmuInstance {
