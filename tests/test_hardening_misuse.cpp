@@ -16,6 +16,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fmi3FunctionTypes.h"
 #include "fmu_loader.hpp"
 #include "hardening_table.hpp"
 
@@ -387,6 +388,58 @@ TEST_F(HardeningMisuse, NullAndForeignComponentsAreErrorsWithoutACrash) {
             "32 functions that take one (and fmi2FreeInstance)",
             "fmi2Error each (nobody to log to); fmi2FreeInstance ignores it",
             "yes: no crash, the foreign memory untouched");
+}
+
+// Both libraries are built from the same sources: an instance made by one
+// has the right tag for the other, only its model definition differs. Each
+// library must serve its own model's instances only (issue 17.5), and the
+// FMI 3.0 entry points only instances made by fmi3Instantiate*.
+TEST_F(HardeningMisuse, InstancesOfTheOtherModelOrFmiVersionAreErrors) {
+  FmuLibrary& inverse = inverse_library();
+  InverseFmu inv;
+  PlantFmu plant;
+  ASSERT_NE(inv.c, nullptr);
+  ASSERT_NE(plant.c, nullptr);
+  const fmi2ValueReference vr = 1;
+  for (auto [library, foreign] : {std::pair<FmuLibrary*, fmi2Component>{&lib, inv.c}, {&inverse, plant.c}}) {
+    double v = kCanary;
+    fmi2FMUstate state = nullptr;
+    EXPECT_EQ(library->fmi2SetReal(foreign, &vr, 1, &v), fmi2Error);
+    EXPECT_EQ(library->fmi2GetReal(foreign, &vr, 1, &v), fmi2Error);
+    EXPECT_EQ(v, kCanary);
+    EXPECT_EQ(library->fmi2SetupExperiment(foreign, fmi2False, 0, 0, fmi2False, 0), fmi2Error);
+    EXPECT_EQ(library->fmi2EnterInitializationMode(foreign), fmi2Error);
+    EXPECT_EQ(library->fmi2DoStep(foreign, 0.0, 1e-3, fmi2True), fmi2Error);
+    EXPECT_EQ(library->fmi2GetFMUstate(foreign, &state), fmi2Error);
+    EXPECT_EQ(state, nullptr);
+    EXPECT_EQ(library->fmi2Reset(foreign), fmi2Error);
+    library->fmi2FreeInstance(foreign);  // ignored: not this library's
+  }
+  // An FMI 2.0 instance handed to the same library's FMI 3.0 functions.
+  auto* fmi3_do_step = reinterpret_cast<fmi3DoStepTYPE*>(dlsym(lib.handle, "fmi3DoStep"));
+  auto* fmi3_get = reinterpret_cast<fmi3GetFloat64TYPE*>(dlsym(lib.handle, "fmi3GetFloat64"));
+  auto* fmi3_free = reinterpret_cast<fmi3FreeInstanceTYPE*>(dlsym(lib.handle, "fmi3FreeInstance"));
+  ASSERT_TRUE(fmi3_do_step && fmi3_get && fmi3_free);
+  fmi3Boolean event = fmi3False, terminate = fmi3False, early = fmi3False;
+  fmi3Float64 last = kCanary, v = kCanary;
+  const fmi3ValueReference vr3 = 1;
+  EXPECT_EQ(fmi3_do_step(plant.c, 0.0, 1e-3, fmi3True, &event, &terminate, &early, &last), fmi3Error);
+  EXPECT_EQ(fmi3_get(plant.c, &vr3, 1, &v, 1), fmi3Error);
+  EXPECT_EQ(v, kCanary);
+  fmi3_free(plant.c);  // ignored: an FMI 2.0 instance
+
+  // Both instances survived every call above and still work with their own library.
+  inv.initialize();
+  EXPECT_NEAR(inv.get("F[1]"), kStaticForce, 1e-9) << inv.log.dump();
+  plant.initialize();
+  for (int i = 1; i <= 4; ++i) ASSERT_EQ(plant.set(force_name(i), kStaticForce), fmi2OK);
+  ASSERT_EQ(plant.step(0.0, 1e-3), fmi2OK) << plant.log.dump();
+  EXPECT_NEAR(plant.get("z"), 0.05, 1e-12) << "held at rest by the static forces";
+  table_row("an instance of the inverse FMU passed to the plant library (and the reverse), and an FMI 2.0 instance "
+            "to the FMI 3.0 functions: SetReal, GetReal, SetupExperiment, EnterInitializationMode, DoStep, "
+            "GetFMUstate, Reset, FreeInstance",
+            "fmi2Error / fmi3Error each; FreeInstance ignores it; the instance keeps working with its own library",
+            "yes");
 }
 
 TEST_F(HardeningMisuse, InstantiateWithBadArguments) {
