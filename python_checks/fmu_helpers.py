@@ -1,5 +1,5 @@
 """Small helpers for the FMU checks: the spec's trajectory and constants, and a
-thin, always-cleaning-up wrapper around fmpy's FMU2Slave.
+thin, always-cleaning-up wrapper around fmpy's FMU2Slave and FMU3Slave.
 
 Every number here is copied from /work/shared/MODEL_SPEC.md (the authoritative
 definition of the mechanism), never from an output of the code under test.
@@ -10,6 +10,7 @@ import shutil
 import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
 
 # --- MODEL_SPEC "Auto-test": rest-to-rest quintic from P0 to P1 in 2 s -------
 T_MOVE = 2.0  # s
@@ -68,7 +69,8 @@ def pdd(t):
 
 
 class Fmu:
-    """One FMI 2.0 Co-Simulation instance, initialised and ready to step.
+    """One Co-Simulation instance, FMI 2.0 or 3.0 (from the archive's model
+    description), initialised and ready to step.
 
     with Fmu(path, start={"solver": 1, "g": 0.0}) as fmu:
         fmu.set(F, [1, 2, 3, 4]); fmu.do_step(0.0, 1e-3); fmu.get(["x"])
@@ -78,6 +80,8 @@ class Fmu:
     is terminated and freed and its extracted directory removed, also when
     something failed. `unzipdir` lets several instances share one extraction
     (and so one loaded shared library); the caller then owns that directory.
+    The methods below hide the two versions' different names (setReal /
+    setFloat64, getFMUstate / getFMUState, ...); `fmu.fmu` is fmpy's object.
     """
 
     def __init__(self, path, start=None, instance_name="instance", unzipdir=None, start_time=0.0):
@@ -87,6 +91,7 @@ class Fmu:
         self.start_time = start_time
         self.md = read_model_description(self.path)
         self._vars = {v.name: v for v in self.md.modelVariables}
+        self.fmi3 = self.md.fmiVersion.startswith("3.")
         self._own_dir = unzipdir is None
         self.unzipdir = unzipdir
         self.fmu = None
@@ -98,7 +103,8 @@ class Fmu:
         try:
             if self.unzipdir is None:
                 self.unzipdir = extract(self.path)
-            self.fmu = FMU2Slave(
+            slave = FMU3Slave if self.fmi3 else FMU2Slave
+            self.fmu = slave(
                 guid=self.md.guid,
                 unzipDirectory=self.unzipdir,
                 modelIdentifier=self.md.coSimulation.modelIdentifier,
@@ -113,11 +119,15 @@ class Fmu:
         return self
 
     def initialize(self):
-        """setupExperiment, start values, enter/exit initialization mode."""
-        self.fmu.setupExperiment(startTime=self.start_time)
+        """setupExperiment (FMI 2.0), start values, enter/exit initialization mode."""
+        if not self.fmi3:
+            self.fmu.setupExperiment(startTime=self.start_time)
         for name, value in self.start.items():
             self.set_any(name, value)
-        self.fmu.enterInitializationMode()
+        if self.fmi3:
+            self.fmu.enterInitializationMode(startTime=self.start_time)
+        else:
+            self.fmu.enterInitializationMode()
         self.fmu.exitInitializationMode()
         self._initialized = True
 
@@ -156,29 +166,54 @@ class Fmu:
     def set_any(self, name, value):
         v = self.var(name)
         vr = [v.valueReference]
-        if v.type == "Real":
-            self.fmu.setReal(vr, [float(value)])
-        elif v.type in ("Integer", "Enumeration"):
+        if v.type in ("Real", "Float64"):
+            self._set_real(vr, [float(value)])
+        elif v.type in ("Integer", "Enumeration") and not self.fmi3:
             self.fmu.setInteger(vr, [int(value)])
+        elif v.type in ("Int32", "Enumeration"):
+            self.fmu.setInt32(vr, [int(value)])
         elif v.type == "Boolean":
             self.fmu.setBoolean(vr, [bool(value)])
         else:
             self.fmu.setString(vr, [str(value)])
 
+    def _set_real(self, vrs, values):
+        (self.fmu.setFloat64 if self.fmi3 else self.fmu.setReal)(vrs, values)
+
     def set(self, names, values):
-        """setReal by names."""
-        self.fmu.setReal(self.vrs(names), [float(v) for v in values])
+        """setReal / setFloat64 by names."""
+        self._set_real(self.vrs(names), [float(v) for v in values])
 
     def get(self, names):
-        """getReal by names, as a numpy array."""
-        return np.array(self.fmu.getReal(self.vrs(names)))
+        """getReal / getFloat64 by names, as a numpy array."""
+        vrs = self.vrs(names)
+        return np.array(self.fmu.getFloat64(vrs) if self.fmi3 else self.fmu.getReal(vrs))
 
     def set_derivatives(self, names, values, order=1):
-        """setRealInputDerivatives by names."""
+        """setRealInputDerivatives by names (FMI 2.0 only: the FMI 3.0 FMUs
+        hold their inputs over a step)."""
+        if self.fmi3:
+            raise NotImplementedError("the FMI 3.0 FMUs take no input derivatives")
         self.fmu.setRealInputDerivatives(self.vrs(names), [order] * len(names), [float(v) for v in values])
 
     def do_step(self, t, h, no_set_prior=True):
         self.fmu.doStep(t, h, noSetFMUStatePriorToCurrentPoint=no_set_prior)
+
+    # -- FMU state ----------------------------------------------------------
+    def get_state(self):
+        return self.fmu.getFMUState() if self.fmi3 else self.fmu.getFMUstate()
+
+    def set_state(self, state):
+        (self.fmu.setFMUState if self.fmi3 else self.fmu.setFMUstate)(state)
+
+    def free_state(self, state):
+        (self.fmu.freeFMUState if self.fmi3 else self.fmu.freeFMUstate)(state)
+
+    def serialize(self, state):
+        return (self.fmu.serializeFMUState if self.fmi3 else self.fmu.serializeFMUstate)(state)
+
+    def deserialize(self, blob):
+        return (self.fmu.deserializeFMUState if self.fmi3 else self.fmu.deSerializeFMUstate)(blob)
 
 
 def run(fmu, t0, h, n, inputs, out_names, first_row=True):

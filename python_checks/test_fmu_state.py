@@ -1,6 +1,7 @@
 """FMU state save/restore is exact: a state taken at t = 1 s and restored
 replays 1 s .. 1.5 s bit for bit, in the same instance (get/setFMUstate) and
-in a fresh one (serialize / deSerialize).
+in a fresh one (serialize / deSerialize), for the FMI 2.0 and the FMI 3.0
+Co-Simulation FMU.
 
 An FMU state holds everything the FMU needs, parameters included (FMI 2.0,
 section 2.1.8), so the run uses non-default solver settings and the fresh
@@ -44,31 +45,33 @@ def _assert_identical(a, b, what):
 
 
 @pytest.mark.parametrize("solver", list(SOLVERS))
-def test_state_restore_is_exact(plant_fmu, solver):
+@pytest.mark.parametrize("archive", ["plant_fmu", "plant_fmu3"])
+def test_state_restore_is_exact(archive, solver, request):
+    plant_fmu = request.getfixturevalue(archive)
     k_save, k_end = round(T_SAVE / H), round(T_END / H)
     with Fmu(plant_fmu, start=SOLVERS[solver]) as fmu:
         advance(fmu, 0, k_save)
         at_save = fmu.get(OUT)
-        state = fmu.fmu.getFMUstate()
+        state = fmu.get_state()
         try:
             first = advance(fmu, k_save, k_end)
             moved = np.abs(first[-1, :4] - at_save[:4]).max()
             assert moved > 1e-6, f"the platform barely moved ({moved:.2e}): the check would be trivial"
 
-            fmu.fmu.setFMUstate(state)
+            fmu.set_state(state)
             _assert_identical(fmu.get(OUT)[None], at_save[None], f"{solver}: outputs right after setFMUstate")
             _assert_identical(advance(fmu, k_save, k_end), first, f"{solver}: replay after setFMUstate")
 
-            blob = fmu.fmu.serializeFMUstate(state)
+            blob = fmu.serialize(state)
         finally:
-            fmu.fmu.freeFMUstate(state)
+            fmu.free_state(state)
 
     with Fmu(plant_fmu, instance_name="fresh") as fresh:  # default parameters
-        restored = fresh.fmu.deSerializeFMUstate(blob)
+        restored = fresh.deserialize(blob)
         try:
-            fresh.fmu.setFMUstate(restored)
+            fresh.set_state(restored)
         finally:
-            fresh.fmu.freeFMUstate(restored)
+            fresh.free_state(restored)
         _assert_identical(fresh.get(OUT)[None], at_save[None], f"{solver}: outputs after deSerializeFMUstate")
         _assert_identical(advance(fresh, k_save, k_end), first, f"{solver}: replay in a fresh instance")
-    print(f"\n{solver}: state at t = {T_SAVE} s, {len(blob)} bytes serialized, replay bit-identical")
+    print(f"\n{archive}, {solver}: state at t = {T_SAVE} s, {len(blob)} bytes serialized, replay bit-identical")
