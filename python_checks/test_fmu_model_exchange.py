@@ -1,0 +1,154 @@
+"""Model Exchange through an importer's own integrator (fmpy's CVode), FMI 2.0
+and FMI 3.0: the paper's auto-test against the Co-Simulation FMU, and the
+singularity guards as event indicators that the importer locates.
+
+The forces are the auto-test's, from the inverse FMU, held over each 1 ms
+interval at their midpoint value: a piecewise-constant signal that fmpy and
+the Co-Simulation FMU both apply exactly (fmpy's CVode applies inputs only at
+its root-function calls and communication points, not in the right-hand
+side, so a continuously interpolated input would be integrated as a staircase
+of fmpy's choosing; the jumps at the 2,000 interval boundaries are input
+events, where fmpy restarts CVode). Both runs then integrate the same ODE,
+and their difference is integrator error only.
+
+Not passed to simulate_fmu: `logger=`. fmpy's logging proxy keeps the last
+logger it was given in one global, which simulate_fmu frees when it returns;
+the next FMU that logs through fmpy's default callbacks then calls freed
+memory (a crash in fmpy 0.3.32, not in the FMU). The log is read from fmpy's
+default logger, which prints, instead.
+"""
+import numpy as np
+import pytest
+from fmpy import simulate_fmu
+from fmpy.fmi1 import FMICallException
+
+from fmu_helpers import F, P0, POSE, STATIC_FORCE_P0, T_MOVE, Fmu, arr, inverse_forces, p, run
+
+H = 1e-3  # s, the interval of the held forces and the communication step
+N = round(T_MOVE / H)
+START = {"x0": P0[0], "y0": P0[1], "z0": P0[2], "phi0": P0[3]}
+WRENCH = ["Fe[1]", "Fe[2]", "Fe[3]", "Me_z"]
+TOL = 1e-8  # m and rad: Model Exchange against Co-Simulation (issue 11)
+TOL_PATH = 5e-8  # m and rad: either against the prescribed path (test_fmu_autotest)
+
+
+@pytest.fixture(scope="module")
+def midpoint_forces(inverse_fmu):
+    """F1..F4 at the midpoint of every 1 ms interval of the auto-test."""
+    with Fmu(inverse_fmu) as inv:
+        return inverse_forces(inv, (np.arange(N) + 0.5) * H)
+
+
+def staircase(forces):
+    """fmpy's input table for forces held over [k h, (k+1) h): every boundary
+    time appears twice (left value, right value), which fmpy treats as an
+    input event. The wrench is zero."""
+    times = np.repeat(np.arange(N + 1) * H, 2)[1:-1]
+    signal = np.zeros(len(times), dtype=[("time", float)] + [(n, float) for n in F + WRENCH])
+    signal["time"] = times
+    held = np.repeat(forces, 2, axis=0)
+    for i, name in enumerate(F):
+        signal[name] = held[:, i]
+    return signal
+
+
+@pytest.fixture(scope="module")
+def co_simulation(plant_fmu, midpoint_forces):
+    """The Co-Simulation FMU (its CVODE at rtol 1e-10) driven by the same held
+    forces: (t, pose) at every communication point."""
+    def hold(fmu, k, t):
+        fmu.set(F, midpoint_forces[k])
+
+    with Fmu(plant_fmu, start=dict(START, rtol=1e-10, atol=1e-12)) as fmu:
+        return run(fmu, 0.0, H, N, hold, POSE)
+
+
+def model_exchange(path, forces, rtol):
+    r = simulate_fmu(str(path), fmi_type="ModelExchange", solver="CVode", relative_tolerance=rtol, stop_time=T_MOVE,
+                     output_interval=H, input=staircase(forces), start_values=START, output=POSE,
+                     record_events=False)
+    return r["time"], np.array([[row[n] for n in POSE] for row in r])
+
+
+@pytest.mark.parametrize("archive", ["plant_fmu", "plant_fmu3"])
+def test_model_exchange_auto_test_converges_to_co_simulation(archive, request, midpoint_forces, co_simulation):
+    """fmpy's CVode restarts at each of the 2,000 input events; at rtol 1e-10
+    (absolute tolerance rtol x nominal) that leaves an integration error of
+    order 1e-8 over 2 s. The difference to Co-Simulation must shrink with the
+    importer's tolerance (it is the importer's error, not a model difference)
+    and be below 1e-8 m / 1e-8 rad from rtol 1e-11 on."""
+    t_cs, cs = co_simulation
+    ref = np.array([p(t) for t in t_cs])
+    cs_path = np.abs(cs - ref).max(axis=0)
+    assert cs_path[:3].max() < TOL_PATH and cs_path[3] < TOL_PATH
+    err = {}
+    for rtol in (1e-10, 1e-11, 1e-12):
+        t_me, me = model_exchange(request.getfixturevalue(archive), midpoint_forces, rtol)
+        assert np.array_equal(t_me, t_cs), "fmpy's output grid must be the communication grid"
+        d = np.abs(me - cs).max(axis=0)
+        err[rtol] = (d[:3].max(), d[3])
+        print(f"\n{archive}: fmpy CVode rtol {rtol:.0e}: |ME - CS| {d[:3].max():.3g} m, {d[3]:.3g} rad")
+    assert err[1e-11][0] < TOL and err[1e-11][1] < TOL, f"ME vs CS at rtol 1e-11: {err[1e-11]}"
+    assert err[1e-12][0] < TOL / 10 and err[1e-12][1] < TOL / 10, f"ME vs CS at rtol 1e-12: {err[1e-12]}"
+    for k in (0, 1):
+        assert err[1e-12][k] < err[1e-10][k] / 10, f"no convergence with the importer's tolerance: {err}"
+
+
+# --- the singularity guards as event indicators ---------------------------------
+# Each case drives the platform towards a guard that a parameter tightens, so
+# that it is reached within a fraction of a second from the home pose (the
+# defaults are far outside the workspace the auto-test uses):
+#   condition: a moment about z turns the platform until the actuator
+#              Jacobian's condition number reaches max_jacobian_condition = 20;
+#   leg:       a force along x pushes it until a leg's |cos th2 sin th2|
+#              falls to min_leg_measure = 0.48.
+HOLD = {name: STATIC_FORCE_P0 for name in F}
+GUARDS = {
+    "condition": ({"max_jacobian_condition": 20.0}, {"Me_z": 0.05}),
+    "leg": ({"min_leg_measure": 0.48}, {"Fe[1]": 1.0}),
+}
+INDICATORS = ["guard_condition_margin"] + arr("guard_leg_margin", 4)
+THETA2 = arr("theta2", 4)
+
+
+def guard_measure(case, row):
+    """The guarded quantity from the FMU's ordinary outputs (not from its
+    indicators): the condition number, or the smallest |cos th2 sin th2|."""
+    if case == "condition":
+        return row["jacobian_condition"]
+    return min(abs(np.cos(row[n]) * np.sin(row[n])) for n in THETA2)
+
+
+@pytest.mark.parametrize("archive", ["plant_fmu", "plant_fmu3"])
+@pytest.mark.parametrize("case", list(GUARDS))
+def test_guard_crossing_is_an_event_the_importer_locates(case, archive, request, capfd):
+    parameters, push = GUARDS[case]
+    limit = next(iter(parameters.values()))
+    r = simulate_fmu(str(request.getfixturevalue(archive)), fmi_type="ModelExchange", solver="CVode",
+                     relative_tolerance=1e-10, stop_time=2.0, output_interval=H,
+                     start_values={**parameters, **HOLD, **push}, debug_logging=True,
+                     output=INDICATORS + THETA2 + ["jacobian_condition"])
+    log = capfd.readouterr().out
+    t_event = r["time"][-1]
+    assert t_event < 1.0, f"the {case} guard was not reached: the run ended at t = {t_event}"
+    z = np.array([[row[n] for n in INDICATORS] for row in r])
+    crossed = int(np.argmin(np.abs(z[-1])))
+    # Before the event every indicator is positive; at it, the crossed one is
+    # zero to the root finder's accuracy, and the guarded quantity is at its limit.
+    assert (z[:-1] > 0).all(), f"an indicator was not positive before the event:\n{z[:-1].min(axis=0)}"
+    assert abs(z[-1, crossed]) < 1e-9, f"{INDICATORS[crossed]} = {z[-1, crossed]:.3g} at the event"
+    assert (crossed == 0) == (case == "condition"), f"{INDICATORS[crossed]} crossed in the {case} case"
+    assert guard_measure(case, r[-1]) == pytest.approx(limit, rel=1e-8), "event not at the guard's limit"
+    assert "terminateSimulation = true" in log, log[-2000:]
+
+    # Co-Simulation with the same inputs fails the step that contains the event.
+    with Fmu(request.getfixturevalue(archive), start=parameters) as fmu:
+        fmu.set(list(HOLD) + list(push), list(HOLD.values()) + list(push.values()))
+        k = 0
+        with pytest.raises(FMICallException) as failure:
+            for k in range(round(2.0 / H)):
+                fmu.do_step(k * H, H)
+        assert failure.value.status == 2, "a guard crossing is a Discard"
+        assert k * H <= t_event < (k + 1) * H, f"Co-Simulation stopped in [{k * H}, {(k + 1) * H}], ME at {t_event}"
+    print(f"\n{archive}, {case} guard: event at t = {t_event:.9f} s, "
+          f"{INDICATORS[crossed]} = {z[-1, crossed]:.2g}; Co-Simulation discards the step [{k * H:.3f}, {(k + 1) * H:.3f}]")
