@@ -16,26 +16,18 @@
 #include <unistd.h>
 
 #include "fmi2FunctionTypes.h"
+#include "fmi_functions.h"
 
 #ifndef PKM_HARNESS_NAME
 #error "define PKM_HARNESS_NAME before including fmu_harness.h"
 #endif
 
+/* Every FMI 2.0 function the binaries export (fmu_src/fmi/fmi_functions.h). */
 typedef struct {
   void* handle;
-  fmi2InstantiateTYPE* fmi2Instantiate;
-  fmi2FreeInstanceTYPE* fmi2FreeInstance;
-  fmi2SetupExperimentTYPE* fmi2SetupExperiment;
-  fmi2EnterInitializationModeTYPE* fmi2EnterInitializationMode;
-  fmi2ExitInitializationModeTYPE* fmi2ExitInitializationMode;
-  fmi2TerminateTYPE* fmi2Terminate;
-  fmi2GetRealTYPE* fmi2GetReal;
-  fmi2SetRealTYPE* fmi2SetReal;
-  fmi2SetIntegerTYPE* fmi2SetInteger;
-  fmi2GetFMUstateTYPE* fmi2GetFMUstate;
-  fmi2SetFMUstateTYPE* fmi2SetFMUstate;
-  fmi2FreeFMUstateTYPE* fmi2FreeFMUstate;
-  fmi2DoStepTYPE* fmi2DoStep;
+#define PKM_HARNESS_DECLARE(name) name##TYPE* name;
+  PKM_FMI2_FUNCTIONS(PKM_HARNESS_DECLARE)
+#undef PKM_HARNESS_DECLARE
 } Fmu;
 
 /* dlsym returns an object pointer; ISO C has no conversion to a function
@@ -62,20 +54,8 @@ static int load_fmu(const char* path, Fmu* f) {
     fprintf(stderr, PKM_HARNESS_NAME ": dlopen(%s): %s\n", path, dlerror());
     return 0;
   }
-#define LOAD(name) ok &= load_symbol(f->handle, #name, &f->name, sizeof f->name)
-  LOAD(fmi2Instantiate);
-  LOAD(fmi2FreeInstance);
-  LOAD(fmi2SetupExperiment);
-  LOAD(fmi2EnterInitializationMode);
-  LOAD(fmi2ExitInitializationMode);
-  LOAD(fmi2Terminate);
-  LOAD(fmi2GetReal);
-  LOAD(fmi2SetReal);
-  LOAD(fmi2SetInteger);
-  LOAD(fmi2GetFMUstate);
-  LOAD(fmi2SetFMUstate);
-  LOAD(fmi2FreeFMUstate);
-  LOAD(fmi2DoStep);
+#define LOAD(name) ok &= load_symbol(f->handle, #name, &f->name, sizeof f->name);
+  PKM_FMI2_FUNCTIONS(LOAD)
 #undef LOAD
   return ok;
 }
@@ -179,12 +159,23 @@ static void print_machine(void) {
          sysconf(_SC_NPROCESSORS_CONF));
 }
 
+/* The model description that goes with the binary `so`: for the build's own
+ * plant binary (PKM_FMU_PLANT_SO) the copy staged beside it
+ * (PKM_FMU_PLANT_XML), otherwise the FMU layout's
+ * <stage>/binaries/<platform>/<id>.so -> <stage>/modelDescription.xml.
+ * The caller frees the result. */
 static char* default_xml_path(const char* so) {
-  /* <stage>/binaries/<platform>/<id>.so -> <stage>/modelDescription.xml */
   const char* suffix = "modelDescription.xml";
   size_t n = strlen(so);
   int slashes = 0;
   char* path;
+#if defined(PKM_FMU_PLANT_SO) && defined(PKM_FMU_PLANT_XML)
+  if (strcmp(so, PKM_FMU_PLANT_SO) == 0) {
+    path = malloc(strlen(PKM_FMU_PLANT_XML) + 1);
+    if (path) strcpy(path, PKM_FMU_PLANT_XML);
+    return path;
+  }
+#endif
   while (n > 0 && slashes < 3)
     if (so[--n] == '/') ++slashes;
   if (slashes < 3) return NULL;

@@ -6,10 +6,10 @@
  *   pkm_fmu_bench [PKM4PUU.so [modelDescription.xml]]
  *
  * Default .so: the build's $<TARGET_FILE:PKM4PUU> (PKM_FMU_PLANT_SO). The
- * GUID and the value references are read at run time from the
- * modelDescription.xml of the unpacked FMU, i.e. <so>/../../../
- * modelDescription.xml (the FMU layout binaries/linux64/<id>.so), unless
- * given as the second argument.
+ * GUID and the value references are read at run time from a
+ * modelDescription.xml: the second argument if given, else the build's staged
+ * copy for the build's binary, else that of the unpacked FMU the .so sits in
+ * (<so>/../../../modelDescription.xml, the layout binaries/linux64/<id>.so).
  *
  * Scenario: the home pose (default parameters), F[1..4] = 2.655616050 N (the
  * static forces of MODEL_SPEC) plus 0.01 sin(2 pi t) N on F[1], set before
