@@ -87,6 +87,27 @@ elseif(_pkm_cpu MATCHES "^(aarch64|arm64)$")
 endif()
 set(PKM_FMU3_PLATFORM "${_pkm_cpu}-${_pkm_fmi3_os}")
 
+# The archives' entry dates: $SOURCE_DATE_EPOCH if set, else the date of the
+# commit being built (read at configure time), else 1980-01-01; with
+# cmake/pack_fmu.py writing nothing else that varies, the same commit builds
+# bit-identical .fmu files (reproducible-builds.org's convention).
+if(DEFINED ENV{SOURCE_DATE_EPOCH})
+  set(PKM_SOURCE_DATE_EPOCH "$ENV{SOURCE_DATE_EPOCH}")
+else()
+  execute_process(COMMAND git -C "${CMAKE_SOURCE_DIR}" log -1 --format=%ct
+                  OUTPUT_VARIABLE PKM_SOURCE_DATE_EPOCH OUTPUT_STRIP_TRAILING_WHITESPACE
+                  RESULT_VARIABLE _pkm_git_rc ERROR_QUIET)
+  if(NOT _pkm_git_rc EQUAL 0 OR NOT PKM_SOURCE_DATE_EPOCH MATCHES "^[0-9]+$")
+    set(PKM_SOURCE_DATE_EPOCH 315532800)
+  endif()
+endif()
+if(PKM_FMU_PYTHON)
+  set(_pkm_pack_python "${PKM_FMU_PYTHON}")
+else()
+  find_program(_pkm_pack_python NAMES python3 REQUIRED)
+endif()
+set(PKM_PACK_FMU "${CMAKE_CURRENT_LIST_DIR}/pack_fmu.py")
+
 # One FMU binary <id> (PREFIX "", only the fmi2* and fmi3* functions
 # exported, the C++ runtime linked statically) and its two archives:
 #   ${CMAKE_BINARY_DIR}/<id>.fmu       FMI 2.0 (Co-Simulation and Model Exchange)
@@ -140,12 +161,20 @@ function(pkm_add_fmu id)
       COMMAND ${CMAKE_COMMAND} -E copy "${md}" "${stage}/modelDescription.xml"
       COMMAND ${CMAKE_COMMAND} -E copy "$<TARGET_FILE:${id}>" "${stage}/binaries/${platform}/${binary_name}"
       COMMAND ${F_DOC_TOOL} ${id} "${stage}/documentation/index.html"
-      COMMAND ${CMAKE_COMMAND} -E chdir "${stage}" ${CMAKE_COMMAND} -E tar cf "${fmu}" --format=zip
+      COMMAND ${CMAKE_COMMAND} -E env SOURCE_DATE_EPOCH=${PKM_SOURCE_DATE_EPOCH}
+              "${_pkm_pack_python}" "${PKM_PACK_FMU}" "${fmu}" "${stage}"
               modelDescription.xml "binaries/${platform}/${binary_name}" documentation/index.html
-      DEPENDS ${id} "${md}" ${F_DOC_TOOL}
+      DEPENDS ${id} "${md}" ${F_DOC_TOOL} "${PKM_PACK_FMU}"
       COMMENT "Packaging ${fmu} (FMI ${version}.0)"
       VERBATIM)
     add_custom_target(${target} ALL DEPENDS "${fmu}")
+    if(PKM_BUILD_TESTS)
+      add_test(NAME fmu_archive_reproducible_fmi${version}_${id}
+               COMMAND ${CMAKE_COMMAND} -DFMU=${fmu} -DSTAGE=${stage} -DID=${id} -DDOC_TOOL=$<TARGET_FILE:${F_DOC_TOOL}>
+                       -DPYTHON=${_pkm_pack_python} -DPACK=${PKM_PACK_FMU} -DEPOCH=${PKM_SOURCE_DATE_EPOCH}
+                       -DWORK=${CMAKE_BINARY_DIR}/reproducible/fmi${version}_${id}
+                       -P ${CMAKE_CURRENT_FUNCTION_LIST_DIR}/check_reproducible_fmu.cmake)
+    endif()
     if(version EQUAL 2)
       set(${id}_FMU_DIR "${stage}" PARENT_SCOPE)
       set(${id}_FMU_FILE "${fmu}" PARENT_SCOPE)
