@@ -28,7 +28,14 @@ struct RefParams {
   double m_platform = 0.45474;
   double Izz_platform = 2874.21e-6;
   double g = 9.81;
+  // Spec "The machine around the mechanism": drives and payload (defaults: none).
+  double screw_lead = 0.004;   // m per revolution
+  double rotor_inertia = 0.0;  // kg m^2, turns at 2 pi rhod / screw_lead rad/s
+  double payload_mass = 0.0;   // kg, rigidly on the platform
+  std::array<double, 2> payload_com{0.0, 0.0};  // platform frame, relative to P, at P's height
+  double payload_Izz = 0.0;    // kg m^2 about its own centre of mass
 };
+
 
 // Elementary homogeneous transforms.
 inline Eigen::Matrix4d rot_z(double t) {
@@ -103,7 +110,15 @@ auto ddir(F f, const Q& q, const Q& qd) {
   return r;
 }
 
-// Spec "Bodies (Table III)": T = sum over legs (slider + rod) + platform.
+// The payload's centre of mass in the world: P + Rz(phi) c.
+inline Eigen::Vector3d payload_com_world(const RefParams& p, const Q& q) {
+  const Eigen::Vector3d c(p.payload_com[0], p.payload_com[1], 0.0);
+  return Eigen::Vector3d(q(12), q(13), q(14)) + rot_z(q(15)).block<3, 3>(0, 0) * c;
+}
+
+// Spec "Bodies (Table III)": T = sum over legs (slider + rod) + platform,
+// plus the machine's rotors (1/2 J w^2, w = 2 pi rhod / lead) and payload
+// (its centre's velocity by finite differences, 1/2 I_l phid^2).
 inline double kinetic_energy(const RefParams& p, const Q& q, const Q& qd) {
   double T = 0;
   const Eigen::Vector3d Irod(p.I_rod[0], p.I_rod[1], p.I_rod[2]);
@@ -123,6 +138,14 @@ inline double kinetic_energy(const RefParams& p, const Q& q, const Q& qd) {
   // Platform: CoM at P, rotates about z only.
   T += 0.5 * p.m_platform * qd.segment<3>(12).squaredNorm() +
        0.5 * p.Izz_platform * qd(15) * qd(15);
+  for (int i = 0; i < 4; ++i) {
+    const double w = 2 * kPi * qd(3 * i) / p.screw_lead;
+    T += 0.5 * p.rotor_inertia * w * w;
+  }
+  if (p.payload_mass != 0.0 || p.payload_Izz != 0.0) {
+    const Eigen::Vector3d v = ddir([&](const Q& qq) { return payload_com_world(p, qq); }, q, qd);
+    T += 0.5 * p.payload_mass * v.squaredNorm() + 0.5 * p.payload_Izz * qd(15) * qd(15);
+  }
   return T;
 }
 
@@ -134,7 +157,7 @@ inline double potential_energy(const RefParams& p, const Q& q) {
     V += p.m_slider * p.g * leg_frame(p, q, i, 1)(2, 3);
     V += p.m_rod * p.g * rod_com_world(p, q, i)(2);
   }
-  return V + p.m_platform * p.g * q(14);
+  return V + p.m_platform * p.g * q(14) + p.payload_mass * p.g * payload_com_world(p, q)(2);
 }
 
 }  // namespace ref

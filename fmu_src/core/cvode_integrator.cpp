@@ -13,7 +13,7 @@
 namespace pkm {
 namespace {
 
-Eigen::Map<Vec8> as_vec(N_Vector v) { return Eigen::Map<Vec8>(N_VGetArrayPointer(v)); }
+Eigen::Map<Vec10> as_vec(N_Vector v) { return Eigen::Map<Vec10>(N_VGetArrayPointer(v)); }
 
 }  // namespace
 
@@ -25,6 +25,8 @@ void CvodeIntegrator::release() {
   if (LS_) SUNLinSolFree(LS_);
   if (A_) SUNMatDestroy(A_);
   if (y_) N_VDestroy(y_);
+  if (atol_) N_VDestroy(atol_);
+  atol_ = nullptr;
   if (ctx_) SUNContext_Free(&ctx_);
   mem_ = nullptr;
   NLS_ = nullptr;
@@ -36,10 +38,15 @@ void CvodeIntegrator::release() {
 
 int CvodeIntegrator::rhs_trampoline(double t, N_Vector y, N_Vector ydot, void* self) {
   auto* me = static_cast<CvodeIntegrator*>(self);
-  Vec8 out;
+  Vec10 out;
   const int r = me->rhs_(t, as_vec(y), out, me->user_);
   if (r == 0) as_vec(ydot) = out;
   return r;
+}
+
+int CvodeIntegrator::root_trampoline(double t, N_Vector y, double* g, void* self) {
+  auto* me = static_cast<CvodeIntegrator*>(self);
+  return me->roots_(t, as_vec(y), g, me->user_);
 }
 
 void CvodeIntegrator::error_handler(int code, const char* module, const char* function, char* msg,
@@ -50,22 +57,32 @@ void CvodeIntegrator::error_handler(int code, const char* module, const char* fu
                std::to_string(code) + "): " + (msg ? msg : "");
 }
 
-Status CvodeIntegrator::init(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user) {
+Status CvodeIntegrator::init(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user, int n_roots,
+                             RootFn roots) {
   release();
   error_.clear();
   if (!(rtol > 0.0) || !(atol > 0.0) || !std::isfinite(rtol) || !std::isfinite(atol) || !rhs)
     return Status::InvalidArgument;
   rhs_ = rhs;
+  roots_ = roots;
   user_ = user;
   if (SUNContext_Create(nullptr, &ctx_) != 0) return Status::SolverFailure;
-  y_ = N_VNew_Serial(8, ctx_);
+  y_ = N_VNew_Serial(10, ctx_);
   mem_ = CVodeCreate(method == CvodeMethod::BDF ? CV_BDF : CV_ADAMS, ctx_);
   if (!y_ || !mem_) return Status::SolverFailure;
   CVodeSetErrHandlerFn(mem_, &CvodeIntegrator::error_handler, this);
   N_VConst(0.0, y_);
   int flag = CVodeInit(mem_, &CvodeIntegrator::rhs_trampoline, 0.0, y_);
   flag |= CVodeSetUserData(mem_, this);
-  flag |= CVodeSStolerances(mem_, rtol, atol);
+  // The motion (components 0..7) under rtol and atol; the two running
+  // energy integrals (8, 9) out of the error test, as CVODES treats
+  // quadratures by default: they follow the steps the motion needs (their
+  // integrands are smooth functions of the state), and a jump of their
+  // integrand at an end-stop contact does not force steps below the floor.
+  atol_ = N_VNew_Serial(10, ctx_);
+  if (!atol_) return Status::SolverFailure;
+  for (int k = 0; k < 10; ++k) N_VGetArrayPointer(atol_)[k] = k < 8 ? atol : 1e30;
+  flag |= CVodeSVtolerances(mem_, rtol, atol_);
   // Enough for a long communication interval at the natural step (~1 ms),
   // few enough that a run into a singularity fails in a fraction of a second.
   flag |= CVodeSetMaxNumSteps(mem_, 100000);
@@ -78,8 +95,9 @@ Status CvodeIntegrator::init(CvodeMethod method, double rtol, double atol, Rhs r
   // point. The floor is never reached by a step that succeeds otherwise, so
   // regular results are unchanged, bit for bit.
   flag |= CVodeSetMinStep(mem_, kMinStep);
+  if (roots && n_roots > 0) flag |= CVodeRootInit(mem_, n_roots, &CvodeIntegrator::root_trampoline);
   if (method == CvodeMethod::BDF) {
-    A_ = SUNDenseMatrix(8, 8, ctx_);
+    A_ = SUNDenseMatrix(10, 10, ctx_);
     LS_ = SUNLinSol_Dense(y_, A_, ctx_);
     if (!A_ || !LS_) return Status::SolverFailure;
     flag |= CVodeSetLinearSolver(mem_, LS_, A_);
@@ -92,7 +110,7 @@ Status CvodeIntegrator::init(CvodeMethod method, double rtol, double atol, Rhs r
   return flag == 0 ? Status::Ok : Status::SolverFailure;
 }
 
-Status CvodeIntegrator::reset(double t0, const Vec8& y0) {
+Status CvodeIntegrator::reset(double t0, const Vec10& y0) {
   if (!mem_) return Status::NotInitialized;
   as_vec(y_) = y0;
   if (CVodeReInit(mem_, t0, y_) != CV_SUCCESS) return Status::SolverFailure;
@@ -100,14 +118,24 @@ Status CvodeIntegrator::reset(double t0, const Vec8& y0) {
   return Status::Ok;
 }
 
-Status CvodeIntegrator::advance(double t_out, Vec8& y_out) {
+Status CvodeIntegrator::advance(double t_out, Vec10& y_out, double& t_reached, bool& root_found) {
   if (!mem_ || needs_reset_) return Status::NotInitialized;
   CVodeSetStopTime(mem_, t_out);
-  double t_reached = 0.0;
+  t_reached = 0.0;
+  root_found = false;
   const int flag = CVode(mem_, t_out, y_, &t_reached, CV_NORMAL);
   if (flag < 0) {
     needs_reset_ = true;  // its history is no longer trustworthy
     return Status::SolverFailure;
+  }
+  if (flag == CV_ROOT_RETURN) {
+    if (!as_vec(y_).allFinite()) {
+      needs_reset_ = true;
+      return Status::SolverFailure;
+    }
+    root_found = true;
+    y_out = as_vec(y_);
+    return Status::Ok;
   }
   // CVODE (6.4) can report success without having integrated: when the
   // state derivative is so large that the initial step underflows to 0 it
@@ -127,6 +155,7 @@ Status CvodeIntegrator::advance(double t_out, Vec8& y_out) {
     return Status::SolverFailure;
   }
   y_out = as_vec(y_);
+  t_reached = t_out;
   return Status::Ok;
 }
 

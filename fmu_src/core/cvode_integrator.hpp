@@ -1,6 +1,8 @@
 // SUNDIALS CVODE (variable-order, variable-step Adams or BDF) on the
-// 8-dimensional state of minimal_state.hpp. All SUNDIALS objects are created
-// once in init(); advancing allocates nothing.
+// plant's integrated vector: the 8-dimensional state of minimal_state.hpp
+// and the two running energy integrals (plant.hpp). Optional root finding
+// (the end stops' event indicators). All SUNDIALS objects are created once
+// in init(); advancing allocates nothing.
 #pragma once
 
 #include <string>
@@ -26,18 +28,25 @@ class CvodeIntegrator {
  public:
   /// ydot = rhs(t, y); returns 0 on success, > 0 for a recoverable failure
   /// (CVODE retries with a smaller step), < 0 to abort.
-  using Rhs = int (*)(double t, const Vec8& y, Vec8& ydot, void* user);
+  using Rhs = int (*)(double t, const Vec10& y, Vec10& ydot, void* user);
+  /// g[0..n_roots-1] at (t, y); returns 0 on success, nonzero to abort.
+  using RootFn = int (*)(double t, const Vec10& y, double* g, void* user);
 
   CvodeIntegrator() = default;
   ~CvodeIntegrator();
   CvodeIntegrator(const CvodeIntegrator&) = delete;
   CvodeIntegrator& operator=(const CvodeIntegrator&) = delete;
 
-  Status init(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user);
+  /// `roots` (may be null) with `n_roots` indicators: CVODE stops where one
+  /// changes sign (CVodeRootInit).
+  Status init(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user, int n_roots = 0,
+              RootFn roots = nullptr);
   /// Restart the history at (t0, y0): needed after any jump in the inputs.
-  Status reset(double t0, const Vec8& y0);
-  /// Integrates to t_out exactly (stop time set, no overshoot).
-  Status advance(double t_out, Vec8& y_out);
+  Status reset(double t0, const Vec10& y0);
+  /// Integrates towards t_out (stop time set, no overshoot). Returns at
+  /// t_out, or earlier at a root of the indicators (`root_found` set,
+  /// `t_reached` its time; the caller restarts there with reset()).
+  Status advance(double t_out, Vec10& y_out, double& t_reached, bool& root_found);
 
   bool ready() const { return mem_ != nullptr; }
   bool needs_reset() const { return needs_reset_; }
@@ -47,6 +56,7 @@ class CvodeIntegrator {
 
  private:
   static int rhs_trampoline(double t, _generic_N_Vector* y, _generic_N_Vector* ydot, void* self);
+  static int root_trampoline(double t, _generic_N_Vector* y, double* g, void* self);
   static void error_handler(int code, const char* module, const char* function, char* msg,
                             void* self);
   void release();
@@ -54,10 +64,12 @@ class CvodeIntegrator {
   _SUNContext* ctx_ = nullptr;
   void* mem_ = nullptr;  // CVODE memory
   _generic_N_Vector* y_ = nullptr;
+  _generic_N_Vector* atol_ = nullptr;
   _generic_SUNMatrix* A_ = nullptr;                // BDF: dense Jacobian
   _generic_SUNLinearSolver* LS_ = nullptr;         // BDF: dense LU
   _generic_SUNNonlinearSolver* NLS_ = nullptr;     // Adams: fixed point
   Rhs rhs_ = nullptr;
+  RootFn roots_ = nullptr;
   void* user_ = nullptr;
   bool needs_reset_ = true;
   std::string error_;

@@ -2,6 +2,7 @@
 
 #include "constraints.hpp"
 #include "lagrangian.hpp"
+#include "machine.hpp"
 
 namespace pkm {
 namespace {
@@ -34,9 +35,28 @@ Status actuator_forces(const Model& m, const Vec16& q, const Vec16& qd, const Ve
   lambda = lu.solve(rhs);  // Eq. 10
   for (int i = 0; i < kLegs; ++i) {
     const int k = kActuated[i];
-    F[i] = inertial[k] + Cq.col(k).dot(lambda);  // Eq. 11
+    F[i] = inertial[k] + Cq.col(k).dot(lambda)  // Eq. 11
+           - passive_joint_force(m.p, q[k], qd[k]);
   }
   if (!F.allFinite() || !lambda.allFinite()) return Status::Singular;
+  return Status::Ok;
+}
+
+unsigned joints_beyond_stops(const Params& p, const Vec16& q) {
+  unsigned mask = 0;
+  for (int i = 0; i < kLegs; ++i) {
+    const double rho = q[leg_offset(i)];
+    if (rho < p.rho_min) mask |= 1u << i;
+    if (rho > p.rho_max) mask |= 1u << (kLegs + i);
+  }
+  return mask;
+}
+
+Status holding_forces(const Model& m, const Vec16& q, const Wrench& we, Vec4& F) {
+  Vec12 lambda;
+  const Status s = actuator_forces(m, q, Vec16::Zero(), Vec16::Zero(), we, F, lambda);
+  if (s != Status::Ok) return s;
+  for (int i = 0; i < kLegs; ++i) F[i] += stop_force(m.p, q[leg_offset(i)], 0.0);  // not counted on
   return Status::Ok;
 }
 
@@ -57,7 +77,10 @@ Status inverse_dynamics(const Model& m, const Pose& pose, const Pose& pose_d, co
   if (s != Status::Ok) return s;
   out.qd = J.velocity(pose_d);
   out.qdd = J.acceleration(m, out.q, out.qd, pose_dd);
-  return actuator_forces(m, out.q, out.qd, out.qdd, we, out.F, out.lambda);
+  out.beyond_stops = joints_beyond_stops(m.p, out.q);
+  s = actuator_forces(m, out.q, out.qd, out.qdd, we, out.F, out.lambda);
+  out.tau = out.F / m.drive_ratio;
+  return s;
 }
 
 }  // namespace pkm

@@ -9,15 +9,34 @@
 
 namespace pkm {
 
+//
+// The machine (machine.hpp) is included: the rotor's reflected mass and the
+// payload through M, V and G, and the joints' passive forces (friction and,
+// beyond a stop, the stop's force) are subtracted, so that F is what the
+// actuators must add for the plant to follow the motion. A motion whose
+// rho lies beyond an end stop is still solved; `beyond_stops` reports it.
 struct InverseDynamicsResult {
   Vec16 q, qd, qdd;
   Vec12 lambda;
   Vec4 F;
+  /// The equivalent motor torques, F_i p / (2 pi) (N*m).
+  Vec4 tau = Vec4::Zero();
+  /// Bit i set (i = 0..3): rho_i < rho_min; bit 4 + i: rho_i > rho_max.
+  unsigned beyond_stops = 0;
 };
 
-/// Eqs. 10-11 at a known motion (q, qd, qdd), external wrench `we`.
+/// Bit mask of the joints beyond their end stops (InverseDynamicsResult).
+unsigned joints_beyond_stops(const Params& p, const Vec16& q);
+
+/// Eqs. 10-11 at a known motion (q, qd, qdd), external wrench `we`: the
+/// actuator forces on top of the joints' passive forces (header comment).
 Status actuator_forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& qdd,
                        const Wrench& we, Vec4& F, Vec12& lambda);
+
+/// The actuator forces that hold the configuration q at rest under gravity,
+/// the payload and the wrench `we` (no friction at rest; the end stops'
+/// springs are not counted on: gravity compensation for a controller).
+Status holding_forces(const Model& m, const Vec16& q, const Wrench& we, Vec4& F);
 
 /// The whole inverse problem for a platform motion: position (Newton from
 /// the guess in out.q, or from the closed form when `warm_start` is false),

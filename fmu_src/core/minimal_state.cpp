@@ -1,6 +1,7 @@
 #include "minimal_state.hpp"
 
 #include "constraints.hpp"
+#include "machine.hpp"
 #include "reduced_dynamics.hpp"
 #include "servo_kinematics.hpp"
 
@@ -22,8 +23,17 @@ Status expand_state(const Model& m, const Vec8& y, Vec16& q, Vec16& qd) {
   return Status::Ok;
 }
 
+Vec16 with_passive_forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f) {
+  Vec16 out = f;
+  for (int i = 0; i < kLegs; ++i) {
+    const int o = leg_offset(i);
+    out[o] += passive_joint_force(m.p, q[o], qd[o]);
+  }
+  return out;
+}
+
 Status state_derivative(const Model& m, Formulation form, const Vec8& y, const Vec16& f, Vec8& ydot,
-                        MechanismState* full) {
+                        MechanismState* full, JointMotion* joints) {
   if (!y.allFinite() || !f.allFinite()) return Status::NonFinite;
   ydot.head<4>() = y.tail<4>();
   if (form == Formulation::LegPartitioned && full == nullptr) {
@@ -39,7 +49,12 @@ Status state_derivative(const Model& m, Formulation form, const Vec8& y, const V
       if (s != Status::Ok) return s;
       s = rd.prepare_leg(m, i, c, pc);
       if (s != Status::Ok) return s;
-      rd.add_leg(m, i, rd.leg_velocity(i, pd), pd[3], f[leg_offset(i)]);
+      const Vec3 qd_leg = rd.leg_velocity(i, pd);
+      rd.add_leg(m, i, qd_leg, pd[3], f[leg_offset(i)] + passive_joint_force(m.p, c.rho, qd_leg[0]));
+      if (joints) {
+        joints->rho[i] = c.rho;
+        joints->rhod[i] = qd_leg[0];
+      }
     }
     Pose pdd;
     const Status s = rd.solve_platform(m, f.segment<4>(kPlatform), pdd);
@@ -50,8 +65,14 @@ Status state_derivative(const Model& m, Formulation form, const Vec8& y, const V
   MechanismState& st = full ? *full : local;
   Status s = expand_state(m, y, st.q, st.qd);
   if (s != Status::Ok) return s;
-  s = forward_dynamics(m, form, st.q, st.qd, f, st.qdd, st.lambda);
+  s = forward_dynamics(m, form, st.q, st.qd, with_passive_forces(m, st.q, st.qd, f), st.qdd, st.lambda);
   if (s != Status::Ok) return s;
+  if (joints) {
+    for (int i = 0; i < kLegs; ++i) {
+      joints->rho[i] = st.q[leg_offset(i)];
+      joints->rhod[i] = st.qd[leg_offset(i)];
+    }
+  }
   ydot.tail<4>() = st.qdd.segment<4>(kPlatform);
   return Status::Ok;
 }

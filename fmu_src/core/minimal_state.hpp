@@ -24,9 +24,20 @@ struct MechanismState {
 /// outside if continuity matters).
 Status expand_state(const Model& m, const Vec8& y, Vec16& q, Vec16& qd);
 
-/// dy/dt for generalised forces f (Eq. 1's right-hand side), with the
-/// chosen formulation. If `full` is given it receives q, qd, qdd, lambda.
+/// The actuated joints at a state.
+struct JointMotion {
+  Vec4 rho = Vec4::Zero(), rhod = Vec4::Zero();
+};
+
+/// dy/dt for the applied generalised forces f (actuators, drives, external
+/// wrench: Eq. 1's right-hand side), with the chosen formulation; the
+/// joints' passive forces (friction, end stops: machine.hpp) are added here
+/// from the state. If `full` is given it receives q, qd, qdd, lambda; if
+/// `joints` is given, rho and rhod.
 Status state_derivative(const Model& m, Formulation form, const Vec8& y, const Vec16& f, Vec8& ydot,
-                        MechanismState* full = nullptr);
+                        MechanismState* full = nullptr, JointMotion* joints = nullptr);
+
+/// f plus the passive joint forces at (q, qd).
+Vec16 with_passive_forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f);
 
 }  // namespace pkm

@@ -18,7 +18,14 @@ Status make_model(const Params& p, Model& out, std::string* error) {
     const double a = p.beta[i] + p.gamma[i];
     out.r_Q[i] = Vec3(p.r_Q * std::cos(a), p.r_Q * std::sin(a), 0.0);
   }
-  out.total_mass = p.m_platform + kLegs * (p.m_slider + p.m_rod);
+  out.total_mass = p.m_platform + p.payload_mass + kLegs * (p.m_slider + p.m_rod);
+  out.drive_ratio = 2.0 * kPi / p.screw_lead;
+  out.reflected_mass = p.rotor_inertia * out.drive_ratio * out.drive_ratio;
+  out.platform_mass = p.m_platform + p.payload_mass;
+  const double c2 = p.payload_com[0] * p.payload_com[0] + p.payload_com[1] * p.payload_com[1];
+  out.platform_Izz = p.Izz_platform + p.payload_Izz + p.payload_mass * c2;
+  out.payload_mx = p.payload_mass * p.payload_com[0];
+  out.payload_my = p.payload_mass * p.payload_com[1];
   return Status::Ok;
 }
 

@@ -19,8 +19,15 @@ struct Model {
   std::array<double, kLegs> cos_beta, sin_beta;
   // Platform attachment point of leg i in the platform frame, r_Qi.
   std::array<Vec3, kLegs> r_Q;
-  // Total mass carried by gravity (platform, sliders, rods), kg.
+  // Total mass carried by gravity (platform, sliders, rods, payload), kg.
   double total_mass = 0;
+  // Derived machine quantities (params.hpp, "The machine around the mechanism").
+  double drive_ratio = 0;     // 2 pi / screw_lead: force on rho per motor torque, 1/m
+  double reflected_mass = 0;  // rotor_inertia (2 pi / screw_lead)^2, kg, on each rho's diagonal
+  // The platform with its payload as one rigid body, about P:
+  double platform_mass = 0;   // m_platform + payload_mass, kg
+  double platform_Izz = 0;    // Izz_platform + payload_Izz + payload_mass |payload_com|^2, kg*m^2
+  double payload_mx = 0, payload_my = 0;  // payload_mass * payload_com (platform frame), kg*m
 };
 
 /// Validates `p` and derives the placement. On failure returns

@@ -28,6 +28,30 @@ struct Params {
   double Izz_platform = 2874.21e-6;
   // Gravity along -z_G, m/s^2. Zero is allowed (the comparison test).
   double g = 9.81;
+
+  // The machine around the mechanism (MODEL_SPEC "The machine around the
+  // mechanism"). Every default leaves the paper's ideal mechanism unchanged.
+  // Drives: a motor on a ball screw per actuator.
+  double screw_lead = 0.004;       // m per revolution, > 0
+  double rotor_inertia = 0.0;      // kg*m^2 (motor + screw), >= 0
+  // Joint friction in each prismatic joint:
+  //   F_fric = -friction_viscous rhod - friction_coulomb tanh(rhod / friction_velocity).
+  double friction_viscous = 0.0;   // N*s/m, >= 0
+  double friction_coulomb = 0.0;   // N, >= 0
+  double friction_velocity = 1e-3; // m/s, > 0
+  // End stops: each slider travels in [rho_min, rho_max]; past a limit by
+  // depth delta > 0 a compliant stop pushes back with k delta + d delta_dot,
+  // never pulling.
+  double rho_min = 0.0;            // m
+  double rho_max = 0.15;           // m, > rho_min
+  double stop_stiffness = 1e5;     // N/m, >= 0
+  double stop_damping = 100.0;     // N*s/m, >= 0
+  // Payload rigidly fixed to the platform: mass, centre of mass in the
+  // platform frame relative to P (at P's height), inertia about its own
+  // centre of mass.
+  double payload_mass = 0.0;                 // kg, >= 0
+  std::array<double, 2> payload_com{0.0, 0.0};  // m
+  double payload_Izz = 0.0;                  // kg*m^2, >= 0
 };
 
 /// Checks every parameter. Returns an empty string when they are valid,

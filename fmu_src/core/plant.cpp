@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "constraints.hpp"
+#include "inverse_dynamics.hpp"
 #include "lagrangian.hpp"
 #include "rk4.hpp"
 #include "servo_kinematics.hpp"
@@ -20,14 +21,32 @@ void eval_linear(void* user, double t, Vec4& F, Wrench& we) {
   we = in->we0 + in->dwe * dt;
 }
 
-void read_inputs(const InputSignal& in, double t, Vec4& F, Wrench& we) {
+void eval_linear_tau(void* user, double t, Vec4& tau) {
+  const auto* in = static_cast<const LinearInputs*>(user);
+  tau = in->tau0 + in->dtau * (t - in->t0);
+}
+
+void read_inputs(const InputSignal& in, double t, Vec4& F, Wrench& we, Vec4& tau) {
   if (in.eval) {
     in.eval(in.user, t, F, we);
   } else {
     F.setZero();
     we.setZero();
   }
+  if (in.eval_tau) {
+    in.eval_tau(in.user, t, tau);
+  } else {
+    tau.setZero();
+  }
 }
+
+// RK4 contact location (Plant::advance_rk4): at most this many located
+// events per grid step (beyond, the step goes on without locating: a
+// chattering contact), and the bisection's resolution in time.
+constexpr int kMaxEventsPerStep = 64;
+double event_time_tolerance(double t) { return 1e-12 + 8.0 * std::numeric_limits<double>::epsilon() * std::fabs(t); }
+// CVODE: at most this many roots in one advance.
+constexpr int kMaxEventsPerAdvance = 100000;
 
 double unwrap_near(double angle, double ref) {
   constexpr double two_pi = 2.0 * kPi;
@@ -36,7 +55,7 @@ double unwrap_near(double angle, double ref) {
 
 }  // namespace
 
-InputSignal LinearInputs::signal() { return {&eval_linear, this}; }
+InputSignal LinearInputs::signal() { return {&eval_linear, this, &eval_linear_tau}; }
 
 std::string validate(const SolverSettings& s) {
   char buf[160];
@@ -105,9 +124,10 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
   }
   y_ = y;
   t_ = t0;
+  energy_ = EnergyIntegrals{};
   for (int i = 0; i < kLegs; ++i) theta1_ref_[i] = q[leg_offset(i) + 1];
   theta1_stale_ = false;
-  if (cvode_ready_) cvode_.reset(t_, y_);
+  if (cvode_ready_) cvode_.reset(t_, packed());
   initialized_ = true;
   return Status::Ok;
 }
@@ -123,7 +143,7 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
   y_ = y;
   theta1_ref_ = theta1_ref;
   theta1_stale_ = false;
-  if (cvode_ready_) cvode_.reset(t_, y_);
+  if (cvode_ready_) cvode_.reset(t_, packed());
   initialized_ = true;
   return Status::Ok;
 }
@@ -149,25 +169,104 @@ Status Plant::derivative_now(const InputSignal& inputs, Vec8& ydot) const {
   if (!initialized_) return Status::NotInitialized;
   Vec4 F;
   Wrench we;
-  read_inputs(inputs, t_, F, we);
-  return state_derivative(model_, settings_.formulation, y_, generalized_forces(F, we), ydot);
+  Vec4 tau;
+  read_inputs(inputs, t_, F, we, tau);
+  return state_derivative(model_, settings_.formulation, y_, generalized_forces(model_, F, tau, we), ydot);
 }
 
-Status Plant::derivative(double t, const Vec8& y, Vec8& ydot) {
-  Vec4 F;
+Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e) {
+  if (!std::isfinite(e.actuator_work) || !std::isfinite(e.dissipated)) return Status::NonFinite;
+  const EnergyIntegrals keep = energy_;
+  energy_ = e;
+  const Status s = restore(t, y, theta1_ref);
+  if (s != Status::Ok) energy_ = keep;
+  return s;
+}
+
+Vec10 Plant::packed() const {
+  Vec10 x;
+  x.head<8>() = y_;
+  x[8] = energy_.actuator_work;
+  x[9] = energy_.dissipated;
+  return x;
+}
+
+void Plant::unpack(const Vec10& x) {
+  y_ = x.head<8>();
+  energy_.actuator_work = x[8];
+  energy_.dissipated = x[9];
+}
+
+unsigned Plant::contact_mask(const Vec10& x) const {
+  Vec4 rho;
+  if (actuator_positions(model_, x.head<4>(), rho) != Status::Ok) return ~0u;
+  unsigned mask = 0;
+  for (int i = 0; i < kLegs; ++i) {
+    if (rho[i] < model_.p.rho_min) mask |= 1u << i;
+    if (rho[i] > model_.p.rho_max) mask |= 1u << (kLegs + i);
+  }
+  if (mask == 0) return mask;
+  // Past a stop: also whether the stop is released (its spring and damper
+  // would pull, the force is held at 0), a kink in the force that RK4
+  // should not step across either. Needs the joint rates.
+  Vec16 q, qd;
+  if (expand_state(model_, x.head<8>(), q, qd) != Status::Ok) return ~0u;
+  for (int i = 0; i < kLegs; ++i) {
+    const StopContact c = stop_contact(model_.p, rho[i], qd[leg_offset(i)]);
+    if (c.depth > 0.0 && c.force == 0.0) mask |= 1u << (2 * kLegs + i);
+  }
+  return mask;
+}
+
+double Plant::contact_step() const {
+  // The fastest motion a stop can excite in one joint: its spring and
+  // damper against the least mass that can sit behind rho_i, the slider
+  // with its rotor (the rest of the mechanism only adds mass). A tenth of
+  // the inverse rate keeps RK4's error per step near (0.1)^5 / 120 ~ 1e-7
+  // of the contact's motion.
+  const double mass = model_.p.m_slider + model_.reflected_mass;
+  const double rate = std::sqrt(model_.p.stop_stiffness / mass) + model_.p.stop_damping / mass;
+  return rate > 0.0 ? 0.1 / rate : std::numeric_limits<double>::infinity();
+}
+
+Status Plant::derivative(double t, const Vec10& x, Vec10& xdot) {
+  Vec4 F, tau;
   Wrench we;
   ++rhs_count_;
   // A non-finite trial time or state is the integrator's (a step size
   // computed from absurd accelerations), not the inputs': the step fails,
   // the state is kept.
   if (!std::isfinite(t)) return Status::SolverFailure;
-  read_inputs(inputs_, t, F, we);
-  if (!F.allFinite() || !we.allFinite()) return Status::NonFinite;  // the inputs' fault
-  const Status s = state_derivative(model_, settings_.formulation, y, generalized_forces(F, we), ydot);
-  return s == Status::NonFinite ? Status::SolverFailure : s;  // finite inputs: the trial state was not
+  read_inputs(inputs_, t, F, we, tau);
+  if (!F.allFinite() || !we.allFinite() || !tau.allFinite()) return Status::NonFinite;  // the inputs' fault
+  const Vec4 Fa = F + model_.drive_ratio * tau;  // actuator force plus the screw's
+  const Vec8 y = x.head<8>();
+  Vec8 ydot;
+  JointMotion jm;
+  const Status s = state_derivative(model_, settings_.formulation, y, generalized_forces(Fa, we), ydot, nullptr, &jm);
+  if (s != Status::Ok) return s == Status::NonFinite ? Status::SolverFailure : s;  // finite inputs: the trial state was not
+  xdot.head<8>() = ydot;
+  // The energy audit's integrands: the inputs' power and the dissipation.
+  xdot[8] = Fa.dot(jm.rhod) + we.dot(y.tail<4>());
+  double diss = 0.0;
+  for (int i = 0; i < kLegs; ++i) diss += dissipated_power(model_.p, jm.rho[i], jm.rhod[i]);
+  xdot[9] = diss;
+  return Status::Ok;
 }
 
-int Plant::cvode_rhs(double t, const Vec8& y, Vec8& ydot, void* self) {
+int Plant::cvode_roots(double t, const Vec10& x, double* g, void* self) {
+  (void)t;
+  const auto* me = static_cast<const Plant*>(self);
+  Vec4 rho;
+  if (actuator_positions(me->model_, x.head<4>(), rho) != Status::Ok) {
+    for (int k = 0; k < kStopIndicators; ++k) g[k] = 1.0;  // off the workspace: the rhs reports it
+    return 0;
+  }
+  stop_indicators(me->model_.p, rho, g);
+  return 0;
+}
+
+int Plant::cvode_rhs(double t, const Vec10& y, Vec10& ydot, void* self) {
   auto* me = static_cast<Plant*>(self);
   const Status s = me->derivative(t, y, ydot);
   me->rhs_status_ = s;
@@ -202,25 +301,70 @@ Status Plant::advance_rk4(double t_end) {
   }
   const long n = std::max(1L, static_cast<long>(steps));
   const double h = span / static_cast<double>(n);
-  auto f = [this](double t, const Vec8& y, Vec8& ydot) { return derivative(t, y, ydot); };
+  auto f = [this](double t, const Vec10& x, Vec10& xdot) { return derivative(t, x, xdot); };
   const double t0 = t_;
+  const double h_contact = contact_step();
   for (long k = 0; k < n; ++k) {
     const double tk = (k == 0) ? t0 : t0 + static_cast<double>(k) * h;
-    const Vec8 before = y_;
-    Status s = rk4_step(f, tk, h, y_);
+    const double t_next = (k + 1 == n) ? t_end : t0 + static_cast<double>(k + 1) * h;
+    // One grid step, split where a joint reaches or leaves an end stop
+    // (the stop force switches on or off there) and, while a joint is past
+    // a stop, into substeps of h_contact. A split is located by bisection
+    // on re-stepping from the step's start: the shortest step after which
+    // the set of joints past their stops has changed.
+    Vec10 x = packed();
+    double t = tk;
+    unsigned mask = contact_mask(x);
+    int events = 0;
+    Status s = Status::Ok;
+    while (t < t_next && s == Status::Ok) {
+      double step = t_next - t;
+      bool to_end = true;
+      if (mask != 0 && step > h_contact) {
+        step = h_contact;
+        to_end = false;
+      }
+      Vec10 trial = x;
+      s = rk4_step(f, t, step, trial);
+      if (s != Status::Ok) break;
+      unsigned trial_mask = contact_mask(trial);
+      if (trial_mask == ~0u) trial_mask = mask;  // off the workspace: the guard reports it
+      if (trial_mask != mask && events < kMaxEventsPerStep) {
+        double lo = 0.0, hi = step;
+        const double tol = event_time_tolerance(t);
+        while (hi - lo > tol && s == Status::Ok) {
+          const double mid = 0.5 * (lo + hi);
+          Vec10 xm = x;
+          s = rk4_step(f, t, mid, xm);
+          const unsigned mm = contact_mask(xm);
+          if (mm == mask || mm == ~0u) {
+            lo = mid;
+          } else {
+            hi = mid;
+            trial = xm;
+            trial_mask = mm;
+          }
+        }
+        if (s != Status::Ok) break;
+        if (hi < step) to_end = false;
+        step = hi;
+        ++events;
+        ++contact_events_;
+      }
+      x = trial;
+      mask = trial_mask;
+      t = to_end ? t_next : t + step;
+    }
     if (s != Status::Ok) {
       char buf[160];
-      std::snprintf(buf, sizeof buf, "the RK4 step from t = %.17g s could not be evaluated: %s", tk,
+      std::snprintf(buf, sizeof buf, "the RK4 step from t = %.17g s could not be evaluated: %s", t,
                     status_name(s));
       error_ = buf;
       return s;
     }
-    const double t_next = (k + 1 == n) ? t_end : t0 + static_cast<double>(k + 1) * h;
-    s = guard(y_, t_next);  // every step ends within the limits, or is undone
-    if (s != Status::Ok) {
-      y_ = before;
-      return s;
-    }
+    s = guard(x.head<8>(), t_next);  // every step ends within the limits, or is undone
+    if (s != Status::Ok) return s;
+    unpack(x);
     t_ = t_next;
   }
   return Status::Ok;
@@ -229,7 +373,7 @@ Status Plant::advance_rk4(double t_end) {
 Status Plant::advance_cvode(double t_end, bool continuous) {
   if (!cvode_ready_) {
     Status s = cvode_.init(settings_.cvode_method, settings_.rtol, settings_.atol, &Plant::cvode_rhs,
-                           this);
+                           this, kStopIndicators, &Plant::cvode_roots);
     if (s != Status::Ok) {
       error_ = "CVODE could not be set up: " + cvode_.last_error();
       return s;
@@ -238,23 +382,46 @@ Status Plant::advance_cvode(double t_end, bool continuous) {
     continuous = false;
   }
   if (!continuous || cvode_.needs_reset()) {
-    const Status s = cvode_.reset(t_, y_);
+    const Status s = cvode_.reset(t_, packed());
     if (s != Status::Ok) return s;
   }
-  Vec8 y = y_;
+  Vec10 x = packed();
   rhs_status_ = Status::Ok;
-  Status s = cvode_.advance(t_end, y);
+  // CVODE stops at every root of the stop indicators (a joint reaching or
+  // leaving a stop: the stop force switches there); the history restarts
+  // at that point, then integration goes on to t_end.
+  int events = 0;
+  Status s = Status::Ok;
+  for (;;) {
+    double t_reached = t_end;
+    bool root = false;
+    s = cvode_.advance(t_end, x, t_reached, root);
+    if (s != Status::Ok) break;
+    if (!root) break;
+    ++contact_events_;
+    if (++events > kMaxEventsPerAdvance) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "more than %d end-stop events before t = %.17g s (chattering contact)",
+                    kMaxEventsPerAdvance, t_end);
+      cvode_.reset(t_, packed());
+      error_ = buf;
+      return Status::SolverFailure;
+    }
+    if (!(t_reached < t_end)) break;
+    s = cvode_.reset(t_reached, x);
+    if (s != Status::Ok) break;
+  }
   if (s != Status::Ok) {
     error_ = cvode_.last_error();
-    cvode_.reset(t_, y_);
+    cvode_.reset(t_, packed());
     return rhs_status_ != Status::Ok ? rhs_status_ : s;
   }
-  s = guard(y, t_end);  // the interval ends within the limits, or is undone
+  s = guard(x.head<8>(), t_end);  // the interval ends within the limits, or is undone
   if (s != Status::Ok) {
-    cvode_.reset(t_, y_);
+    cvode_.reset(t_, packed());
     return s;
   }
-  y_ = y;
+  unpack(x);
   t_ = t_end;
   return Status::Ok;
 }
@@ -286,16 +453,43 @@ void Plant::update_theta1_ref() const {
 
 Status Plant::mechanism(const InputSignal& inputs, MechanismState& out) const {
   if (!initialized_) return Status::NotInitialized;
-  Vec4 F;
+  Vec4 F, tau;
   Wrench we;
-  read_inputs(inputs, t_, F, we);
+  read_inputs(inputs, t_, F, we, tau);
   Vec8 ydot;
-  const Status s = state_derivative(model_, settings_.formulation, y_, generalized_forces(F, we), ydot, &out);
+  const Status s = state_derivative(model_, settings_.formulation, y_, generalized_forces(model_, F, tau, we),
+                                    ydot, &out);
   if (s != Status::Ok) return s;
   for (int i = 0; i < kLegs; ++i) {
     double& th1 = out.q[leg_offset(i) + 1];
     th1 = unwrap_near(th1, theta1_ref()[i]);
   }
+  return Status::Ok;
+}
+
+Status Plant::machine_outputs(const InputSignal& inputs, MachineOutputs& out) const {
+  if (!initialized_) return Status::NotInitialized;
+  Vec16 q, qd;
+  Status s = expand_state(model_, y_, q, qd);
+  if (s != Status::Ok) return s;
+  Vec4 F, tau;
+  Wrench we;
+  read_inputs(inputs, t_, F, we, tau);
+  const Params& p = model_.p;
+  for (int i = 0; i < kLegs; ++i) {
+    const int o = leg_offset(i);
+    out.rho[i] = q[o];
+    out.rhod[i] = qd[o];
+    out.stop_force[i] = stop_force(p, q[o], qd[o]);
+    out.friction_force[i] = friction_force(p, qd[o]);
+  }
+  s = holding_forces(model_, q, we, out.F_hold);
+  if (s != Status::Ok) return s;
+  out.kinetic_energy = kinetic_energy(model_, q, qd);
+  out.potential_energy = potential_energy(model_, q);
+  out.actuator_work = energy_.actuator_work;
+  out.dissipated_energy = energy_.dissipated;
+  stop_indicators(p, out.rho, out.stop_indicators);
   return Status::Ok;
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cvode_integrator.hpp"
+#include "machine.hpp"
 #include "minimal_state.hpp"
 #include "workspace_guard.hpp"
 
@@ -38,10 +39,12 @@ constexpr double kMaxRk4StepsPerAdvance = 1e7;
 std::string validate(const SolverSettings& s);
 
 /// Inputs over an interval: actuator forces F (N) and the external platform
-/// wrench (N, N*m) at time t.
+/// wrench (N, N*m) at time t; optionally the motor torques tau (N*m, zero
+/// when eval_tau is null), called with the same user pointer.
 struct InputSignal {
   void (*eval)(void* user, double t, Vec4& F, Wrench& we) = nullptr;
   void* user = nullptr;
+  void (*eval_tau)(void* user, double t, Vec4& tau) = nullptr;
 };
 
 /// Inputs held constant, or varying linearly: F(t) = F0 + dF (t - t0).
@@ -49,7 +52,31 @@ struct LinearInputs {
   double t0 = 0;
   Vec4 F0 = Vec4::Zero(), dF = Vec4::Zero();
   Wrench we0 = Wrench::Zero(), dwe = Wrench::Zero();
+  Vec4 tau0 = Vec4::Zero(), dtau = Vec4::Zero();
   InputSignal signal();
+};
+
+/// The running integrals of the plant's energy audit (J), integrated with
+/// the motion by the same integrator: kinetic + potential - actuator_work +
+/// dissipated stays constant.
+struct EnergyIntegrals {
+  double actuator_work = 0;  // of (F_i + (2 pi/p) tau_i) rhod_i plus the external wrench's power
+  double dissipated = 0;     // friction plus the end stops' damping
+};
+
+/// The machine's outputs at the current time (MODEL_SPEC "The machine
+/// around the mechanism").
+struct MachineOutputs {
+  Vec4 rho = Vec4::Zero(), rhod = Vec4::Zero();  // m, m/s
+  Vec4 stop_force = Vec4::Zero();      // N, signed along +z
+  Vec4 friction_force = Vec4::Zero();  // N, signed along +z
+  Vec4 F_hold = Vec4::Zero();          // N: holds the current pose at rest (gravity, payload, wrench)
+  double kinetic_energy = 0;           // J, rotors included
+  double potential_energy = 0;         // J, gravity plus the stops' springs
+  double actuator_work = 0;            // J, running integral
+  double dissipated_energy = 0;        // J, running integral
+  /// Event indicators (machine.hpp): rho_i - rho_min, then rho_max - rho_i.
+  double stop_indicators[kStopIndicators] = {};
 };
 
 class Plant {
@@ -85,8 +112,20 @@ class Plant {
   /// The integrated state [pose; velocity].
   const Vec8& state() const { return y_; }
   /// Restores a state saved earlier (time, y, theta1 continuity); refused
-  /// (nothing changes) if y lies beyond the singularity limits.
+  /// (nothing changes) if y lies beyond the singularity limits. The energy
+  /// integrals keep their values unless given.
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref);
+  Status restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e);
+
+  /// The running energy integrals (zero at initialize()).
+  const EnergyIntegrals& energy_integrals() const { return energy_; }
+
+  /// stop_force, F_hold, energies and the stop indicators at the current
+  /// time, for the inputs at that time.
+  Status machine_outputs(const InputSignal& inputs, MachineOutputs& out) const;
+
+  /// End-stop contact events located so far (RK4 step splits, CVODE roots).
+  long contact_events() const { return contact_events_; }
 
   // ---- Model Exchange: the importer's integrator owns time and state.
   /// Sets the time (the state is kept).
@@ -118,8 +157,17 @@ class Plant {
   const std::string& last_error() const { return error_; }
 
  private:
-  static int cvode_rhs(double t, const Vec8& y, Vec8& ydot, void* self);
-  Status derivative(double t, const Vec8& y, Vec8& ydot);
+  static int cvode_rhs(double t, const Vec10& x, Vec10& xdot, void* self);
+  static int cvode_roots(double t, const Vec10& x, double* g, void* self);
+  /// d/dt of x = [y; actuator_work; dissipated].
+  Status derivative(double t, const Vec10& x, Vec10& xdot);
+  Vec10 packed() const;
+  void unpack(const Vec10& x);
+  /// Which joints are past a stop at the pose x.head<4>() (bit i: below
+  /// rho_min, bit 4 + i: above rho_max); all bits set if unreachable.
+  unsigned contact_mask(const Vec10& x) const;
+  /// RK4 substep while a joint is past a stop (resolves the stop's spring).
+  double contact_step() const;
   Status advance_rk4(double t_end);
   Status advance_cvode(double t_end, bool continuous);
   /// check_configuration of y's pose against the settings' limits; on
@@ -135,6 +183,8 @@ class Plant {
   bool initialized_ = false;
   double t_ = 0;
   Vec8 y_ = Vec8::Zero();
+  EnergyIntegrals energy_;
+  long contact_events_ = 0;
   mutable Vec4 theta1_ref_ = Vec4::Zero();
   mutable bool theta1_stale_ = false;
   long rhs_count_ = 0;

@@ -28,7 +28,9 @@ Status ReducedDynamics::prepare_leg(const Model& m, int leg, const LegConfig& c,
   // A_i = L_i^{-1} P_i with P_i = [I3, e_z x Rz(phi) r_Qi].
   L.A.leftCols<3>() = L.Linv;
   L.A.col(3) = L.Linv.col(1) * L.attach.x() - L.Linv.col(0) * L.attach.y();
-  L.M = leg_mass_matrix(p, c);
+  L.M = leg_mass_matrix(m, c);
+  cphi_ = pc.cphi;
+  sphi_ = pc.sphi;
   return Status::Ok;
 }
 
@@ -42,6 +44,7 @@ void ReducedDynamics::add_leg(const Model& m, int leg, const Vec3& qd_leg, doubl
   if (leg == 0) {
     Mr_.setZero();
     rhs_.setZero();
+    phid_ = phid;
   }
   // A^T M A with M's zeros (M01 = M12 = 0) and the result's symmetry.
   Mat34 MA;
@@ -54,12 +57,18 @@ void ReducedDynamics::add_leg(const Model& m, int leg, const Vec3& qd_leg, doubl
 }
 
 Status ReducedDynamics::solve_platform(const Model& m, const Wrench& we, Pose& a) const {
-  const Params& p = m.p;
-  // The upper triangle of the reduced mass matrix (add_leg fills only it).
+  // The upper triangle of the reduced mass matrix (add_leg fills only it),
+  // plus the platform with its payload (lagrangian.hpp): M_p, V_p, G_p.
+  const PlatformInertia pi = platform_inertia(m, cphi_, sphi_);
   Mat4 Mr = Mr_;
-  Mr.diagonal() += Vec4(p.m_platform, p.m_platform, p.m_platform, p.Izz_platform);
+  Mr.diagonal() += Vec4(pi.mass, pi.mass, pi.mass, pi.Izz);
+  Mr(0, 3) -= pi.mwy;
+  Mr(1, 3) += pi.mwx;
   Vec4 rhs = rhs_ + we;
-  rhs[2] -= p.m_platform * p.g;  // G_p
+  const double w2 = phid_ * phid_;
+  rhs[0] += pi.mwx * w2;
+  rhs[1] += pi.mwy * w2;
+  rhs[2] -= pi.mass * m.p.g;
   // LDL^T of the symmetric positive definite 4x4, written out (no square
   // roots): Mr = U^T D U with unit upper-triangular U, then two substitutions.
   double d[4];

@@ -26,7 +26,8 @@ class ReducedDynamics {
   Vec3 leg_velocity(int leg, const Pose& pd) const { return legs_[leg].A * pd; }
 
   /// Adds leg i's contribution, with its rates qd_leg, the platform's
-  /// angular rate phid and the actuator force F on rho_i.
+  /// angular rate phid and the generalised force F on rho_i (actuator,
+  /// drive, friction and end stop together).
   void add_leg(const Model& m, int leg, const Vec3& qd_leg, double phid, double F);
 
   /// Solves the reduced 4x4 system (with the external wrench on the
@@ -48,6 +49,7 @@ class ReducedDynamics {
   };
   std::array<Leg, kLegs> legs_;
   Mat4 Mr_ = Mat4::Zero();
+  double cphi_ = 1, sphi_ = 0, phid_ = 0;  // the platform's angle and rate (payload terms)
   Vec4 rhs_ = Vec4::Zero();
 };
 

@@ -21,7 +21,9 @@ constexpr int leg_offset(int leg) { return 3 * leg; }
 
 using Vec3 = Eigen::Vector3d;
 using Vec4 = Eigen::Matrix<double, 4, 1>;
+using Vec2 = Eigen::Vector2d;
 using Vec8 = Eigen::Matrix<double, 8, 1>;
+using Vec10 = Eigen::Matrix<double, 10, 1>;
 using Vec12 = Eigen::Matrix<double, 12, 1>;
 using Vec16 = Eigen::Matrix<double, 16, 1>;
 using Mat3 = Eigen::Matrix3d;

@@ -1,0 +1,95 @@
+// The machine around the mechanism (MODEL_SPEC "The machine around the
+// mechanism: drives, friction, end stops, payload"): the forces that act on
+// each actuated coordinate rho_i besides the actuator force F_i, their
+// power, and the end stops' event indicators. Per joint, allocation free;
+// the platform's payload enters the mass matrix (lagrangian.hpp) instead.
+//
+// On rho_i (positive along +z) act
+//   F_i + (2 pi / p) tau_i                      actuator force and motor torque on a lossless screw
+//   F_fric,i = -b rhod_i - F_c tanh(rhod_i / v_s)  regularised joint friction
+//   F_stop,i                                    compliant end stop:
+//     below rho_min by delta = rho_min - rho_i > 0:  +max(0, k delta + d delta_dot)
+//     above rho_max by delta = rho_i - rho_max > 0:  -max(0, k delta + d delta_dot)
+// and the rotor's reflected mass J (2 pi / p)^2 sits on rho_i's diagonal of M.
+//
+// Energy: the stop's spring stores 1/2 k delta^2 (potential_energy); the rest
+// of the stop force dissipates, at the rate (|F_stop| - k delta) delta_dot,
+// which is d delta_dot^2 while the stop pushes and -k delta delta_dot >= 0
+// while it is released (k delta + d delta_dot < 0 means delta_dot < 0).
+#pragma once
+
+#include <cmath>
+
+#include "model.hpp"
+
+namespace pkm {
+
+/// Regularised joint friction on rho (N, opposes rhod).
+inline double friction_force(const Params& p, double rhod) {
+  double F = -p.friction_viscous * rhod;
+  if (p.friction_coulomb != 0.0) F -= p.friction_coulomb * std::tanh(rhod / p.friction_velocity);
+  return F;
+}
+
+/// One joint against its end stops.
+struct StopContact {
+  double depth = 0;   // delta >= 0, m (0: within the travel)
+  double rate = 0;    // delta_dot, m/s (0 when depth is 0)
+  double force = 0;   // F_stop on rho, signed along +z, N
+};
+
+inline StopContact stop_contact(const Params& p, double rho, double rhod) {
+  StopContact c;
+  if (rho < p.rho_min) {
+    c.depth = p.rho_min - rho;
+    c.rate = -rhod;
+    c.force = std::fmax(0.0, p.stop_stiffness * c.depth + p.stop_damping * c.rate);
+  } else if (rho > p.rho_max) {
+    c.depth = rho - p.rho_max;
+    c.rate = rhod;
+    c.force = -std::fmax(0.0, p.stop_stiffness * c.depth + p.stop_damping * c.rate);
+  }
+  return c;
+}
+
+/// F_stop on rho (N, signed along +z).
+inline double stop_force(const Params& p, double rho, double rhod) { return stop_contact(p, rho, rhod).force; }
+
+/// Friction plus end stop on rho (N): the joint's passive force.
+inline double passive_joint_force(const Params& p, double rho, double rhod) {
+  return friction_force(p, rhod) + stop_force(p, rho, rhod);
+}
+
+/// Energy stored in the stop's spring, 1/2 k delta^2 (J).
+inline double stop_potential(const Params& p, double rho) {
+  const double d = rho < p.rho_min ? p.rho_min - rho : (rho > p.rho_max ? rho - p.rho_max : 0.0);
+  return 0.5 * p.stop_stiffness * d * d;
+}
+
+/// Power dissipated in joint i (W, >= 0): friction plus the stop's damping
+/// (header comment).
+inline double dissipated_power(const Params& p, double rho, double rhod) {
+  const StopContact c = stop_contact(p, rho, rhod);
+  return -friction_force(p, rhod) * rhod + (std::fabs(c.force) - p.stop_stiffness * c.depth) * c.rate;
+}
+
+/// Number of end-stop event indicators: rho_i - rho_min (i = 0..3), then
+/// rho_max - rho_i (i = 0..3). Each is positive within the travel.
+constexpr int kStopIndicators = 2 * kLegs;
+
+/// The indicators from the actuator positions.
+inline void stop_indicators(const Params& p, const Vec4& rho, double g[kStopIndicators]) {
+  for (int i = 0; i < kLegs; ++i) {
+    g[i] = rho[i] - p.rho_min;
+    g[kLegs + i] = p.rho_max - rho[i];
+  }
+}
+
+/// The actuator positions rho_1..4 at a platform pose (closed-form leg
+/// inverse kinematics). Status::Unreachable outside the workspace.
+Status actuator_positions(const Model& m, const Pose& pose, Vec4& rho);
+
+/// The indicators at a platform pose (any state: they depend on the pose only).
+Status stop_indicators(const Model& m, const Pose& pose, double g[kStopIndicators]);
+
+}  // namespace pkm
