@@ -491,7 +491,7 @@ DropRun drop(const Model& m, Solver solver, double interval, double duration) {
 
 }  // namespace
 
-TEST(MachineStops, DISABLED_DropOntoTheLowerStopsComesToRestWithinTheDerivedBound) {
+TEST(MachineStops, DropOntoTheLowerStopsComesToRestWithinTheDerivedBound) {
   const Model m = default_model();
   const double m_tot = 0.45474 + 4 * (0.09331 + 0.06371), g = 9.81, k = 1e5;
   const double rho0 = 0.0443193423;
@@ -507,7 +507,9 @@ TEST(MachineStops, DISABLED_DropOntoTheLowerStopsComesToRestWithinTheDerivedBoun
       EXPECT_EQ(runs[j].status, Status::Ok) << name << " every " << intervals[j] << " s: " << runs[j].error;
       if (runs[j].status != Status::Ok) continue;
       EXPECT_LE(runs[j].max_depth, bound) << name;
-      EXPECT_GT(runs[j].max_depth, 0.5 * bound) << name;  // it did land hard
+      if (j == 0) {
+        EXPECT_GT(runs[j].max_depth, 0.5 * bound) << name;  // it did land hard (seen every 0.1 ms)
+      }
       EXPECT_NEAR(runs[j].final_depth, delta_s, 1e-9) << name;
       EXPECT_LT(runs[j].final_speed, 1e-6) << name;
       EXPECT_LT(runs[j].max_asymmetry, 1e-9) << name;
@@ -517,7 +519,6 @@ TEST(MachineStops, DISABLED_DropOntoTheLowerStopsComesToRestWithinTheDerivedBoun
     for (int j = 1; j < 3; ++j)
       for (size_t s = 0; s < runs[0].samples.size(); ++s) {
         const double d = (runs[j].samples[s] - runs[0].samples[s]).head<3>().lpNorm<Eigen::Infinity>();
-        if (getenv("PKM_DEBUG") && d > 1e-7) std::printf("j %d sample %zu: %.3e z0 %.9f\n", j, s, d, runs[0].samples[s][2]);
         worst = std::max(worst, d);
       }
     EXPECT_LT(worst, 1e-6) << name;

@@ -118,7 +118,7 @@ Status CvodeIntegrator::reset(double t0, const Vec10& y0) {
   return Status::Ok;
 }
 
-Status CvodeIntegrator::advance(double t_out, Vec10& y_out, double& t_reached, bool& root_found) {
+Status CvodeIntegrator::advance(double t_out, Vec10& y_out, double& t_reached, bool& root_found, int* root_dirs) {
   if (!mem_ || needs_reset_) return Status::NotInitialized;
   CVodeSetStopTime(mem_, t_out);
   t_reached = 0.0;
@@ -134,6 +134,7 @@ Status CvodeIntegrator::advance(double t_out, Vec10& y_out, double& t_reached, b
       return Status::SolverFailure;
     }
     root_found = true;
+    if (root_dirs) CVodeGetRootInfo(mem_, root_dirs);
     y_out = as_vec(y_);
     return Status::Ok;
   }

@@ -46,7 +46,9 @@ class CvodeIntegrator {
   /// Integrates towards t_out (stop time set, no overshoot). Returns at
   /// t_out, or earlier at a root of the indicators (`root_found` set,
   /// `t_reached` its time; the caller restarts there with reset()).
-  Status advance(double t_out, Vec10& y_out, double& t_reached, bool& root_found);
+  /// `root_dirs` (may be null, n_roots entries) receives CVodeGetRootInfo:
+  /// +1 / -1 for an indicator that rose / fell through zero, else 0.
+  Status advance(double t_out, Vec10& y_out, double& t_reached, bool& root_found, int* root_dirs = nullptr);
 
   bool ready() const { return mem_ != nullptr; }
   bool needs_reset() const { return needs_reset_; }

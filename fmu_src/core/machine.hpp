@@ -55,9 +55,38 @@ inline StopContact stop_contact(const Params& p, double rho, double rhod) {
 /// F_stop on rho (N, signed along +z).
 inline double stop_force(const Params& p, double rho, double rhod) { return stop_contact(p, rho, rhod).force; }
 
+/// Which stops act, held fixed between located events by the integrators
+/// (bit i: leg i's lower stop, bit 4 + i: its upper stop), so that the
+/// state derivative is smooth between events (up to the release kink) and
+/// the rounding of a located crossing cannot switch a stop on or off again.
+/// kStopsFromState: each stop acts when its joint is past it (the plain
+/// state function, for Model Exchange and the outputs).
+constexpr unsigned kStopsFromState = ~0u;
+
+/// The same as stop_contact with the stops held: a held stop acts with
+/// the signed depth (slightly negative just before the located crossing),
+/// a stop not held does not act.
+inline StopContact stop_contact(const Params& p, int leg, unsigned stops, double rho, double rhod) {
+  if (stops == kStopsFromState) return stop_contact(p, rho, rhod);
+  StopContact c;
+  if (stops & (1u << leg)) {
+    c.depth = p.rho_min - rho;
+    c.rate = -rhod;
+    c.force = std::fmax(0.0, p.stop_stiffness * c.depth + p.stop_damping * c.rate);
+  } else if (stops & (1u << (4 + leg))) {
+    c.depth = rho - p.rho_max;
+    c.rate = rhod;
+    c.force = -std::fmax(0.0, p.stop_stiffness * c.depth + p.stop_damping * c.rate);
+  }
+  return c;
+}
+
 /// Friction plus end stop on rho (N): the joint's passive force.
 inline double passive_joint_force(const Params& p, double rho, double rhod) {
   return friction_force(p, rhod) + stop_force(p, rho, rhod);
+}
+inline double passive_joint_force(const Params& p, int leg, unsigned stops, double rho, double rhod) {
+  return friction_force(p, rhod) + stop_contact(p, leg, stops, rho, rhod).force;
 }
 
 /// Energy stored in the stop's spring, 1/2 k delta^2 (J).
@@ -68,8 +97,8 @@ inline double stop_potential(const Params& p, double rho) {
 
 /// Power dissipated in joint i (W, >= 0): friction plus the stop's damping
 /// (header comment).
-inline double dissipated_power(const Params& p, double rho, double rhod) {
-  const StopContact c = stop_contact(p, rho, rhod);
+inline double dissipated_power(const Params& p, int leg, unsigned stops, double rho, double rhod) {
+  const StopContact c = stop_contact(p, leg, stops, rho, rhod);
   return -friction_force(p, rhod) * rhod + (std::fabs(c.force) - p.stop_stiffness * c.depth) * c.rate;
 }
 

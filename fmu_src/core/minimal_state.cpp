@@ -23,17 +23,17 @@ Status expand_state(const Model& m, const Vec8& y, Vec16& q, Vec16& qd) {
   return Status::Ok;
 }
 
-Vec16 with_passive_forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f) {
+Vec16 with_passive_forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f, unsigned stops) {
   Vec16 out = f;
   for (int i = 0; i < kLegs; ++i) {
     const int o = leg_offset(i);
-    out[o] += passive_joint_force(m.p, q[o], qd[o]);
+    out[o] += passive_joint_force(m.p, i, stops, q[o], qd[o]);
   }
   return out;
 }
 
 Status state_derivative(const Model& m, Formulation form, const Vec8& y, const Vec16& f, Vec8& ydot,
-                        MechanismState* full, JointMotion* joints) {
+                        MechanismState* full, JointMotion* joints, unsigned stops) {
   if (!y.allFinite() || !f.allFinite()) return Status::NonFinite;
   ydot.head<4>() = y.tail<4>();
   if (form == Formulation::LegPartitioned && full == nullptr) {
@@ -50,7 +50,7 @@ Status state_derivative(const Model& m, Formulation form, const Vec8& y, const V
       s = rd.prepare_leg(m, i, c, pc);
       if (s != Status::Ok) return s;
       const Vec3 qd_leg = rd.leg_velocity(i, pd);
-      rd.add_leg(m, i, qd_leg, pd[3], f[leg_offset(i)] + passive_joint_force(m.p, c.rho, qd_leg[0]));
+      rd.add_leg(m, i, qd_leg, pd[3], f[leg_offset(i)] + passive_joint_force(m.p, i, stops, c.rho, qd_leg[0]));
       if (joints) {
         joints->rho[i] = c.rho;
         joints->rhod[i] = qd_leg[0];
@@ -65,7 +65,7 @@ Status state_derivative(const Model& m, Formulation form, const Vec8& y, const V
   MechanismState& st = full ? *full : local;
   Status s = expand_state(m, y, st.q, st.qd);
   if (s != Status::Ok) return s;
-  s = forward_dynamics(m, form, st.q, st.qd, with_passive_forces(m, st.q, st.qd, f), st.qdd, st.lambda);
+  s = forward_dynamics(m, form, st.q, st.qd, with_passive_forces(m, st.q, st.qd, f, stops), st.qdd, st.lambda);
   if (s != Status::Ok) return s;
   if (joints) {
     for (int i = 0; i < kLegs; ++i) {

@@ -34,10 +34,13 @@ struct JointMotion {
 /// joints' passive forces (friction, end stops: machine.hpp) are added here
 /// from the state. If `full` is given it receives q, qd, qdd, lambda; if
 /// `joints` is given, rho and rhod.
+/// `stops` (machine.hpp): which end stops act, or kStopsFromState.
 Status state_derivative(const Model& m, Formulation form, const Vec8& y, const Vec16& f, Vec8& ydot,
-                        MechanismState* full = nullptr, JointMotion* joints = nullptr);
+                        MechanismState* full = nullptr, JointMotion* joints = nullptr,
+                        unsigned stops = ~0u);
 
 /// f plus the passive joint forces at (q, qd).
-Vec16 with_passive_forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f);
+Vec16 with_passive_forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f,
+                          unsigned stops = ~0u);
 
 }  // namespace pkm

@@ -243,13 +243,14 @@ Status Plant::derivative(double t, const Vec10& x, Vec10& xdot) {
   const Vec8 y = x.head<8>();
   Vec8 ydot;
   JointMotion jm;
-  const Status s = state_derivative(model_, settings_.formulation, y, generalized_forces(Fa, we), ydot, nullptr, &jm);
+  const Status s =
+      state_derivative(model_, settings_.formulation, y, generalized_forces(Fa, we), ydot, nullptr, &jm, stops_);
   if (s != Status::Ok) return s == Status::NonFinite ? Status::SolverFailure : s;  // finite inputs: the trial state was not
   xdot.head<8>() = ydot;
   // The energy audit's integrands: the inputs' power and the dissipation.
   xdot[8] = Fa.dot(jm.rhod) + we.dot(y.tail<4>());
   double diss = 0.0;
-  for (int i = 0; i < kLegs; ++i) diss += dissipated_power(model_.p, jm.rho[i], jm.rhod[i]);
+  for (int i = 0; i < kLegs; ++i) diss += dissipated_power(model_.p, i, stops_, jm.rho[i], jm.rhod[i]);
   xdot[9] = diss;
   return Status::Ok;
 }
@@ -324,6 +325,7 @@ Status Plant::advance_rk4(double t_end) {
         step = h_contact;
         to_end = false;
       }
+      stops_ = mask & 0xFFu;  // held on over the step (and its re-steps)
       Vec10 trial = x;
       s = rk4_step(f, t, step, trial);
       if (s != Status::Ok) break;
@@ -355,6 +357,7 @@ Status Plant::advance_rk4(double t_end) {
       mask = trial_mask;
       t = to_end ? t_next : t + step;
     }
+    stops_ = kStopsFromState;
     if (s != Status::Ok) {
       char buf[160];
       std::snprintf(buf, sizeof buf, "the RK4 step from t = %.17g s could not be evaluated: %s", t,
@@ -390,20 +393,30 @@ Status Plant::advance_cvode(double t_end, bool continuous) {
   // CVODE stops at every root of the stop indicators (a joint reaching or
   // leaving a stop: the stop force switches there); the history restarts
   // at that point, then integration goes on to t_end.
+  // The stops held on between roots: those past at the start, then
+  // switched by the direction of each root (not by the side of zero on
+  // which the located state happens to fall).
+  stops_ = contact_mask(x) & 0xFFu;
   int events = 0;
   Status s = Status::Ok;
   for (;;) {
     double t_reached = t_end;
     bool root = false;
-    s = cvode_.advance(t_end, x, t_reached, root);
+    int dirs[kStopIndicators] = {};
+    s = cvode_.advance(t_end, x, t_reached, root, dirs);
     if (s != Status::Ok) break;
     if (!root) break;
+    for (int k = 0; k < kStopIndicators; ++k) {
+      if (dirs[k] < 0) stops_ |= 1u << k;   // indicator fell through 0: past the stop
+      if (dirs[k] > 0) stops_ &= ~(1u << k);
+    }
     ++contact_events_;
     if (++events > kMaxEventsPerAdvance) {
       char buf[160];
       std::snprintf(buf, sizeof buf, "more than %d end-stop events before t = %.17g s (chattering contact)",
                     kMaxEventsPerAdvance, t_end);
       cvode_.reset(t_, packed());
+      stops_ = kStopsFromState;
       error_ = buf;
       return Status::SolverFailure;
     }
@@ -411,6 +424,7 @@ Status Plant::advance_cvode(double t_end, bool continuous) {
     s = cvode_.reset(t_reached, x);
     if (s != Status::Ok) break;
   }
+  stops_ = kStopsFromState;
   if (s != Status::Ok) {
     error_ = cvode_.last_error();
     cvode_.reset(t_, packed());

@@ -185,6 +185,7 @@ class Plant {
   Vec8 y_ = Vec8::Zero();
   EnergyIntegrals energy_;
   long contact_events_ = 0;
+  unsigned stops_ = kStopsFromState;  // the stops held on while integrating (machine.hpp)
   mutable Vec4 theta1_ref_ = Vec4::Zero();
   mutable bool theta1_stale_ = false;
   long rhs_count_ = 0;
