@@ -543,3 +543,51 @@ TEST(MachineStops, IndicatorsAndStopForcesAtAnArbitraryState) {
   EXPECT_EQ(stop_force(p, -1e-4, 0.2), 0.0);                  // would pull: released
   EXPECT_NEAR(stop_force(p, 0.1501, 0.0), -10.0, 1e-9);       // upper stop pushes down
 }
+
+// ---------------------------------------------------------------------------
+// The C API (pkm.h)
+// ---------------------------------------------------------------------------
+
+#include "pkm.h"
+
+TEST(MachineCApi, ParametersInputsAndOutputs) {
+  pkm_params p;
+  pkm_default_params(&p);
+  pkm_machine_params mp;
+  pkm_default_machine_params(&mp);
+  EXPECT_EQ(mp.screw_lead, 0.004);
+  EXPECT_EQ(mp.rho_max, 0.15);
+  char err[256];
+  pkm_model* m = nullptr;
+  mp.friction_velocity = 0.0;
+  EXPECT_EQ(pkm_create_machine(&p, &mp, &m, err, sizeof err), PKM_ERR_INVALID_PARAMETER);
+  EXPECT_NE(std::string(err).find("parameter friction_velocity "), std::string::npos) << err;
+  pkm_default_machine_params(&mp);
+  mp.payload_mass = 0.1;
+  ASSERT_EQ(pkm_create_machine(&p, &mp, &m, err, sizeof err), PKM_OK) << err;
+  const double home[4] = {0, 0, 0.05, 0};
+  ASSERT_EQ(pkm_init_pose(m, 0.0, home, nullptr), PKM_OK);
+  pkm_machine_outputs o;
+  ASSERT_EQ(pkm_get_machine_outputs(m, nullptr, nullptr, nullptr, &o), PKM_OK);
+  // The spec's check with 0.1 kg more on the platform: (10.622464200 + 0.981) / 4 N each.
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(o.F_hold[i], (10.622464200 + 0.1 * 9.81) / 4, 1e-9);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(o.stop_indicators[i], 0.0443193423, 1e-10);
+  // Held half by forces, half by motor torques: stays put, and the torques
+  // are F p / (2 pi) as the inverse dynamics reports them.
+  pkm_inverse_machine_result inv;
+  const double zero[4] = {0, 0, 0, 0};
+  ASSERT_EQ(pkm_inverse_dynamics_machine(m, home, zero, zero, nullptr, &inv), PKM_OK);
+  double F[4], tau[4];
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(inv.F[i], o.F_hold[i], 1e-12);
+    EXPECT_NEAR(inv.tau[i], inv.F[i] * 0.004 / (2 * kPi), 1e-15);
+    F[i] = 0.5 * inv.F[i];
+    tau[i] = 0.5 * inv.tau[i];
+  }
+  EXPECT_EQ(inv.beyond_stops, 0u);
+  ASSERT_EQ(pkm_advance_drives(m, 0.5, F, tau, nullptr), PKM_OK) << pkm_last_error(m);
+  double t, y[8];
+  ASSERT_EQ(pkm_get_state(m, &t, y, nullptr), PKM_OK);
+  EXPECT_LT(std::fabs(y[2] - 0.05), 1e-12);
+  pkm_destroy(m);
+}

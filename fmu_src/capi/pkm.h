@@ -142,8 +142,72 @@ PKM_API pkm_status pkm_get_state(const pkm_model* m, double* t, double y[8], dou
 PKM_API pkm_status pkm_set_state(pkm_model* m, double t, const double y[8], const double theta1_ref[4]);
 
 /* Total mechanical energy T + U (J) at the current state (U with the
- * spec's gravity, up to a constant). */
+ * spec's gravity, up to a constant; with the machine below, T includes the
+ * rotors and U the end stops' springs). */
 PKM_API pkm_status pkm_energy(pkm_model* m, double* kinetic, double* potential);
+
+/* ---- The machine around the mechanism (MODEL_SPEC): drives, friction,
+ * end stops, payload. Separate structs and functions, so the ones above
+ * keep their layout and behaviour; a model made by pkm_create has the
+ * default machine (pkm_default_machine_params). ---- */
+typedef struct {
+  double screw_lead;        /* m per revolution, > 0, default 0.004 */
+  double rotor_inertia;     /* kg*m^2 (motor + screw), >= 0, default 0 */
+  double friction_viscous;  /* N*s/m, >= 0, default 0 */
+  double friction_coulomb;  /* N, >= 0, default 0 */
+  double friction_velocity; /* m/s, > 0, default 1e-3 */
+  double rho_min, rho_max;  /* m, end stops, default 0.0 and 0.15 */
+  double stop_stiffness;    /* N/m, >= 0, default 1e5 */
+  double stop_damping;      /* N*s/m, >= 0, default 100 */
+  double payload_mass;      /* kg, >= 0, default 0 */
+  double payload_com[2];    /* m, platform frame, relative to P, default 0 */
+  double payload_Izz;       /* kg*m^2 about its own centre of mass, default 0 */
+} pkm_machine_params;
+
+PKM_API void pkm_default_machine_params(pkm_machine_params* mp);
+
+/* pkm_create with the machine parameters (mp may be NULL: the defaults). */
+PKM_API pkm_status pkm_create_machine(const pkm_params* p, const pkm_machine_params* mp, pkm_model** out,
+                                      char* err, size_t err_len);
+
+/* Motor torques tau[4] (N*m) at time t, for pkm_advance_fn_drives. */
+typedef void (*pkm_torque_fn)(void* user, double t, double tau[4]);
+
+/* pkm_advance with constant motor torques tau[4] besides F and the wrench
+ * (any may be NULL: zero); tau_i adds (2 pi / screw_lead) tau_i to F_i. */
+PKM_API pkm_status pkm_advance_drives(pkm_model* m, double t_end, const double F[4], const double tau[4],
+                                      const double wrench[4]);
+/* pkm_advance_fn with a torque callback (may be NULL: zero), same user pointer. */
+PKM_API pkm_status pkm_advance_fn_drives(pkm_model* m, double t_end, pkm_input_fn inputs, pkm_torque_fn torques,
+                                         void* user, int continuous);
+
+typedef struct {
+  double stop_force[4];      /* N, signed along +z */
+  double friction_force[4];  /* N, signed along +z */
+  double F_hold[4];          /* N: hold the current pose at rest (gravity, payload, wrench) */
+  double kinetic_energy;     /* J, rotors included */
+  double potential_energy;   /* J, gravity plus the stops' springs */
+  double actuator_work;      /* J, running integral since pkm_init_pose */
+  double dissipated_energy;  /* J, running integral since pkm_init_pose */
+  double stop_indicators[8]; /* rho_i - rho_min (i = 1..4), then rho_max - rho_i */
+} pkm_machine_outputs;
+
+/* The machine's outputs at the current time for the inputs F, tau, wrench
+ * at that time (any may be NULL: zero). */
+PKM_API pkm_status pkm_get_machine_outputs(pkm_model* m, const double F[4], const double tau[4],
+                                           const double wrench[4], pkm_machine_outputs* out);
+
+typedef struct {
+  double F[4];          /* N, on top of friction (and of a stop's force if beyond one) */
+  double tau[4];        /* N*m, the equivalent motor torques F_i p / (2 pi) */
+  double lambda[12];
+  unsigned beyond_stops; /* bit i-1: rho_i < rho_min; bit 3+i: rho_i > rho_max (a warning, not an error) */
+} pkm_inverse_machine_result;
+
+/* Inverse dynamics with the machine (rotor inertia, friction, payload). */
+PKM_API pkm_status pkm_inverse_dynamics_machine(pkm_model* m, const double pose[4], const double velocity[4],
+                                                const double acceleration[4], const double wrench[4],
+                                                pkm_inverse_machine_result* out);
 
 #ifdef __cplusplus
 }

@@ -60,6 +60,7 @@ pkm_status fail(pkm_model* m, Status s, const std::string& what) {
 struct CallbackInputs {
   pkm_input_fn fn;
   void* user;
+  pkm_torque_fn torques = nullptr;
   static void eval(void* self, double t, pkm::Vec4& F, pkm::Wrench& we) {
     auto* c = static_cast<CallbackInputs*>(self);
     double f[4] = {0, 0, 0, 0}, w[4] = {0, 0, 0, 0};
@@ -67,7 +68,48 @@ struct CallbackInputs {
     F = vec4(f);
     we = vec4(w);
   }
+  static void eval_tau(void* self, double t, pkm::Vec4& tau) {
+    auto* c = static_cast<CallbackInputs*>(self);
+    double a[4] = {0, 0, 0, 0};
+    c->torques(c->user, t, a);
+    tau = vec4(a);
+  }
 };
+
+void to_params(const pkm_machine_params& c, pkm::Params& p) {
+  p.screw_lead = c.screw_lead;
+  p.rotor_inertia = c.rotor_inertia;
+  p.friction_viscous = c.friction_viscous;
+  p.friction_coulomb = c.friction_coulomb;
+  p.friction_velocity = c.friction_velocity;
+  p.rho_min = c.rho_min;
+  p.rho_max = c.rho_max;
+  p.stop_stiffness = c.stop_stiffness;
+  p.stop_damping = c.stop_damping;
+  p.payload_mass = c.payload_mass;
+  p.payload_com = {c.payload_com[0], c.payload_com[1]};
+  p.payload_Izz = c.payload_Izz;
+}
+
+pkm_status create(const pkm::Params& params, pkm_model** out, char* err, size_t err_len) {
+  auto message = [&](const std::string& s) {
+    if (err && err_len > 0) std::snprintf(err, err_len, "%s", s.c_str());
+  };
+  pkm::Model model;
+  std::string why;
+  const Status s = pkm::make_model(params, model, &why);
+  if (s != Status::Ok) {
+    message(why);
+    return to_c(s);
+  }
+  *out = new (std::nothrow) pkm_model(model);
+  if (!*out) {
+    message("pkm_create: out of memory");
+    return PKM_ERR_INVALID_ARGUMENT;
+  }
+  message("");
+  return PKM_OK;
+}
 
 }  // namespace
 
@@ -119,19 +161,101 @@ pkm_status pkm_create(const pkm_params* p, pkm_model** out, char* err, size_t er
     message("pkm_create: params is NULL");
     return PKM_ERR_INVALID_ARGUMENT;
   }
-  pkm::Model model;
-  std::string why;
-  const Status s = pkm::make_model(from_c(*p), model, &why);
-  if (s != Status::Ok) {
-    message(why);
-    return to_c(s);
-  }
-  *out = new (std::nothrow) pkm_model(model);
-  if (!*out) {
-    message("pkm_create: out of memory");
+  return create(from_c(*p), out, err, err_len);
+}
+
+void pkm_default_machine_params(pkm_machine_params* c) {
+  if (!c) return;
+  const pkm::Params p;
+  c->screw_lead = p.screw_lead;
+  c->rotor_inertia = p.rotor_inertia;
+  c->friction_viscous = p.friction_viscous;
+  c->friction_coulomb = p.friction_coulomb;
+  c->friction_velocity = p.friction_velocity;
+  c->rho_min = p.rho_min;
+  c->rho_max = p.rho_max;
+  c->stop_stiffness = p.stop_stiffness;
+  c->stop_damping = p.stop_damping;
+  c->payload_mass = p.payload_mass;
+  c->payload_com[0] = p.payload_com[0];
+  c->payload_com[1] = p.payload_com[1];
+  c->payload_Izz = p.payload_Izz;
+}
+
+pkm_status pkm_create_machine(const pkm_params* p, const pkm_machine_params* mp, pkm_model** out, char* err,
+                              size_t err_len) {
+  auto message = [&](const std::string& s) {
+    if (err && err_len > 0) std::snprintf(err, err_len, "%s", s.c_str());
+  };
+  if (!out) {
+    message("pkm_create_machine: out is NULL");
     return PKM_ERR_INVALID_ARGUMENT;
   }
-  message("");
+  *out = nullptr;
+  if (!p) {
+    message("pkm_create_machine: params is NULL");
+    return PKM_ERR_INVALID_ARGUMENT;
+  }
+  pkm::Params params = from_c(*p);
+  if (mp) to_params(*mp, params);
+  return create(params, out, err, err_len);
+}
+
+pkm_status pkm_advance_drives(pkm_model* m, double t_end, const double F[4], const double tau[4],
+                              const double wrench[4]) {
+  if (!m) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::LinearInputs in;
+  in.F0 = vec4(F);
+  in.tau0 = vec4(tau);
+  in.we0 = vec4(wrench);
+  if (!in.F0.allFinite() || !in.we0.allFinite() || !in.tau0.allFinite())
+    return fail(m, Status::NonFinite, "pkm_advance_drives: inputs");
+  const Status s = m->plant.advance(t_end, in.signal(), false);
+  return s == Status::Ok ? PKM_OK : fail(m, s, "pkm_advance_drives");
+}
+
+pkm_status pkm_advance_fn_drives(pkm_model* m, double t_end, pkm_input_fn fn, pkm_torque_fn torques, void* user,
+                                 int continuous) {
+  if (!m || !fn) return PKM_ERR_INVALID_ARGUMENT;
+  CallbackInputs cb{fn, user, torques};
+  pkm::InputSignal in{&CallbackInputs::eval, &cb, torques ? &CallbackInputs::eval_tau : nullptr};
+  const Status s = m->plant.advance(t_end, in, continuous != 0);
+  return s == Status::Ok ? PKM_OK : fail(m, s, "pkm_advance_fn_drives");
+}
+
+pkm_status pkm_get_machine_outputs(pkm_model* m, const double F[4], const double tau[4], const double wrench[4],
+                                   pkm_machine_outputs* out) {
+  if (!m || !out) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::LinearInputs in;
+  in.F0 = vec4(F);
+  in.tau0 = vec4(tau);
+  in.we0 = vec4(wrench);
+  pkm::MachineOutputs o;
+  const Status s = m->plant.machine_outputs(in.signal(), o);
+  if (s != Status::Ok) return fail(m, s, "pkm_get_machine_outputs");
+  copy(o.stop_force, out->stop_force);
+  copy(o.friction_force, out->friction_force);
+  copy(o.F_hold, out->F_hold);
+  out->kinetic_energy = o.kinetic_energy;
+  out->potential_energy = o.potential_energy;
+  out->actuator_work = o.actuator_work;
+  out->dissipated_energy = o.dissipated_energy;
+  for (int k = 0; k < 8; ++k) out->stop_indicators[k] = o.stop_indicators[k];
+  return PKM_OK;
+}
+
+pkm_status pkm_inverse_dynamics_machine(pkm_model* m, const double pose[4], const double velocity[4],
+                                        const double acceleration[4], const double wrench[4],
+                                        pkm_inverse_machine_result* out) {
+  if (!m || !pose || !velocity || !acceleration || !out) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::InverseDynamicsResult r;
+  const Status s = pkm::inverse_dynamics(m->plant.model(), vec4(pose), vec4(velocity), vec4(acceleration),
+                                         vec4(wrench), r);
+  if (s != Status::Ok) return fail(m, s, "pkm_inverse_dynamics_machine");
+  copy(r.F, out->F);
+  copy(r.tau, out->tau);
+  copy<12>(r.lambda, out->lambda);
+  out->beyond_stops = r.beyond_stops;
   return PKM_OK;
 }
 
