@@ -165,13 +165,13 @@ Status Plant::set_state(const Vec8& y) {
   return Status::Ok;
 }
 
-Status Plant::derivative_now(const InputSignal& inputs, Vec8& ydot) const {
+Status Plant::derivative_now(const InputSignal& inputs, Vec10& xdot) const {
   if (!initialized_) return Status::NotInitialized;
-  Vec4 F;
-  Wrench we;
-  Vec4 tau;
-  read_inputs(inputs, t_, F, we, tau);
-  return state_derivative(model_, settings_.formulation, y_, generalized_forces(model_, F, tau, we), ydot);
+  Vec10 x;
+  x.head<8>() = y_;
+  x[8] = energy_.actuator_work;
+  x[9] = energy_.dissipated;
+  return machine_rates(inputs, t_, x, kStopsFromState, xdot);
 }
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e) {
@@ -230,27 +230,39 @@ double Plant::contact_step() const {
 }
 
 Status Plant::derivative(double t, const Vec10& x, Vec10& xdot) {
-  Vec4 F, tau;
-  Wrench we;
   ++rhs_count_;
   // A non-finite trial time or state is the integrator's (a step size
   // computed from absurd accelerations), not the inputs': the step fails,
   // the state is kept.
   if (!std::isfinite(t)) return Status::SolverFailure;
-  read_inputs(inputs_, t, F, we, tau);
-  if (!F.allFinite() || !we.allFinite() || !tau.allFinite()) return Status::NonFinite;  // the inputs' fault
-  const Vec4 Fa = F + model_.drive_ratio * tau;  // actuator force plus the screw's
+  bool inputs_fault = false;
+  const Status s = machine_rates(inputs_, t, x, stops_, xdot, &inputs_fault);
+  // With finite inputs a non-finite derivative is the trial state's.
+  if (s == Status::NonFinite && !inputs_fault) return Status::SolverFailure;
+  return s;
+}
+
+Status Plant::machine_rates(const InputSignal& inputs, double t, const Vec10& x, unsigned stops, Vec10& xdot,
+                            bool* inputs_fault) const {
+  Vec4 F, tau;
+  Wrench we;
+  read_inputs(inputs, t, F, we, tau);
+  if (!F.allFinite() || !we.allFinite() || !tau.allFinite()) {
+    if (inputs_fault) *inputs_fault = true;
+    return Status::NonFinite;
+  }
+  const Vec4 Fa = F + model_.drive_ratio * tau;   // actuator force plus the screw's
   const Vec8 y = x.head<8>();
   Vec8 ydot;
   JointMotion jm;
   const Status s =
-      state_derivative(model_, settings_.formulation, y, generalized_forces(Fa, we), ydot, nullptr, &jm, stops_);
-  if (s != Status::Ok) return s == Status::NonFinite ? Status::SolverFailure : s;  // finite inputs: the trial state was not
+      state_derivative(model_, settings_.formulation, y, generalized_forces(Fa, we), ydot, nullptr, &jm, stops);
+  if (s != Status::Ok) return s;
   xdot.head<8>() = ydot;
   // The energy audit's integrands: the inputs' power and the dissipation.
   xdot[8] = Fa.dot(jm.rhod) + we.dot(y.tail<4>());
   double diss = 0.0;
-  for (int i = 0; i < kLegs; ++i) diss += dissipated_power(model_.p, i, stops_, jm.rho[i], jm.rhod[i]);
+  for (int i = 0; i < kLegs; ++i) diss += dissipated_power(model_.p, i, stops, jm.rho[i], jm.rhod[i]);
   xdot[9] = diss;
   return Status::Ok;
 }

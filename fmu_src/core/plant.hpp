@@ -136,8 +136,11 @@ class Plant {
   /// singularity limits are not checked here: the event indicators
   /// (guard_indicators) locate their crossing.
   Status set_state(const Vec8& y);
-  /// dy/dt at the current time and state for the given inputs.
-  Status derivative_now(const InputSignal& inputs, Vec8& ydot) const;
+  /// Sets the running energy integrals (the importer integrates them too).
+  void set_energy_integrals(const EnergyIntegrals& e) { energy_ = e; }
+  /// d/dt of [y; actuator_work; dissipated] at the current time and state
+  /// for the given inputs, each end stop acting when its joint is past it.
+  Status derivative_now(const InputSignal& inputs, Vec10& xdot) const;
 
   /// q, qd, qdd and lambda at the current time, for the inputs at that time
   /// (evaluated on demand; theta1 continuous in time). Reading changes nothing.
@@ -159,8 +162,13 @@ class Plant {
  private:
   static int cvode_rhs(double t, const Vec10& x, Vec10& xdot, void* self);
   static int cvode_roots(double t, const Vec10& x, double* g, void* self);
-  /// d/dt of x = [y; actuator_work; dissipated].
+  /// d/dt of x = [y; actuator_work; dissipated] for the integrators
+  /// (counts the evaluation; the inputs of the current advance, the stops held).
   Status derivative(double t, const Vec10& x, Vec10& xdot);
+  /// The same for any inputs and stops (the integrators' and Model
+  /// Exchange's); *inputs_fault tells a NonFinite caused by the inputs.
+  Status machine_rates(const InputSignal& inputs, double t, const Vec10& x, unsigned stops, Vec10& xdot,
+                       bool* inputs_fault = nullptr) const;
   Vec10 packed() const;
   void unpack(const Vec10& x);
   /// Which joints are past a stop at the pose x.head<4>() (bit i: below
