@@ -13,7 +13,7 @@ namespace {
 
 constexpr std::uint64_t kStateTag = 0x53324d464d4b5002ull;  // marks a live SavedState
 constexpr unsigned char kMagic[8] = {'P', 'K', 'M', 'F', 'M', 'U', 'S', 'T'};
-constexpr std::uint32_t kFormatVersion = 2;
+constexpr std::uint32_t kFormatVersion = 3;  // 3: the plant's energy integrals and end-stop contacts
 constexpr std::size_t kHeaderSize = 32;
 constexpr std::size_t kTrailerSize = 8;
 

@@ -75,3 +75,35 @@ inline constexpr pkm::Params kDefaultParams{};
   real_parameter(120, "g", kDefaultParams.g, "m/s2",                                                              \
                  "Gravitational acceleration, along -z of the base frame (0 switches gravity off)",               \
                  PKM_FMI_PARAM(g), 0)
+
+// Value references 150..160, identical in both FMUs: the machine around the
+// mechanism (MODEL_SPEC "The machine around the mechanism"). Every default
+// leaves the paper's ideal machine unchanged.
+#define PKM_FMI_MACHINE_PARAMETERS                                                                                \
+  real_parameter(150, "screw_lead", kDefaultParams.screw_lead, "m",                                                \
+                 "Lead p of each ball screw, per revolution: a motor torque tau acts as (2 pi/p) tau on its slider", \
+                 PKM_FMI_PARAM(screw_lead), 0, 0.0),                                                                \
+  real_parameter(151, "rotor_inertia", kDefaultParams.rotor_inertia, "kg.m2",                                     \
+                 "Inertia J of each motor and screw: adds the reflected mass J (2 pi/p)^2 to its slider",         \
+                 PKM_FMI_PARAM(rotor_inertia), 0, 0.0),                                                             \
+  real_parameter(152, "friction_viscous", kDefaultParams.friction_viscous, "N.s/m",                               \
+                 "Viscous friction b of each prismatic joint: -b drho",                                           \
+                 PKM_FMI_PARAM(friction_viscous), 0, 0.0),                                                          \
+  real_parameter(153, "friction_coulomb", kDefaultParams.friction_coulomb, "N",                                   \
+                 "Coulomb friction F_c of each prismatic joint, regularised: -F_c tanh(drho/friction_velocity)",  \
+                 PKM_FMI_PARAM(friction_coulomb), 0, 0.0),                                                          \
+  real_parameter(154, "friction_velocity", kDefaultParams.friction_velocity, "m/s",                               \
+                 "Regularisation speed v_s of the Coulomb friction (> 0)", PKM_FMI_PARAM(friction_velocity), 0, 0.0), \
+  real_parameter(155, "rho_min", kDefaultParams.rho_min, "m", "Lower end of each slider's travel (end stop)",    \
+                 PKM_FMI_PARAM(rho_min), 0),                                                                        \
+  real_parameter(156, "rho_max", kDefaultParams.rho_max, "m",                                                     \
+                 "Upper end of each slider's travel (end stop), above rho_min", PKM_FMI_PARAM(rho_max), 0),         \
+  real_parameter(157, "payload_mass", kDefaultParams.payload_mass, "kg", "Mass of a payload fixed to the platform", \
+                 PKM_FMI_PARAM(payload_mass), 0, 0.0),                                                              \
+  real_parameter(158, "payload_com[1]", kDefaultParams.payload_com[0], "m",                                       \
+                 "Payload centre of mass in the platform frame relative to P, x", PKM_FMI_PARAM_ARRAY(payload_com), 0), \
+  real_parameter(159, "payload_com[2]", kDefaultParams.payload_com[1], "m",                                       \
+                 "Payload centre of mass in the platform frame relative to P, y", PKM_FMI_PARAM_ARRAY(payload_com), 1), \
+  real_parameter(160, "payload_Izz", kDefaultParams.payload_Izz, "kg.m2",                                         \
+                 "Payload inertia about the vertical axis through its own centre of mass",                         \
+                 PKM_FMI_PARAM(payload_Izz), 0, 0.0)

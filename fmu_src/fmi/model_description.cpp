@@ -271,7 +271,7 @@ std::string exact_text(double v) {
 
 Dependencies dependencies_of(const ModelDefinition& d, const Variable& v) {
   Dependencies deps;
-  const int half = static_cast<int>(d.n_states / 2);
+  const int half = static_cast<int>(d.n_position_states);
   if (v.depends & kOnOwnState) {
     deps.knowns.push_back(v.vr);
     deps.constant = true;

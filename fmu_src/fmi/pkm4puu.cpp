@@ -19,16 +19,20 @@
 // the accelerations, hence lambda, depend on the inputs at the current time.
 //
 // Model Exchange: the continuous states are the pose and its velocity (the
-// outputs x..dphi); the importer's integrator sets them and the time, the
-// legs are reconstructed from them (closed form), so the states never leave
-// the constraint manifold. The event indicators are the singularity guards
-// (pkm::guard_indicators); a crossing terminates the simulation with a
-// logged reason, as a discarded step does in Co-Simulation.
+// outputs x..dphi) and the energy audit's two running integrals
+// (actuator_work, dissipated_energy); the importer's integrator sets them and
+// the time, the legs are reconstructed from the pose (closed form), so the
+// states never leave the constraint manifold. The event indicators are the
+// singularity guards (pkm::guard_indicators), whose crossing terminates the
+// simulation with a logged reason as a discarded step does in
+// Co-Simulation, and the end stops (rho_i - rho_min, rho_max - rho_i), whose
+// crossings are events logged under logEvents.
 #include <cmath>
 #include <iterator>
 #include <memory>
 
 #include "constraints.hpp"
+#include "machine.hpp"
 #include "mechanism_parameters.hpp"
 #include "models.hpp"
 #include "plant.hpp"
@@ -38,6 +42,13 @@ namespace pkm_fmi {
 namespace {
 
 constexpr pkm::SolverSettings kDefaultSolver{};
+constexpr int kStates = 10;  // pose, velocity, actuator_work, dissipated_energy
+constexpr int kIndicators = pkm::kGuardIndicators + pkm::kStopIndicators;
+constexpr int kInputs = 12;  // F[1..4], Fe[1..3], Me_z, tau[1..4]
+// MODEL_SPEC "A check anyone can derive": each actuator's share of the
+// weight at the default initial pose, the start value of F[1..4] (so that a
+// plant nothing drives stays where it is).
+constexpr double kHoldingForce = 2.655616050;
 
 struct PlantData final : MechanismData {
   // Parameters beyond the mechanism's: initial state and solver settings.
@@ -51,16 +62,24 @@ struct PlantData final : MechanismData {
   std::int32_t formulation = static_cast<std::int32_t>(kDefaultSolver.formulation);
   double max_jacobian_condition = kDefaultSolver.max_jacobian_condition;
   double min_leg_measure = kDefaultSolver.min_leg_measure;
-  // Inputs u = [F1..F4, Fe1..Fe3, Me_z] at the current time, and du/dt.
-  double u[8] = {};
-  double du[8] = {};
+  // Inputs u = [F1..F4, Fe1..Fe3, Me_z, tau1..tau4] at the current time, and du/dt.
+  double u[kInputs] = {kHoldingForce, kHoldingForce, kHoldingForce, kHoldingForce};
+  double du[kInputs] = {};
   // Outputs (computed by update_outputs).
   double pose[4] = {}, vel[4] = {};
   double rho[4] = {}, drho[4] = {}, theta1[4] = {}, theta2[4] = {};
   double lambda[12] = {};
   double residual = 0.0, condition = 0.0;
-  double dy[8] = {};  // der(x) .. der(dphi)
-  double z[pkm::kGuardIndicators] = {};  // the event indicators
+  double F_hold[4] = {}, stop_force[4] = {};
+  double kinetic = 0.0, potential = 0.0;
+  double energy[2] = {};  // actuator_work, dissipated_energy (states)
+  double dy[kStates] = {};  // der(x) .. der(dphi), der(actuator_work), der(dissipated_energy)
+  double z[kIndicators] = {};  // the event indicators: guards, then end stops
+  // Model Exchange: which end-stop indicators were negative at the last
+  // event (bit k: indicator k), to log contacts and releases.
+  unsigned stops_beyond = 0;
+  // Co-Simulation: end-stop events located so far (logged per step).
+  long contact_events = 0;
   // The simulated machine (nullptr before initialisation).
   std::unique_ptr<pkm::Plant> plant;
 
@@ -88,6 +107,10 @@ struct PlantData final : MechanismData {
   /// The plant, built from the current parameters in initialisation mode.
   Status ready(Context& ctx, const char* function);
   pkm::LinearInputs inputs(double t0) const;
+  /// The end-stop indicators that are negative now (bit k: indicator k).
+  unsigned beyond_stops() const;
+  /// Logs (logEvents) each stop passed or left since the last call.
+  void log_stop_changes(Context& ctx, unsigned now, const char* where);
 };
 
 Status PlantData::make_plant(Context& ctx, const char* function, std::unique_ptr<pkm::Plant>& out) const {
@@ -147,7 +170,30 @@ Status PlantData::build(Context& ctx, const char* function) {
     return Status::Error;
   }
   plant = std::move(p);
+  contact_events = plant->contact_events();
+  stops_beyond = beyond_stops();
   return Status::OK;
+}
+
+unsigned PlantData::beyond_stops() const {
+  double g[pkm::kStopIndicators];
+  unsigned mask = 0;
+  if (pkm::stop_indicators(plant->model(), plant->state().head<4>(), g) != pkm::Status::Ok) return mask;
+  for (int k = 0; k < pkm::kStopIndicators; ++k)
+    if (g[k] < 0.0) mask |= 1u << k;
+  return mask;
+}
+
+void PlantData::log_stop_changes(Context& ctx, unsigned now, const char* where) {
+  const unsigned changed = now ^ stops_beyond;
+  for (int k = 0; k < pkm::kStopIndicators; ++k) {
+    if (!(changed & (1u << k))) continue;
+    const bool lower = k < 4;
+    ctx.log.event("%s at t = %.17g: slider %d %s its %s end stop (%s = %.9g m)", where, plant->time(), k % 4 + 1,
+                  (now & (1u << k)) ? "passes" : "leaves", lower ? "lower" : "upper", lower ? "rho_min" : "rho_max",
+                  lower ? plant->model().p.rho_min : plant->model().p.rho_max);
+  }
+  stops_beyond = now;
 }
 
 pkm::LinearInputs PlantData::inputs(double t0) const {
@@ -157,6 +203,8 @@ pkm::LinearInputs PlantData::inputs(double t0) const {
   in.dF = pkm::Vec4(du[0], du[1], du[2], du[3]);
   in.we0 = pkm::Wrench(u[4], u[5], u[6], u[7]);
   in.dwe = pkm::Wrench(du[4], du[5], du[6], du[7]);
+  in.tau0 = pkm::Vec4(u[8], u[9], u[10], u[11]);
+  in.dtau = pkm::Vec4(du[8], du[9], du[10], du[11]);
   return in;
 }
 
@@ -185,7 +233,8 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
   t_reached = t_start;
   pkm::LinearInputs in = inputs(t_start);
   const double span = t_end - t_start;
-  if (!(in.F0 + in.dF * span).allFinite() || !(in.we0 + in.dwe * span).allFinite()) {
+  if (!(in.F0 + in.dF * span).allFinite() || !(in.we0 + in.dwe * span).allFinite() ||
+      !(in.tau0 + in.dtau * span).allFinite()) {
     ctx.log.error("DoStep: the inputs extrapolated with their derivatives to t = %.17g are not finite", t_end);
     return Status::Error;
   }
@@ -193,8 +242,12 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
   t_reached = plant->time();
   // The inputs now refer to the time reached.
   if (t_reached != t_start)
-    for (int k = 0; k < 8; ++k)
+    for (int k = 0; k < kInputs; ++k)
       if (du[k] != 0.0) u[k] += du[k] * (t_reached - t_start);
+  if (plant->contact_events() != contact_events) {
+    contact_events = plant->contact_events();
+    if (ctx.log.enabled(LogCategory::Events)) log_stop_changes(ctx, beyond_stops(), "DoStep");
+  }
   switch (s) {
     case pkm::Status::Ok:
       return Status::OK;
@@ -240,12 +293,36 @@ Status PlantData::update_outputs(Context& ctx) {
     theta2[i] = ms.q[o + 2];
   }
   for (int k = 0; k < 12; ++k) lambda[k] = ms.lambda[k];
+  pkm::MachineOutputs mo;
+  const pkm::Status sm = plant->machine_outputs(inputs(plant->time()).signal(), mo);
+  if (sm != pkm::Status::Ok) {
+    ctx.log.error("get: the machine's outputs cannot be evaluated at t = %.17g: %s", plant->time(),
+                  pkm::status_name(sm));
+    return Status::Error;
+  }
+  for (int i = 0; i < 4; ++i) {
+    F_hold[i] = mo.F_hold[i];
+    stop_force[i] = mo.stop_force[i];
+  }
+  kinetic = mo.kinetic_energy;
+  potential = mo.potential_energy;
+  energy[0] = mo.actuator_work;
+  energy[1] = mo.dissipated_energy;
+  pkm::Vec10 xdot;
+  if (plant->derivative_now(inputs(plant->time()).signal(), xdot) != pkm::Status::Ok) {
+    ctx.log.error("get: the state derivative at t = %.17g cannot be evaluated", plant->time());
+    return Status::Error;
+  }
+  dy[8] = xdot[8];
+  dy[9] = xdot[9];
+  for (int k = 0; k < pkm::kStopIndicators; ++k) z[pkm::kGuardIndicators + k] = mo.stop_indicators[k];
   // From the q just evaluated: one closed-form expansion serves every output.
   residual = pkm::constraints(plant->model(), ms.q).norm();
   condition = pkm::actuator_jacobian_condition(plant->model(), ms.q);  // +inf at a singularity, never NaN
   bool finite = std::isfinite(residual) && !std::isnan(condition);
-  for (const double* block : {pose, vel, rho, drho, theta1, theta2, dy + 4})
+  for (const double* block : {pose, vel, rho, drho, theta1, theta2, dy + 4, F_hold, stop_force})
     for (int i = 0; i < 4; ++i) finite = finite && std::isfinite(block[i]);
+  for (double v : {kinetic, potential, energy[0], energy[1], dy[8], dy[9]}) finite = finite && std::isfinite(v);
   for (double v : lambda) finite = finite && std::isfinite(v);
   if (pkm::guard_indicators(plant->model(), y.head<4>(), plant->solver().limits(), z) != pkm::Status::Ok)
     finite = false;
@@ -262,6 +339,8 @@ Status PlantData::get_states(Context& ctx, double x[]) {
   const Status st = ready(ctx, "GetContinuousStates");
   if (st != Status::OK) return st;
   for (int k = 0; k < 8; ++k) x[k] = plant->state()[k];
+  x[8] = plant->energy_integrals().actuator_work;
+  x[9] = plant->energy_integrals().dissipated;
   return Status::OK;
 }
 
@@ -269,7 +348,13 @@ Status PlantData::set_states(Context& ctx, const double x[]) {
   const Status st = ready(ctx, "SetContinuousStates");
   if (st != Status::OK) return st;
   const pkm::Vec8 y = Eigen::Map<const pkm::Vec8>(x);
+  if (!std::isfinite(x[8]) || !std::isfinite(x[9])) {
+    ctx.log.error("SetContinuousStates: actuator_work = %g J or dissipated_energy = %g J is not finite; the states "
+                  "are unchanged", x[8], x[9]);
+    return Status::Error;
+  }
   const pkm::Status s = plant->set_state(y);
+  if (s == pkm::Status::Ok) plant->set_energy_integrals({x[8], x[9]});
   if (s != pkm::Status::Ok) {
     ctx.log.discard("SetContinuousStates: the pose x = %.9g m, y = %.9g m, z = %.9g m, phi = %.9g rad at t = %.17g "
                     "cannot be assembled (%s: %s); the states are unchanged (a smaller step may stay within the "
@@ -283,21 +368,23 @@ Status PlantData::set_states(Context& ctx, const double x[]) {
 Status PlantData::get_derivatives(Context& ctx, double dx[]) {
   const Status st = ready(ctx, "GetDerivatives");
   if (st != Status::OK) return st;
-  pkm::Vec8 ydot;
-  const pkm::Status s = plant->derivative_now(inputs(plant->time()).signal(), ydot);
-  if (s != pkm::Status::Ok || !ydot.allFinite()) {
+  pkm::Vec10 xdot;
+  const pkm::Status s = plant->derivative_now(inputs(plant->time()).signal(), xdot);
+  if (s != pkm::Status::Ok || !xdot.allFinite()) {
     ctx.log.error("GetDerivatives: the state derivative at t = %.17g cannot be evaluated: %s", plant->time(),
                   s != pkm::Status::Ok ? pkm::status_name(s) : "not finite (singular configuration?)");
     return Status::Error;
   }
-  for (int k = 0; k < 8; ++k) dx[k] = ydot[k];
+  for (int k = 0; k < kStates; ++k) dx[k] = xdot[k];
   return Status::OK;
 }
 
 Status PlantData::get_event_indicators(Context& ctx, double z[]) {
   const Status st = ready(ctx, "GetEventIndicators");
   if (st != Status::OK) return st;
-  const pkm::Status s = pkm::guard_indicators(plant->model(), plant->state().head<4>(), plant->solver().limits(), z);
+  const pkm::Pose pose_now = plant->state().head<4>();
+  pkm::Status s = pkm::guard_indicators(plant->model(), pose_now, plant->solver().limits(), z);
+  if (s == pkm::Status::Ok) s = pkm::stop_indicators(plant->model(), pose_now, z + pkm::kGuardIndicators);
   if (s != pkm::Status::Ok) {
     ctx.log.error("GetEventIndicators: not defined at t = %.17g: %s", plant->time(), pkm::status_name(s));
     return Status::Error;
@@ -307,15 +394,20 @@ Status PlantData::get_event_indicators(Context& ctx, double z[]) {
 
 void PlantData::get_nominals(double x[]) const {
   // Pose in m and rad, velocity in m/s and rad/s: the workspace spans
-  // centimetres, so 0.1 keeps an importer's absolute tolerance meaningful.
-  for (int k = 0; k < 8; ++k) x[k] = k == 3 || k == 7 ? 1.0 : 0.1;
+  // centimetres, so 0.1 keeps an importer's absolute tolerance meaningful;
+  // the energy integrals in J (the auto-test's work is about 0.2 J).
+  for (int k = 0; k < kStates; ++k) x[k] = k == 3 || k == 7 ? 1.0 : 0.1;
 }
 
 Status PlantData::event_update(Context& ctx, bool& terminate) {
   terminate = false;
-  double z[pkm::kGuardIndicators];
+  double z[kIndicators];
   const Status st = get_event_indicators(ctx, z);
   if (st != Status::OK) return st;
+  unsigned beyond = 0;
+  for (int k = 0; k < pkm::kStopIndicators; ++k)
+    if (z[pkm::kGuardIndicators + k] < 0.0) beyond |= 1u << k;
+  log_stop_changes(ctx, beyond, "event");
   for (int k = 0; k < pkm::kGuardIndicators; ++k) {
     if (z[k] > 0.0) continue;
     terminate = true;
@@ -342,6 +434,9 @@ void PlantData::save(StateWriter& w) const {
   w.f64(plant->time());
   w.f64s(plant->state().data(), plant->state().data() + 8);
   w.f64s(plant->theta1_ref().data(), plant->theta1_ref().data() + 4);
+  w.f64(plant->energy_integrals().actuator_work);
+  w.f64(plant->energy_integrals().dissipated);
+  w.u32(stops_beyond);
 }
 
 bool PlantData::load(StateReader& r, Context& ctx) {
@@ -352,15 +447,19 @@ bool PlantData::load(StateReader& r, Context& ctx) {
   pkm::Vec4 ref;
   r.f64s(y.data(), y.data() + 8);
   r.f64s(ref.data(), ref.data() + 4);
+  const pkm::EnergyIntegrals e{r.f64(), r.f64()};
+  const unsigned beyond = r.u32();
   if (!r.ok()) return false;
   std::unique_ptr<pkm::Plant> p;
   if (make_plant(ctx, "SetFMUState", p) != Status::OK) return false;
-  const pkm::Status s = p->restore(t, y, ref);
+  const pkm::Status s = p->restore(t, y, ref, e);
   if (s != pkm::Status::Ok) {
     ctx.log.error("SetFMUState: the saved state at t = %.17g cannot be restored: %s", t, pkm::status_name(s));
     return false;
   }
   plant = std::move(p);
+  contact_events = plant->contact_events();  // counted per Plant: a restored one starts anew
+  stops_beyond = beyond;
   return true;
 }
 
@@ -371,21 +470,27 @@ bool PlantData::load(StateReader& r, Context& ctx) {
 #define PLANT_SCALAR(member) \
   [](ModelData& d, int) -> void* { return &static_cast<PlantData&>(d).member; }
 
-constexpr std::uint8_t kSliders = kOnPositions | kOnHeight;  // rho: the only outputs that follow z
-constexpr std::uint8_t kEverything = kOnPositions | kOnRates | kOnInputs;
+// What the outputs depend on. Only the slider positions follow z (the
+// mechanism is otherwise invariant to a vertical translation), and through
+// them whatever the end stops act on; only the slider velocities follow dz,
+// and through them friction and the stops' damping.
+constexpr std::uint8_t kSliders = kOnPositions | kOnHeight;
+constexpr std::uint8_t kSliderRates = kOnPositions | kOnRates | kOnHeightRate;
+constexpr std::uint8_t kEverything = kSliders | kSliderRates | kOnInputs;
+constexpr std::uint8_t kWrench = kOnInputs | kOnWrench;  // the kind of Fe, Me_z
 
 // clang-format off
 constexpr Variable kVariables[] = {
   time_variable(0),
   // Inputs: 1..8.
-  real_input(1, "F[1]", 0.0, "N", "Actuator force on the slider of leg 1, along +z", PLANT(u), 0, PLANT(du)),
-  real_input(2, "F[2]", 0.0, "N", "Actuator force on the slider of leg 2, along +z", PLANT(u), 1, PLANT(du)),
-  real_input(3, "F[3]", 0.0, "N", "Actuator force on the slider of leg 3, along +z", PLANT(u), 2, PLANT(du)),
-  real_input(4, "F[4]", 0.0, "N", "Actuator force on the slider of leg 4, along +z", PLANT(u), 3, PLANT(du)),
-  real_input(5, "Fe[1]", 0.0, "N", "External force on the platform at P, x component (base frame)", PLANT(u), 4, PLANT(du)),
-  real_input(6, "Fe[2]", 0.0, "N", "External force on the platform at P, y component (base frame)", PLANT(u), 5, PLANT(du)),
-  real_input(7, "Fe[3]", 0.0, "N", "External force on the platform at P, z component (base frame)", PLANT(u), 6, PLANT(du)),
-  real_input(8, "Me_z", 0.0, "N.m", "External moment on the platform about z", PLANT(u), 7, PLANT(du)),
+  real_input(1, "F[1]", kHoldingForce, "N", "Actuator force on the slider of leg 1, along +z", PLANT(u), 0, PLANT(du)),
+  real_input(2, "F[2]", kHoldingForce, "N", "Actuator force on the slider of leg 2, along +z", PLANT(u), 1, PLANT(du)),
+  real_input(3, "F[3]", kHoldingForce, "N", "Actuator force on the slider of leg 3, along +z", PLANT(u), 2, PLANT(du)),
+  real_input(4, "F[4]", kHoldingForce, "N", "Actuator force on the slider of leg 4, along +z", PLANT(u), 3, PLANT(du)),
+  real_input(5, "Fe[1]", 0.0, "N", "External force on the platform at P, x component (base frame)", PLANT(u), 4, PLANT(du), kWrench),
+  real_input(6, "Fe[2]", 0.0, "N", "External force on the platform at P, y component (base frame)", PLANT(u), 5, PLANT(du), kWrench),
+  real_input(7, "Fe[3]", 0.0, "N", "External force on the platform at P, z component (base frame)", PLANT(u), 6, PLANT(du), kWrench),
+  real_input(8, "Me_z", 0.0, "N.m", "External moment on the platform about z", PLANT(u), 7, PLANT(du), kWrench),
   // Outputs: 10..53; x..dphi are the continuous states (Model Exchange).
   state_output(10, "x", "m", "Platform reference point P (centre of mass), x in the base frame", PLANT(pose), 0, 0, kOnPositions),
   state_output(11, "y", "m", "Platform reference point P (centre of mass), y in the base frame", PLANT(pose), 1, 1, kOnPositions),
@@ -395,6 +500,8 @@ constexpr Variable kVariables[] = {
   state_output(15, "dy", "m/s", "Velocity of P, y component", PLANT(vel), 1, 5, kOnRates),
   state_output(16, "dz", "m/s", "Velocity of P, z component", PLANT(vel), 2, 6, kOnHeightRate),
   state_output(17, "dphi", "rad/s", "Platform angular velocity about z", PLANT(vel), 3, 7, kOnRates),
+  state_output(18, "actuator_work", "J", "Work done on the machine since the start: integral of (F_i + (2 pi/screw_lead) tau_i) drho_i plus the external wrench's power", PLANT(energy), 0, 8, kOnEnergy),
+  state_output(19, "dissipated_energy", "J", "Energy dissipated since the start by joint friction and the end stops' damping", PLANT(energy), 1, 9, kOnEnergy),
   real_output(20, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", PLANT(rho), 0, kSliders),
   real_output(21, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", PLANT(rho), 1, kSliders),
   real_output(22, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", PLANT(rho), 2, kSliders),
@@ -411,6 +518,10 @@ constexpr Variable kVariables[] = {
   real_output(33, "theta2[2]", "rad", "Second revolute joint of leg 2 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 1, kOnPositions),
   real_output(34, "theta2[3]", "rad", "Second revolute joint of leg 3 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 2, kOnPositions),
   real_output(35, "theta2[4]", "rad", "Second revolute joint of leg 4 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 3, kOnPositions),
+  real_output(36, "stop_force[1]", "N", "End-stop force on the slider of leg 1, along +z (0 within its travel)", PLANT(stop_force), 0, kEverything & ~kOnInputs),
+  real_output(37, "stop_force[2]", "N", "End-stop force on the slider of leg 2, along +z", PLANT(stop_force), 1, kEverything & ~kOnInputs),
+  real_output(38, "stop_force[3]", "N", "End-stop force on the slider of leg 3, along +z", PLANT(stop_force), 2, kEverything & ~kOnInputs),
+  real_output(39, "stop_force[4]", "N", "End-stop force on the slider of leg 4, along +z", PLANT(stop_force), 3, kEverything & ~kOnInputs),
   real_output(40, "lambda[1]", "N", "Lagrange multiplier of leg 1's loop closure, x row (Eq. 1)", PLANT(lambda), 0, kEverything),
   real_output(41, "lambda[2]", "N", "Lagrange multiplier of leg 1's loop closure, y row (Eq. 1)", PLANT(lambda), 1, kEverything),
   real_output(42, "lambda[3]", "N", "Lagrange multiplier of leg 1's loop closure, z row (Eq. 1)", PLANT(lambda), 2, kEverything),
@@ -425,6 +536,12 @@ constexpr Variable kVariables[] = {
   real_output(51, "lambda[12]", "N", "Lagrange multiplier of leg 4's loop closure, z row (Eq. 1)", PLANT(lambda), 11, kEverything),
   real_output(52, "constraint_residual", "m", "Norm of the loop closures ||C(q)|| (Eq. 15) at the current state", PLANT_SCALAR(residual), 0, kOnPositions),
   real_output(53, "jacobian_condition", "", "Condition number of the 4x4 actuator Jacobian d(rho)/d(x, y, z, phi), its phi column divided by 0.1 m", PLANT_SCALAR(condition), 0, kOnPositions),
+  real_output(54, "F_hold[1]", "N", "Actuator force of leg 1 that would hold the current pose at rest under gravity, the payload and the current external wrench", PLANT(F_hold), 0, kOnPositions | kOnWrench),
+  real_output(55, "F_hold[2]", "N", "The same for leg 2", PLANT(F_hold), 1, kOnPositions | kOnWrench),
+  real_output(56, "F_hold[3]", "N", "The same for leg 3", PLANT(F_hold), 2, kOnPositions | kOnWrench),
+  real_output(57, "F_hold[4]", "N", "The same for leg 4", PLANT(F_hold), 3, kOnPositions | kOnWrench),
+  real_output(58, "kinetic_energy", "J", "Kinetic energy of the mechanism, the payload and the rotors", PLANT_SCALAR(kinetic), 0, kSliderRates),
+  real_output(59, "potential_energy", "J", "Potential energy: gravity plus the end stops' springs", PLANT_SCALAR(potential), 0, kSliders),
   // Derivatives of the continuous states: 60..67.
   state_derivative(60, "der(x)", "m/s", "Derivative of x", PLANT(dy), 0, 0, kOnRates),
   state_derivative(61, "der(y)", "m/s", "Derivative of y", PLANT(dy), 1, 1, kOnRates),
@@ -434,6 +551,8 @@ constexpr Variable kVariables[] = {
   state_derivative(65, "der(dy)", "m/s2", "Acceleration of P, y component (Eq. 13)", PLANT(dy), 5, 5, kEverything),
   state_derivative(66, "der(dz)", "m/s2", "Acceleration of P, z component (Eq. 13)", PLANT(dy), 6, 6, kEverything),
   state_derivative(67, "der(dphi)", "rad/s2", "Angular acceleration of the platform about z (Eq. 13)", PLANT(dy), 7, 7, kEverything),
+  state_derivative(68, "der(actuator_work)", "W", "Power of the actuators, drives and external wrench", PLANT(dy), 8, 8, kSliderRates | kOnInputs),
+  state_derivative(69, "der(dissipated_energy)", "W", "Power dissipated by friction and the end stops' damping", PLANT(dy), 9, 9, kEverything & ~kOnInputs),
   // Event indicators (Model Exchange): 70..74.
   event_indicator(70, "guard_condition_margin", "",
                   "1/jacobian_condition - 1/max_jacobian_condition: event indicator of the parallel-singularity guard "
@@ -444,7 +563,21 @@ constexpr Variable kVariables[] = {
   event_indicator(72, "guard_leg_margin[2]", "", "The same for leg 2", PLANT(z), 2, 2, kOnPositions),
   event_indicator(73, "guard_leg_margin[3]", "", "The same for leg 3", PLANT(z), 3, 3, kOnPositions),
   event_indicator(74, "guard_leg_margin[4]", "", "The same for leg 4", PLANT(z), 4, 4, kOnPositions),
-  // Parameters: the mechanism (100..120), the initial state (130..137), the solver (140..147).
+  event_indicator(75, "stop_margin_lower[1]", "m", "rho[1] - rho_min: event indicator of leg 1's lower end stop (negative in contact)", PLANT(z), 5, 5, kSliders),
+  event_indicator(76, "stop_margin_lower[2]", "m", "rho[2] - rho_min", PLANT(z), 6, 6, kSliders),
+  event_indicator(77, "stop_margin_lower[3]", "m", "rho[3] - rho_min", PLANT(z), 7, 7, kSliders),
+  event_indicator(78, "stop_margin_lower[4]", "m", "rho[4] - rho_min", PLANT(z), 8, 8, kSliders),
+  event_indicator(79, "stop_margin_upper[1]", "m", "rho_max - rho[1]: event indicator of leg 1's upper end stop (negative in contact)", PLANT(z), 9, 9, kSliders),
+  event_indicator(80, "stop_margin_upper[2]", "m", "rho_max - rho[2]", PLANT(z), 10, 10, kSliders),
+  event_indicator(81, "stop_margin_upper[3]", "m", "rho_max - rho[3]", PLANT(z), 11, 11, kSliders),
+  event_indicator(82, "stop_margin_upper[4]", "m", "rho_max - rho[4]", PLANT(z), 12, 12, kSliders),
+  // Motor torques: 90..93.
+  real_input(90, "tau[1]", 0.0, "N.m", "Motor torque of leg 1's drive: adds (2 pi/screw_lead) tau to F[1]", PLANT(u), 8, PLANT(du)),
+  real_input(91, "tau[2]", 0.0, "N.m", "Motor torque of leg 2's drive", PLANT(u), 9, PLANT(du)),
+  real_input(92, "tau[3]", 0.0, "N.m", "Motor torque of leg 3's drive", PLANT(u), 10, PLANT(du)),
+  real_input(93, "tau[4]", 0.0, "N.m", "Motor torque of leg 4's drive", PLANT(u), 11, PLANT(du)),
+  // Parameters: the mechanism (100..120), the initial state (130..137), the
+  // solver (140..147), the end stops' compliance (148..149), the machine (150..160).
   PKM_FMI_MECHANISM_PARAMETERS,
   real_parameter(130, "x0", 0.0, "m", "Initial x of P", PLANT(pose0), 0),
   real_parameter(131, "y0", 0.0, "m", "Initial y of P", PLANT(pose0), 1),
@@ -477,6 +610,12 @@ constexpr Variable kVariables[] = {
                  "(rod nearly horizontal or vertical) is discarded (Co-Simulation: Discard, state kept; Model "
                  "Exchange: an event indicator, terminateSimulation); in [0, 0.5)",
                  PLANT_SCALAR(min_leg_measure), 0, 0.0, 0.5),
+  real_parameter(148, "stop_stiffness", kDefaultParams.stop_stiffness, "N/m",
+                 "Stiffness k of the compliant end stops: k delta + d delta_dot pushes a slider back past rho_min or rho_max by delta (never pulls)",
+                 PKM_FMI_PARAM(stop_stiffness), 0, 0.0),
+  real_parameter(149, "stop_damping", kDefaultParams.stop_damping, "N.s/m", "Damping d of the end stops",
+                 PKM_FMI_PARAM(stop_damping), 0, 0.0),
+  PKM_FMI_MACHINE_PARAMETERS,
 };
 // clang-format on
 
@@ -510,8 +649,9 @@ const ModelDefinition kDefinition{
     "saved, restored and serialised.</p>",
     kVariables,
     std::size(kVariables),
-    /*n_states=*/8,
-    /*n_event_indicators=*/pkm::kGuardIndicators,
+    /*n_states=*/kStates,
+    /*n_position_states=*/4,
+    /*n_event_indicators=*/kIndicators,
     /*can_interpolate_inputs=*/true,
     /*default_step=*/1e-3,
     /*default_stop=*/2.0,

@@ -32,7 +32,10 @@ struct InverseData final : MechanismData {
   double vel[4] = {}, acc[4] = {};
   double wrench[4] = {};  // Fe1..Fe3, Me_z
   // Outputs.
-  double F[4] = {}, rho[4] = {}, drho[4] = {}, lambda[12] = {};
+  double F[4] = {}, tau[4] = {}, rho[4] = {}, drho[4] = {}, lambda[12] = {};
+  // Joints beyond their end stops at the last evaluation (bit i: below
+  // rho_min, 4 + i: above rho_max): a warning is given on entering, once.
+  unsigned beyond_stops = 0;
   // Built at the end of initialisation.
   std::unique_ptr<pkm::Model> model;
 
@@ -93,11 +96,25 @@ Status InverseData::update_outputs(Context& ctx) {
   for (int i = 0; i < 4; ++i) {
     const int o = pkm::leg_offset(i);
     F[i] = r.F[i];
+    tau[i] = r.tau[i];
     rho[i] = r.q[o];
     drho[i] = r.qd[o];
   }
   for (int k = 0; k < 12; ++k) lambda[k] = r.lambda[k];
-  return Status::OK;
+  const unsigned entered = r.beyond_stops & ~beyond_stops;
+  beyond_stops = r.beyond_stops;
+  if (entered == 0) return Status::OK;
+  for (int k = 0; k < 8; ++k) {
+    if (!(entered & (1u << k))) continue;
+    const bool lower = k < 4;
+    ctx.log.warning("get: the requested pose x = %g m, y = %g m, z = %g m, phi = %g rad puts slider %d at rho = %.9g m, "
+                    "%s its %s end stop %s = %.9g m: the forces include the stop's reaction, a real machine would not "
+                    "follow",
+                    pose[0], pose[1], pose[2], pose[3], k % 4 + 1, rho[k % 4], lower ? "below" : "above",
+                    lower ? "lower" : "upper", lower ? "rho_min" : "rho_max",
+                    lower ? m->p.rho_min : m->p.rho_max);
+  }
+  return Status::Warning;
 }
 
 void InverseData::save(StateWriter& w) const { w.u8(model ? 1 : 0); }
@@ -119,7 +136,12 @@ bool InverseData::load(StateReader& r, Context& ctx) {
 #define INV(member) \
   [](ModelData& d, int i) -> void* { return &static_cast<InverseData&>(d).member[i]; }
 
-constexpr std::uint8_t kEverything = kOnPositions | kOnRates | kOnInputs;
+// The multipliers: invariant to a vertical translation. The forces follow z
+// too, through the end stops (beyond them), and dz through the joints'
+// friction and the stops' damping (which act on the sliders only, so the
+// multipliers do not see them).
+constexpr std::uint8_t kMultipliers = kOnPositions | kOnRates | kOnInputs;
+constexpr std::uint8_t kForces = kMultipliers | kOnHeight | kOnHeightRate;
 
 // clang-format off
 constexpr Variable kVariables[] = {
@@ -142,10 +164,10 @@ constexpr Variable kVariables[] = {
   real_input(15, "Fe[3]", 0.0, "N", "External force on the platform at P, z component (base frame)", INV(wrench), 2, nullptr),
   real_input(16, "Me_z", 0.0, "N.m", "External moment on the platform about z", INV(wrench), 3, nullptr),
   // Outputs: 20..51.
-  real_output(20, "F[1]", "N", "Actuator force on the slider of leg 1, along +z (Eq. 11)", INV(F), 0, kEverything),
-  real_output(21, "F[2]", "N", "Actuator force on the slider of leg 2, along +z (Eq. 11)", INV(F), 1, kEverything),
-  real_output(22, "F[3]", "N", "Actuator force on the slider of leg 3, along +z (Eq. 11)", INV(F), 2, kEverything),
-  real_output(23, "F[4]", "N", "Actuator force on the slider of leg 4, along +z (Eq. 11)", INV(F), 3, kEverything),
+  real_output(20, "F[1]", "N", "Actuator force on the slider of leg 1, along +z (Eq. 11)", INV(F), 0, kForces),
+  real_output(21, "F[2]", "N", "Actuator force on the slider of leg 2, along +z (Eq. 11)", INV(F), 1, kForces),
+  real_output(22, "F[3]", "N", "Actuator force on the slider of leg 3, along +z (Eq. 11)", INV(F), 2, kForces),
+  real_output(23, "F[4]", "N", "Actuator force on the slider of leg 4, along +z (Eq. 11)", INV(F), 3, kForces),
   real_output(24, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", INV(rho), 0, kOnPositions | kOnHeight),
   real_output(25, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", INV(rho), 1, kOnPositions | kOnHeight),
   real_output(26, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", INV(rho), 2, kOnPositions | kOnHeight),
@@ -154,20 +176,25 @@ constexpr Variable kVariables[] = {
   real_output(29, "drho[2]", "m/s", "Slider velocity of leg 2", INV(drho), 1, kOnPositions | kOnRates | kOnHeightRate),
   real_output(30, "drho[3]", "m/s", "Slider velocity of leg 3", INV(drho), 2, kOnPositions | kOnRates | kOnHeightRate),
   real_output(31, "drho[4]", "m/s", "Slider velocity of leg 4", INV(drho), 3, kOnPositions | kOnRates | kOnHeightRate),
-  real_output(40, "lambda[1]", "N", "Lagrange multiplier of leg 1's loop closure, x row (Eq. 10)", INV(lambda), 0, kEverything),
-  real_output(41, "lambda[2]", "N", "Lagrange multiplier of leg 1's loop closure, y row (Eq. 10)", INV(lambda), 1, kEverything),
-  real_output(42, "lambda[3]", "N", "Lagrange multiplier of leg 1's loop closure, z row (Eq. 10)", INV(lambda), 2, kEverything),
-  real_output(43, "lambda[4]", "N", "Lagrange multiplier of leg 2's loop closure, x row (Eq. 10)", INV(lambda), 3, kEverything),
-  real_output(44, "lambda[5]", "N", "Lagrange multiplier of leg 2's loop closure, y row (Eq. 10)", INV(lambda), 4, kEverything),
-  real_output(45, "lambda[6]", "N", "Lagrange multiplier of leg 2's loop closure, z row (Eq. 10)", INV(lambda), 5, kEverything),
-  real_output(46, "lambda[7]", "N", "Lagrange multiplier of leg 3's loop closure, x row (Eq. 10)", INV(lambda), 6, kEverything),
-  real_output(47, "lambda[8]", "N", "Lagrange multiplier of leg 3's loop closure, y row (Eq. 10)", INV(lambda), 7, kEverything),
-  real_output(48, "lambda[9]", "N", "Lagrange multiplier of leg 3's loop closure, z row (Eq. 10)", INV(lambda), 8, kEverything),
-  real_output(49, "lambda[10]", "N", "Lagrange multiplier of leg 4's loop closure, x row (Eq. 10)", INV(lambda), 9, kEverything),
-  real_output(50, "lambda[11]", "N", "Lagrange multiplier of leg 4's loop closure, y row (Eq. 10)", INV(lambda), 10, kEverything),
-  real_output(51, "lambda[12]", "N", "Lagrange multiplier of leg 4's loop closure, z row (Eq. 10)", INV(lambda), 11, kEverything),
-  // Parameters: the mechanism (100..120).
+  real_output(32, "tau[1]", "N.m", "Equivalent motor torque of leg 1, F[1] screw_lead/(2 pi)", INV(tau), 0, kForces),
+  real_output(33, "tau[2]", "N.m", "Equivalent motor torque of leg 2", INV(tau), 1, kForces),
+  real_output(34, "tau[3]", "N.m", "Equivalent motor torque of leg 3", INV(tau), 2, kForces),
+  real_output(35, "tau[4]", "N.m", "Equivalent motor torque of leg 4", INV(tau), 3, kForces),
+  real_output(40, "lambda[1]", "N", "Lagrange multiplier of leg 1's loop closure, x row (Eq. 10)", INV(lambda), 0, kMultipliers),
+  real_output(41, "lambda[2]", "N", "Lagrange multiplier of leg 1's loop closure, y row (Eq. 10)", INV(lambda), 1, kMultipliers),
+  real_output(42, "lambda[3]", "N", "Lagrange multiplier of leg 1's loop closure, z row (Eq. 10)", INV(lambda), 2, kMultipliers),
+  real_output(43, "lambda[4]", "N", "Lagrange multiplier of leg 2's loop closure, x row (Eq. 10)", INV(lambda), 3, kMultipliers),
+  real_output(44, "lambda[5]", "N", "Lagrange multiplier of leg 2's loop closure, y row (Eq. 10)", INV(lambda), 4, kMultipliers),
+  real_output(45, "lambda[6]", "N", "Lagrange multiplier of leg 2's loop closure, z row (Eq. 10)", INV(lambda), 5, kMultipliers),
+  real_output(46, "lambda[7]", "N", "Lagrange multiplier of leg 3's loop closure, x row (Eq. 10)", INV(lambda), 6, kMultipliers),
+  real_output(47, "lambda[8]", "N", "Lagrange multiplier of leg 3's loop closure, y row (Eq. 10)", INV(lambda), 7, kMultipliers),
+  real_output(48, "lambda[9]", "N", "Lagrange multiplier of leg 3's loop closure, z row (Eq. 10)", INV(lambda), 8, kMultipliers),
+  real_output(49, "lambda[10]", "N", "Lagrange multiplier of leg 4's loop closure, x row (Eq. 10)", INV(lambda), 9, kMultipliers),
+  real_output(50, "lambda[11]", "N", "Lagrange multiplier of leg 4's loop closure, y row (Eq. 10)", INV(lambda), 10, kMultipliers),
+  real_output(51, "lambda[12]", "N", "Lagrange multiplier of leg 4's loop closure, z row (Eq. 10)", INV(lambda), 11, kMultipliers),
+  // Parameters: the mechanism (100..120), the machine (150..160).
   PKM_FMI_MECHANISM_PARAMETERS,
+  PKM_FMI_MACHINE_PARAMETERS,
 };
 // clang-format on
 
@@ -193,6 +220,7 @@ const ModelDefinition kDefinition{
     kVariables,
     std::size(kVariables),
     /*n_states=*/0,
+    /*n_position_states=*/0,
     /*n_event_indicators=*/0,
     /*can_interpolate_inputs=*/false,
     /*default_step=*/1e-3,

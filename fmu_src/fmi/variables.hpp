@@ -47,6 +47,8 @@ enum Depends : std::uint8_t {
   kOnOwnState = 1u << 3,   // outputs that are a state: that state only
   kOnHeight = 1u << 4,     // the vertical position (state or input): the machine is otherwise invariant to it
   kOnHeightRate = 1u << 5, // its rate: only the slider velocities follow it
+  kOnWrench = 1u << 6,     // the external wrench inputs (a kind of kOnInputs)
+  kOnEnergy = 1u << 7,     // running-integral states (energy audit): nothing else depends on them
 };
 
 /// One row of a model's variable table: everything modelDescription.xml
@@ -151,6 +153,7 @@ struct ModelDefinition {
   const Variable* variables;  // sorted by value reference, unique
   std::size_t n_variables;
   std::size_t n_states;            // continuous states (Model Exchange)
+  std::size_t n_position_states;   // the first states are positions whose derivatives are the next ones
   std::size_t n_event_indicators;  // Model Exchange
   bool can_interpolate_inputs;     // FMI 2.0 CS: fmi2SetRealInputDerivatives
   double default_step;             // DefaultExperiment stepSize
