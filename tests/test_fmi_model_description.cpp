@@ -125,7 +125,9 @@ struct Harness {
   }
   std::vector<double> read() {
     std::vector<double> y(unknowns.size());
-    EXPECT_EQ(inst->get_real(unknowns.data(), unknowns.size(), y.data()), Status::OK);
+    // Warning: the inverse FMU's note on a pose beyond an end stop (once).
+    const Status s = inst->get_real(unknowns.data(), unknowns.size(), y.data());
+    EXPECT_TRUE(s == Status::OK || s == Status::Warning);
     return y;
   }
   void set(const char* name, double x) {
@@ -138,6 +140,21 @@ struct Harness {
     return {deps.knowns.begin(), deps.knowns.end()};
   }
 };
+
+// Every term of the machine on, and the sliders pressed into their lower end
+// stops (rho_min above every rho of the points below, a soft stop), so that
+// whatever can depend on something does.
+void machine_point(Harness& h) {
+  h.set("rotor_inertia", 2e-6);
+  h.set("friction_viscous", 2.0);
+  h.set("friction_coulomb", 0.1);
+  h.set("payload_mass", 0.2);
+  h.set("payload_com[1]", 0.01);
+  h.set("payload_com[2]", -0.005);
+  h.set("payload_Izz", 1e-4);
+  h.set("rho_min", 0.06);
+  if (h.d.find("stop_stiffness")) h.set("stop_stiffness", 1e3);
+}
 
 // A generic point: the platform moving, every input nonzero.
 void plant_point(Harness& h) {
@@ -154,6 +171,8 @@ void plant_point(Harness& h) {
   h.set("Fe[2]", -0.03);
   h.set("Fe[3]", 0.02);
   h.set("Me_z", 0.001);
+  machine_point(h);
+  for (int i = 1; i <= 4; ++i) h.set(("tau[" + std::to_string(i) + "]").c_str(), 0.001 * i);
 }
 
 // Perturbing an input moves exactly the unknowns that list it: the pose and
@@ -207,6 +226,7 @@ TEST(ModelStructure, InverseInputDependenciesAreExact) {
   h.set("Fe[2]", 0.1);
   h.set("Fe[3]", 0.1);
   h.set("Me_z", 0.01);
+  machine_point(h);
   ASSERT_EQ(h.inst->enter_initialization_mode(), Status::OK);
   ASSERT_EQ(h.inst->exit_initialization_mode(), Status::OK);
   check_input_dependencies(h);
@@ -223,23 +243,28 @@ TEST(ModelStructure, PlantStateDependenciesAreExact) {
   ASSERT_EQ(h.inst->enter_initialization_mode(), Status::OK);
   ASSERT_EQ(h.inst->exit_initialization_mode(), Status::OK);
   ASSERT_EQ(h.inst->enter_continuous_time_mode(), Status::OK);
-  double x[8];
-  ASSERT_EQ(h.inst->get_continuous_states(x, 8), Status::OK);
+  const int n = static_cast<int>(h.d.n_states);
+  std::vector<double> x(n);
+  ASSERT_EQ(h.inst->get_continuous_states(x.data(), n), Status::OK);
   const std::vector<double> base = h.read();
   int listed_and_moved = 0;
-  for (int k = 0; k < 8; ++k) {
+  for (int k = 0; k < n; ++k) {
     const Variable* state = nullptr;
     for (std::size_t i = 0; i < h.d.n_variables; ++i)
       if (h.d.variables[i].state == k) state = &h.d.variables[i];
     ASSERT_NE(state, nullptr);
-    double y[8];
-    std::copy(x, x + 8, y);
+    std::vector<double> y = x;
     y[k] += k < 4 ? 1e-5 : 1e-3;
-    ASSERT_EQ(h.inst->set_continuous_states(y, 8), Status::OK);
+    ASSERT_EQ(h.inst->set_continuous_states(y.data(), n), Status::OK);
     const std::vector<double> moved = h.read();
     for (std::size_t o = 0; o < h.unknowns.size(); ++o) {
       const std::string name = h.d.find(h.unknowns[o])->name;
       if (name == "constraint_residual") continue;
+      // The stops' dissipation, d (d delta/dt)^2 while a stop pushes, does
+      // not depend on the depth; it does while a stop is released (k delta
+      // d delta/dt) and when contact begins or ends: a structural dependence
+      // this point cannot show.
+      if (name == "der(dissipated_energy)" && std::string(state->name) == "z") continue;
       const bool listed = h.declared(h.unknowns[o]).count(state->vr) != 0;
       const bool moves = moved[o] != base[o];
       listed_and_moved += listed && moves;
@@ -247,7 +272,7 @@ TEST(ModelStructure, PlantStateDependenciesAreExact) {
                                << state->name << " but " << (listed ? "lists" : "does not list") << " it";
     }
   }
-  ASSERT_EQ(h.inst->set_continuous_states(x, 8), Status::OK);
+  ASSERT_EQ(h.inst->set_continuous_states(x.data(), n), Status::OK);
   EXPECT_EQ(h.read(), base);
   EXPECT_GT(listed_and_moved, 100);  // the check saw real movement
 }

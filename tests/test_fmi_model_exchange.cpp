@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "autotest.hpp"
 #include "fmu_loader.hpp"
@@ -18,7 +19,7 @@ namespace {
 
 using pkm_test::PlantFmu;
 
-constexpr int kStates = 8;
+constexpr int kStates = 10;  // pose, velocity, actuator_work, dissipated_energy
 using State = std::array<double, kStates>;
 
 /// One Model Exchange instance at the home pose, in continuous-time mode.
@@ -89,6 +90,7 @@ TEST(ModelExchange, OwnRk4WithExactStageForcesMatchesTheInProcessAutoTest) {
   MeInstance me;
   me.start();
   State x = me.states();
+  const double energy_start = me.fmu.get("kinetic_energy") + me.fmu.get("potential_energy");
   const double h = opt.solver.rk4_step;
   double worst_position = 0.0, worst_angle = 0.0, min_indicator = INFINITY;
   for (std::size_t k = 1; k < in_process.samples.size(); ++k) {
@@ -107,8 +109,8 @@ TEST(ModelExchange, OwnRk4WithExactStageForcesMatchesTheInProcessAutoTest) {
     ASSERT_EQ(me.fmu.lib.fmi2CompletedIntegratorStep(me.fmu.c, fmi2True, &enter_event, &terminate), fmi2OK);
     EXPECT_EQ(enter_event, fmi2False);
     EXPECT_EQ(terminate, fmi2False);
-    double z[pkm::kGuardIndicators];
-    ASSERT_EQ(me.fmu.lib.fmi2GetEventIndicators(me.fmu.c, z, pkm::kGuardIndicators), fmi2OK);
+    std::vector<double> z(me.fmu.def.n_event_indicators);  // guards, then end stops
+    ASSERT_EQ(me.fmu.lib.fmi2GetEventIndicators(me.fmu.c, z.data(), z.size()), fmi2OK);
     for (double zi : z) min_indicator = std::min(min_indicator, zi);
 
     const pkm::Pose& simulated = in_process.samples[k].simulated;
@@ -118,9 +120,17 @@ TEST(ModelExchange, OwnRk4WithExactStageForcesMatchesTheInProcessAutoTest) {
   std::printf("  Model Exchange + own RK4 vs in-process auto-test: %.2e m, %.2e rad (bound 1e-10); "
               "in-process vs the path: %.2e m, %.2e rad; smallest guard indicator %.3g\n",
               worst_position, worst_angle, in_process.max_position_error, in_process.max_angle_error, min_indicator);
+  // The energy audit (the default machine: no friction, the stops never
+  // touched): the work done equals the gain in kinetic plus potential energy.
+  const double gain = me.fmu.get("kinetic_energy") + me.fmu.get("potential_energy") - energy_start;
+  std::printf("  energy audit: actuator_work %.12f J, gain %.12f J, difference %.2e J (bound 1e-9)\n", x[8], gain,
+              x[8] - gain);
+  EXPECT_NEAR(x[8], gain, 1e-9);
+  EXPECT_GT(gain, 0.1) << "the platform is lifted 2 cm: about 10.6 N x 0.02 m of work";
+  EXPECT_EQ(x[9], 0.0) << "nothing dissipates in the default machine";
   EXPECT_LE(worst_position, 1e-10);
   EXPECT_LE(worst_angle, 1e-10);
-  EXPECT_GT(min_indicator, 0.0) << "the auto-test stays inside both guards (MODEL_SPEC)";
+  EXPECT_GT(min_indicator, 0.0) << "the auto-test stays inside both guards and the sliders' travel (MODEL_SPEC)";
   // Not trivially zero: the platform moved 2 cm and 4 degrees.
   EXPECT_NEAR(x[2], 0.07, 1e-7);
   EXPECT_NEAR(x[3], 4.0 * pkm_test::kPi / 180.0, 1e-7);

@@ -39,6 +39,10 @@ std::vector<double> work(int k, const std::atomic<bool>* go) {
   p.set("x0", 1e-3 * (k - 3.5));
   p.set("dphi0", 0.01 * k);
   p.set("m_platform", 0.45474 * (1.0 + 0.01 * k));
+  // Some of these runs end on the plant's lower end stops; the inverse FMU,
+  // asked at those poses, would warn of a pose beyond them (once): not this
+  // test's subject, so its stops are moved out of the way.
+  inv.set("rho_min", -1.0);
   if (go) {
     while (!go->load(std::memory_order_acquire)) std::this_thread::yield();
   }
