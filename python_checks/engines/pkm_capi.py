@@ -54,7 +54,27 @@ class InverseResult(ct.Structure):
                 ("qd", ct.c_double * 16), ("qdd", ct.c_double * 16), RESERVE]
 
 
+class MachineParams(ct.Structure):
+    _fields_ = [("screw_lead", ct.c_double), ("rotor_inertia", ct.c_double), ("friction_viscous", ct.c_double),
+                ("friction_coulomb", ct.c_double), ("friction_velocity", ct.c_double), ("rho_min", ct.c_double),
+                ("rho_max", ct.c_double), ("stop_stiffness", ct.c_double), ("stop_damping", ct.c_double),
+                ("payload_mass", ct.c_double), ("payload_com", ct.c_double * 2), ("payload_Izz", ct.c_double),
+                RESERVE]
+
+
+class MachineOutputs(ct.Structure):
+    _fields_ = [("stop_force", ct.c_double * 4), ("friction_force", ct.c_double * 4), ("F_hold", ct.c_double * 4),
+                ("kinetic_energy", ct.c_double), ("potential_energy", ct.c_double), ("actuator_work", ct.c_double),
+                ("dissipated_energy", ct.c_double), ("stop_indicators", ct.c_double * 8), RESERVE]
+
+
+class InverseMachineResult(ct.Structure):
+    _fields_ = [("F", ct.c_double * 4), ("tau", ct.c_double * 4), ("lambda_", ct.c_double * 12),
+                ("beyond_stops", ct.c_uint), RESERVE]
+
+
 INPUT_FN = ct.CFUNCTYPE(None, ct.c_void_p, ct.c_double, ct.POINTER(ct.c_double), ct.POINTER(ct.c_double))
+TORQUE_FN = ct.CFUNCTYPE(None, ct.c_void_p, ct.c_double, ct.POINTER(ct.c_double))
 
 
 def library_path(build=None):
@@ -90,6 +110,17 @@ def load(path=None):
     lib.pkm_get_outputs.restype = i
     lib.pkm_get_state.argtypes = [vp, dp, dp, dp]
     lib.pkm_get_state.restype = i
+    # the machine around the mechanism
+    lib.pkm_default_machine_params.argtypes = [P(MachineParams)]
+    lib.pkm_default_machine_params.restype = None
+    lib.pkm_create_machine.argtypes = [P(Params), P(MachineParams), P(vp), ct.c_char_p, ct.c_size_t]
+    lib.pkm_create_machine.restype = i
+    lib.pkm_advance_fn_drives.argtypes = [vp, ct.c_double, INPUT_FN, TORQUE_FN, vp, i]
+    lib.pkm_advance_fn_drives.restype = i
+    lib.pkm_get_machine_outputs.argtypes = [vp, dp, dp, dp, P(MachineOutputs)]
+    lib.pkm_get_machine_outputs.restype = i
+    lib.pkm_inverse_dynamics_machine.argtypes = [vp, dp, dp, dp, dp, P(InverseMachineResult)]
+    lib.pkm_inverse_dynamics_machine.restype = i
     return lib
 
 
@@ -103,9 +134,11 @@ class PkmError(RuntimeError):
 
 class Model:
     """One pkm_model handle. Keyword arguments override the default parameters
-    (pkm_default_params), e.g. Model(lib, g=0.0)."""
+    (pkm_default_params), e.g. Model(lib, g=0.0). machine: a dict of
+    pkm_machine_params fields overriding pkm_default_machine_params (the
+    model is then made by pkm_create_machine), e.g. {"rotor_inertia": 1e-7}."""
 
-    def __init__(self, lib, **params):
+    def __init__(self, lib, machine=None, **params):
         self.lib = lib
         p = Params()
         lib.pkm_default_params(ct.byref(p))
@@ -114,9 +147,22 @@ class Model:
         self.params = p
         self.handle = ct.c_void_p()
         err = ct.create_string_buffer(256)
-        s = lib.pkm_create(ct.byref(p), ct.byref(self.handle), err, 256)
+        if machine is None:
+            s = lib.pkm_create(ct.byref(p), ct.byref(self.handle), err, 256)
+            what = "pkm_create"
+        else:
+            mp = MachineParams()
+            lib.pkm_default_machine_params(ct.byref(mp))
+            for k, v in machine.items():
+                if k == "payload_com":
+                    mp.payload_com[0], mp.payload_com[1] = v
+                else:
+                    setattr(mp, k, v)
+            self.machine = mp
+            s = lib.pkm_create_machine(ct.byref(p), ct.byref(mp), ct.byref(self.handle), err, 256)
+            what = "pkm_create_machine"
         if s != PKM_OK:
-            raise PkmError(f"pkm_create: status {s}: {err.value.decode()}")
+            raise PkmError(f"{what}: status {s}: {err.value.decode()}")
         self._callback = None
 
     def close(self):
@@ -170,6 +216,40 @@ class Model:
         self._check(self.lib.pkm_advance_fn(self.handle, t_end, self._callback, None, int(continuous)),
                     "pkm_advance_fn")
 
+    def advance_fn_drives(self, t_end, inputs, torques, continuous=True):
+        """inputs(t) -> F[4] (N), or (F, wrench); torques(t) -> tau[4] (N m);
+        both evaluated at the integrator's own times (pkm_advance_fn_drives)."""
+
+        def cb(_user, t, F, w):
+            r = inputs(t)
+            f, wr = (r if isinstance(r, tuple) else (r, None))
+            for k in range(4):
+                F[k] = f[k]
+            if wr is not None:
+                for k in range(4):
+                    w[k] = wr[k]
+
+        def cb_tau(_user, t, tau):
+            r = torques(t)
+            for k in range(4):
+                tau[k] = r[k]
+
+        self._callback = (INPUT_FN(cb), TORQUE_FN(cb_tau))  # kept alive for the call
+        self._check(self.lib.pkm_advance_fn_drives(self.handle, t_end, self._callback[0], self._callback[1], None,
+                                                   int(continuous)), "pkm_advance_fn_drives")
+
+    def machine_outputs(self, F=None, tau=None, wrench=None):
+        o = MachineOutputs()
+        self._check(self.lib.pkm_get_machine_outputs(self.handle, _d4(F), _d4(tau), _d4(wrench), ct.byref(o)),
+                    "pkm_get_machine_outputs")
+        return o
+
+    def inverse_dynamics_machine(self, pose, velocity, acceleration, wrench=None):
+        r = InverseMachineResult()
+        self._check(self.lib.pkm_inverse_dynamics_machine(self.handle, _d4(pose), _d4(velocity), _d4(acceleration),
+                                                          _d4(wrench), ct.byref(r)), "pkm_inverse_dynamics_machine")
+        return r
+
     def outputs(self, F=None, wrench=None):
         o = Outputs()
         self._check(self.lib.pkm_get_outputs(self.handle, _d4(F), _d4(wrench), ct.byref(o)), "pkm_get_outputs")
@@ -177,7 +257,7 @@ class Model:
 
 
 # --- the layout check against pkm.h ------------------------------------------------------
-_C_TYPES = {"double": (8, 8), "int": (4, 4)}
+_C_TYPES = {"double": (8, 8), "int": (4, 4), "unsigned": (4, 4)}
 
 
 def header_structs(path=REPO / "fmu_src" / "capi" / "pkm.h"):
@@ -211,7 +291,8 @@ def binding_mismatches(path=REPO / "fmu_src" / "capi" / "pkm.h"):
     structs = header_structs(path)
     bad = []
     for cname, cls in (("pkm_params", Params), ("pkm_solver_settings", SolverSettings), ("pkm_outputs", Outputs),
-                       ("pkm_inverse_result", InverseResult)):
+                       ("pkm_inverse_result", InverseResult), ("pkm_machine_params", MachineParams),
+                       ("pkm_machine_outputs", MachineOutputs), ("pkm_inverse_machine_result", InverseMachineResult)):
         fields, size = structs[cname]
         ours = [(n.rstrip("_"), getattr(cls, n).offset, getattr(cls, n).size) for n, _ in cls._fields_
                 if n != "_reserved"]
