@@ -167,3 +167,92 @@ def test_capi_binding_matches_pkm_h():
     from engines import pkm_capi
     bad = pkm_capi.binding_mismatches()
     assert not bad, "\n".join(bad)
+
+
+# --- the machine around the mechanism in the engine models (MODEL_SPEC) --------------------------------------
+MACHINE = spec.Machine(screw_lead=0.005, rotor_inertia=6e-8, friction_viscous=0.5, friction_coulomb=0.005,
+                       friction_velocity=2e-3, payload_mass=0.2, payload_com=(0.02, -0.015), payload_Izz=1.5e-4,
+                       payload_z=-0.03, payload_Ixx=1.0e-4, payload_Iyy=1.2e-4)
+
+
+def spec_machine_kinetic_energy(q, v, mc):
+    """T of the mechanism plus the rotors, 1/2 J (2 pi / p)^2 rhod_i^2 each, and
+    the payload: 1/2 m |v_P + phid z x Rz(phi) c|^2 + 1/2 Izz phid^2
+    (MODEL_SPEC "Drives", "Payload"; nothing from the engines)."""
+    T = spec_kinetic_energy(q, v)
+    gear = 2.0 * math.pi / mc.screw_lead
+    T += sum(0.5 * mc.rotor_inertia * (gear * v[3 * i]) ** 2 for i in range(4))
+    c = spec.rz(q[15]) @ np.array([mc.payload_com[0], mc.payload_com[1], mc.payload_z])
+    v_com = v[12:15] + np.cross([0.0, 0.0, v[15]], c)
+    return T + 0.5 * mc.payload_mass * v_com @ v_com + 0.5 * mc.payload_Izz * v[15] ** 2
+
+
+def test_machine_mass_matrix_is_the_spec_kinetic_energy():
+    pm = PinocchioPKM(machine=MACHINE)
+    for _ in range(20):
+        q, v = random_q(), RNG.normal(size=16)
+        T_pin = 0.5 * v @ pm.mass_matrix(q) @ v
+        T_spec = spec_machine_kinetic_energy(q, v, MACHINE)
+        assert abs(T_pin - T_spec) <= 1e-14 * max(1.0, T_spec), (T_pin, T_spec)
+
+
+def test_machine_gravity_and_rnea():
+    """The payload's weight on z only (wherever its centre of mass), and
+    Pinocchio's RNEA with the armature is M a + nle (so the inverse dynamics
+    includes the rotors)."""
+    pm = PinocchioPKM(machine=MACHINE)
+    for _ in range(10):
+        q, v, a = random_q(), RNG.normal(size=16), RNG.normal(size=16)
+        G = pin.computeGeneralizedGravity(pm.model, pm.data, q)
+        expected = spec_gravity(q)
+        expected[14] += MACHINE.payload_mass * spec.G
+        assert np.abs(G - expected).max() < 1e-14
+        tau = pin.rnea(pm.model, pm.data, q, v, a)
+        ref = pm.mass_matrix(q) @ a + pin.nonLinearEffects(pm.model, pm.data, q, v)
+        assert np.abs(tau - ref).max() <= 1e-12 * np.abs(ref).max()
+
+
+def test_machine_friction_forces():
+    """The spec's law, F = -b rhod - F_c tanh(rhod / v_s), in the Pinocchio model's
+    forward dynamics: the same accelerations as extra actuator forces."""
+    pm = PinocchioPKM(g=spec.G, machine=MACHINE)
+    pm_nf = PinocchioPKM(g=spec.G, machine=spec.Machine(
+        screw_lead=MACHINE.screw_lead, rotor_inertia=MACHINE.rotor_inertia, payload_mass=MACHINE.payload_mass,
+        payload_com=MACHINE.payload_com, payload_Izz=MACHINE.payload_Izz, payload_z=MACHINE.payload_z,
+        payload_Ixx=MACHINE.payload_Ixx, payload_Iyy=MACHINE.payload_Iyy))
+    q = pm.q_from_pose(spec.P1)
+    v = pm.complete_velocity(q, np.array([0.01, -0.02, 0.015, 0.2]))
+    rhod = v[[0, 3, 6, 9]]
+    fric = np.array([-MACHINE.friction_viscous * r - MACHINE.friction_coulomb * math.tanh(r / MACHINE.friction_velocity)
+                     for r in rhod])
+    F = spec.STATIC_FORCE_P0 * np.ones(4)
+    a, _ = pm.forward_dynamics(q, v, F)
+    a_ref, _ = pm_nf.forward_dynamics(q, v, F + fric)
+    assert np.abs(fric).min() > 1e-3
+    assert np.abs(a - a_ref).max() <= 1e-12 * np.abs(a_ref).max()
+
+
+def test_mujoco_is_the_same_machine():
+    """Armature, payload body and joint damping of the MJCF against the Pinocchio model
+    (M, bias forces, and MuJoCo's passive forces with the Coulomb callback)."""
+    pm = PinocchioPKM(g=spec.G, machine=MACHINE)
+    model, data = mujoco_model.build(g=spec.G, machine=MACHINE)
+    M = np.zeros((16, 16))
+    with mujoco_model.coulomb_passive(MACHINE):
+        for _ in range(10):
+            q, v = random_q(), RNG.normal(scale=0.01, size=16)
+            data.qpos[:], data.qvel[:] = q, v
+            mujoco.mj_forward(model, data)
+            mujoco.mj_fullM(model, data, M)
+            M_pin = pm.mass_matrix(q)
+            assert np.abs(M - M_pin).max() <= 1e-12 * np.abs(M_pin).max()
+            nle = pin.nonLinearEffects(pm.model, pm.data, q, v)
+            assert np.abs(data.qfrc_bias - nle).max() <= 1e-12 * max(1.0, np.abs(nle).max())
+            expected = np.zeros(16)
+            expected[[0, 3, 6, 9]] = MACHINE.friction(v[[0, 3, 6, 9]])
+            assert np.abs(data.qfrc_passive - expected).max() < 1e-15
+    # the callback is removed again: the ideal model has no passive forces
+    model0, data0 = mujoco_model.build(g=spec.G)
+    data0.qvel[:] = 0.1
+    mujoco.mj_forward(model0, data0)
+    assert np.all(data0.qfrc_passive == 0.0)

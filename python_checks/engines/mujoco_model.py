@@ -23,10 +23,20 @@ Bodies (the same tree as engines/pinocchio_model.py):
   soft by design).
 - actuators: a motor with gear 1 on each rho_i, so ctrl = F (N).
 - contacts disabled (there are no geoms that matter).
+- the machine around the mechanism (MODEL_SPEC; spec.Machine, optional):
+  rotor inertia as the slider joints' armature, J (2 pi / p)^2; viscous
+  friction as their damping b (MuJoCo's joint damper, -b qvel; the damper
+  flag is on only when a machine is given); the payload as a body
+  "payload" without joints inside the platform body (rigidly attached) at
+  (payload_com, payload_z), its own inertia diag(Ixx, Iyy, Izz). Coulomb
+  friction with tanh regularisation has no MuJoCo element: coulomb_passive()
+  adds it through MuJoCo's passive-force callback.
 
 The joints are declared legs first, so qpos is the spec's order
 [rho1, th1_1, th2_1, ..., x, y, z, phi].
 """
+import contextlib
+
 import numpy as np
 import mujoco
 
@@ -47,8 +57,20 @@ def _v(a):
 
 
 def mjcf(g=spec.G, timestep=1e-3, integrator="RK4", solref=DEFAULT_SOLREF, solimp=DEFAULT_SOLIMP,
-         tolerance=1e-15, iterations=100, refsafe=True):
+         tolerance=1e-15, iterations=100, refsafe=True, machine=None):
     legs, eqs, acts, sites = [], [], [], []
+    slide = ""
+    if machine is not None:
+        slide = f' armature="{machine.reflected_mass:.17g}" damping="{machine.friction_viscous:.17g}"'
+    payload = ""
+    if machine is not None and machine.payload_mass > 0.0:
+        # Ixx + Iyy >= Izz etc. (MuJoCo's triangle inequality): Ixx, Iyy never enter (no tilt)
+        at = (machine.payload_com[0], machine.payload_com[1], machine.payload_z)
+        inertia = (machine.payload_Ixx, machine.payload_Iyy, machine.payload_Izz)
+        payload = f"""
+      <body name="payload" pos="{_v(at)}">
+        <inertial pos="0 0 0" mass="{machine.payload_mass:.17g}" diaginertia="{_v(inertia)}"/>
+      </body>"""
     tiny = 1e-9  # kg m^2: rotational inertia of the slider, never used (it only translates)
     rod_inertia = (spec.I_ROD[0], spec.I_ROD[2], spec.I_ROD[1])
     for i in range(4):
@@ -56,7 +78,7 @@ def mjcf(g=spec.G, timestep=1e-3, integrator="RK4", solref=DEFAULT_SOLREF, solim
         pos = spec.base_point(i) + np.array([0.0, 0.0, spec.H])
         legs.append(f"""
     <body name="slider{n}" pos="{_v(pos)}" euler="0 0 {spec.BETA[i]:.17g}">
-      <joint name="rho{n}" type="slide" axis="0 0 1"/>
+      <joint name="rho{n}" type="slide" axis="0 0 1"{slide}/>
       <inertial pos="0 0 0" mass="{spec.M_SLIDER:.17g}" diaginertia="{tiny} {tiny} {tiny}"/>
       <body name="rod{n}">
         <joint name="theta1_{n}" type="hinge" axis="0 0 1"/>
@@ -74,7 +96,8 @@ def mjcf(g=spec.G, timestep=1e-3, integrator="RK4", solref=DEFAULT_SOLREF, solim
     # filtering, midphase) and so is the solver's warm start: the results are
     # bit-identical and mj_step is ~7% faster (engines_bench.py times MuJoCo
     # at its best).
-    flags = ('<flag contact="disable" spring="disable" damper="disable" limit="disable" frictionloss="disable" '
+    damper = "" if machine is not None else ' damper="disable"'
+    flags = (f'<flag contact="disable" spring="disable"{damper} limit="disable" frictionloss="disable" '
              'sensor="disable" clampctrl="disable" filterparent="disable" midphase="disable" warmstart="disable"'
              + ('' if refsafe else ' refsafe="disable"') + '/>')
     return f"""<mujoco model="pkm4puu">
@@ -90,7 +113,7 @@ def mjcf(g=spec.G, timestep=1e-3, integrator="RK4", solref=DEFAULT_SOLREF, solim
       <joint name="z" type="slide" axis="0 0 1"/>
       <joint name="phi" type="hinge" axis="0 0 1"/>
       <inertial pos="0 0 0" mass="{spec.M_PLATFORM:.17g}" diaginertia="{izz / 2:.17g} {izz / 2:.17g} {izz:.17g}"/>
-{chr(10).join(sites)}
+{chr(10).join(sites)}{payload}
     </body>
   </worldbody>
   <equality>
@@ -120,16 +143,39 @@ def set_pose(model, data, pose):
     mujoco.mj_forward(model, data)
 
 
-def run_comparison(model, data, duration=spec.CMP_DURATION):
-    """The comparison test with mj_step at model.opt.timestep; forces held over
-    each step at the step's midpoint value. Returns (t, qpos rows)."""
+def run_comparison(model, data, duration=spec.CMP_DURATION, forces=spec.comparison_forces):
+    """The comparison test with mj_step at model.opt.timestep; forces (F1..F4
+    as a function of t, default the spec's) held over each step at the
+    step's midpoint value. Returns (t, qpos rows)."""
     h = model.opt.timestep
     n = round(duration / h)
     t = np.arange(n + 1) * h
     Q = np.empty((n + 1, model.nq))
     Q[0] = data.qpos
     for k in range(n):
-        data.ctrl[:] = spec.comparison_forces((k + 0.5) * h)
+        data.ctrl[:] = forces((k + 0.5) * h)
         mujoco.mj_step(model, data)
         Q[k + 1] = data.qpos
     return t, Q
+
+
+@contextlib.contextmanager
+def coulomb_passive(machine):
+    """Regularised Coulomb friction -F_c tanh(qvel / v_s) on the slider joints
+    (qvel indices 0, 3, 6, 9), added to qfrc_passive by MuJoCo's passive-force
+    callback (global to the process: installed for the with block only).
+    mj_passive calls it at every evaluation, so RK4 sees it at each stage."""
+    if machine is None or machine.friction_coulomb == 0.0:
+        yield
+        return
+    idx = np.array([0, 3, 6, 9])
+    fc, vs = machine.friction_coulomb, machine.friction_velocity
+
+    def passive(_model, data):
+        data.qfrc_passive[idx] -= fc * np.tanh(data.qvel[idx] / vs)
+
+    mujoco.set_mjcb_passive(passive)
+    try:
+        yield
+    finally:
+        mujoco.set_mjcb_passive(None)

@@ -26,6 +26,17 @@ Structure (a kinematic tree plus loop closures):
   gamma = (classical acceleration of Q_i - of R_i at qdd = 0), so
   C_dd = J qdd + gamma.
 
+The machine around the mechanism (MODEL_SPEC; spec.Machine, optional):
+- rotor inertia: Pinocchio's model.armature on the rho_i joints,
+  J (2 pi / p)^2, which crba and rnea add to M's diagonal and to the joint
+  torque (armature * rho_i_dd);
+- the payload: a second body rigidly attached to the platform joint at
+  (payload_com, payload_z) in the platform frame, with its own inertia
+  diag(Ixx, Iyy, Izz) about its centre of mass (Pinocchio's spatial
+  inertia algebra moves it to the joint, as for a URDF fixed joint);
+- joint friction: a joint force -b rhod_i - F_c tanh(rhod_i / v_s) on rho_i,
+  added to S F in the forward dynamics and taken from it in the inverse.
+
 The dynamics use the project's sign convention for the multipliers,
 M qdd + nle + J^T lambda = S F (S puts F_i on rho_i): then lambda is the
 spec's lambda.
@@ -55,7 +66,8 @@ def _rx(a):
 
 
 class PinocchioPKM:
-    def __init__(self, g=spec.G):
+    def __init__(self, g=spec.G, machine=None):
+        self.machine = machine if machine is not None else spec.Machine()
         model = pin.Model()
         model.name = "pkm4puu"
         self.q_frames, self.r_frames = [], []
@@ -82,11 +94,19 @@ class PinocchioPKM:
         self.platform_joint = j
         model.appendBodyToJoint(j, pin.Inertia(spec.M_PLATFORM, np.zeros(3),
                                                np.diag([0.0, 0.0, spec.IZZ_PLATFORM])), pin.SE3.Identity())
+        mc = self.machine
+        if mc.payload_mass > 0.0:
+            at = np.array([mc.payload_com[0], mc.payload_com[1], mc.payload_z])
+            model.appendBodyToJoint(j, pin.Inertia(mc.payload_mass, np.zeros(3),
+                                                   np.diag([mc.payload_Ixx, mc.payload_Iyy, mc.payload_Izz])),
+                                    pin.SE3(np.eye(3), at))
         for i in range(4):
             self.r_frames.append(model.addFrame(pin.Frame(
                 f"R{i + 1}", j, 0, pin.SE3(np.eye(3), spec.platform_point(i)), pin.FrameType.OP_FRAME)))
         model.gravity = pin.Motion(np.array([0.0, 0.0, -g]), np.zeros(3))
         assert model.nq == NQ and model.nv == NQ
+        for i in range(4):
+            model.armature[model.joints[model.getJointId(f"rho{i + 1}")].idx_v] = mc.reflected_mass
         self.model = model
         self.data = model.createData()
         self.S = np.zeros((NQ, 4))
@@ -161,12 +181,13 @@ class PinocchioPKM:
     def inverse_dynamics(self, pose, pose_rate, pose_acc):
         """Actuator forces F (4) and multipliers lambda (12) that produce the
         platform motion (pose, rate, acceleration): RNEA for the tree, then
-        J^T lambda - S F = -tau_rnea (16 equations, 16 unknowns)."""
+        J^T lambda - S F = -tau_rnea + S F_fric (16 equations, 16 unknowns)."""
         q = self.q_from_pose(pose)
         J = self.jacobian(q)
         v = self.complete_velocity(q, pose_rate, J)
         a = self.complete_acceleration(q, v, pose_acc, J)
-        tau = pin.rnea(self.model, self.data, q, v, a)
+        tau = pin.rnea(self.model, self.data, q, v, a)  # armature * rho_dd included
+        tau -= self.S @ self.machine.friction(v[LEG_ROWS])
         x = np.linalg.solve(np.hstack([J.T, -self.S]), -tau)
         return x[12:], x[:12], (q, v, a)
 
@@ -180,7 +201,7 @@ class PinocchioPKM:
         K[:16, :16] = M
         K[:16, 16:] = J.T
         K[16:, :16] = J
-        rhs = np.concatenate([self.S @ F - nle, -gamma])
+        rhs = np.concatenate([self.S @ (F + self.machine.friction(v[LEG_ROWS])) - nle, -gamma])
         x = np.linalg.solve(K, rhs)
         return x[:16], x[16:]
 
@@ -206,4 +227,5 @@ class PinocchioPKM:
 
     def constraint_dynamics(self, q, v, F):
         """qdd from pinocchio.constraintDynamics (call setup_constraint_dynamics first)."""
-        return pin.constraintDynamics(self.model, self.data, q, v, self.S @ F, self._cm, self._cd, self._prox)
+        tau = self.S @ (F + self.machine.friction(v[LEG_ROWS]))
+        return pin.constraintDynamics(self.model, self.data, q, v, tau, self._cm, self._cd, self._prox)

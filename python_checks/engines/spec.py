@@ -99,3 +99,57 @@ def constraint_residual(q16):
     p, phi = q16[12:15], q16[15]
     return np.concatenate([leg_end_point(i, *q16[3 * i:3 * i + 3]) - p - rz(phi) @ platform_point(i)
                            for i in range(4)])
+
+
+# --- The machine around the mechanism (MODEL_SPEC "The machine around the mechanism") ----------
+# Defaults of the spec; every one leaves the paper's ideal machine unchanged.
+SCREW_LEAD = 0.004  # m per revolution
+FRICTION_VELOCITY = 1e-3  # m/s, v_s of the tanh regularisation
+RHO_MIN, RHO_MAX = 0.0, 0.15  # m, end stops
+
+
+class Machine:
+    """The machine's parameters (MODEL_SPEC names, SI units; defaults: the
+    spec's). payload_z (m) is not a spec parameter: the height of the
+    payload's centre of mass above P in the platform frame, which the spec
+    says cannot matter (the platform only translates and turns about z), so
+    the engine models may place the payload body off P's plane to check it;
+    payload_Ixx, payload_Iyy likewise (the platform cannot tilt)."""
+
+    def __init__(self, screw_lead=SCREW_LEAD, rotor_inertia=0.0, friction_viscous=0.0, friction_coulomb=0.0,
+                 friction_velocity=FRICTION_VELOCITY, payload_mass=0.0, payload_com=(0.0, 0.0), payload_Izz=0.0,
+                 payload_z=0.0, payload_Ixx=0.0, payload_Iyy=0.0):
+        self.screw_lead = screw_lead
+        self.rotor_inertia = rotor_inertia
+        self.friction_viscous = friction_viscous
+        self.friction_coulomb = friction_coulomb
+        self.friction_velocity = friction_velocity
+        self.payload_mass = payload_mass
+        self.payload_com = tuple(payload_com)
+        self.payload_Izz = payload_Izz
+        self.payload_z = payload_z
+        self.payload_Ixx = payload_Ixx
+        self.payload_Iyy = payload_Iyy
+
+    @property
+    def gear(self):
+        """2 pi / p (rad/m): a motor torque tau adds gear * tau to F."""
+        return 2.0 * math.pi / self.screw_lead
+
+    @property
+    def reflected_mass(self):
+        """J (2 pi / p)^2 (kg), on each rho_i's diagonal of M."""
+        return self.rotor_inertia * self.gear**2
+
+    def friction(self, rho_dot):
+        """F_fric,i = -b rhod_i - F_c tanh(rhod_i / v_s) (N), elementwise."""
+        rho_dot = np.asarray(rho_dot, dtype=float)
+        return (-self.friction_viscous * rho_dot
+                - self.friction_coulomb * np.tanh(rho_dot / self.friction_velocity))
+
+    def capi_params(self):
+        """The pkm_machine_params fields this machine sets (end stops: the defaults)."""
+        return {"screw_lead": self.screw_lead, "rotor_inertia": self.rotor_inertia,
+                "friction_viscous": self.friction_viscous, "friction_coulomb": self.friction_coulomb,
+                "friction_velocity": self.friction_velocity, "payload_mass": self.payload_mass,
+                "payload_com": self.payload_com, "payload_Izz": self.payload_Izz}
