@@ -81,30 +81,9 @@ TEST(MachineParams, DefaultsAreTheSpecsAndLeaveTheIdealMechanism) {
   EXPECT_NEAR(m.drive_ratio, 2 * kPi / 0.004, 1e-9);
 }
 
-TEST(MachineParams, ValidationNamesTheParameterAndItsRange) {
-  struct Case { const char* name; void (*spoil)(Params&); };
-  const Case cases[] = {
-      {"parameter screw_lead ", [](Params& p) { p.screw_lead = 0.0; }},
-      {"parameter rotor_inertia ", [](Params& p) { p.rotor_inertia = -1e-6; }},
-      {"parameter friction_viscous ", [](Params& p) { p.friction_viscous = NAN; }},
-      {"parameter friction_coulomb ", [](Params& p) { p.friction_coulomb = -0.1; }},
-      {"parameter friction_velocity ", [](Params& p) { p.friction_velocity = 0.0; }},
-      {"parameter rho_max ", [](Params& p) { p.rho_max = -0.01; }},
-      {"parameter rho_min ", [](Params& p) { p.rho_min = INFINITY; }},
-      {"parameter stop_stiffness ", [](Params& p) { p.stop_stiffness = -1.0; }},
-      {"parameter stop_damping ", [](Params& p) { p.stop_damping = -1.0; }},
-      {"parameter payload_mass ", [](Params& p) { p.payload_mass = -0.1; }},
-      {"parameter payload_com[2] ", [](Params& p) { p.payload_com[1] = NAN; }},
-      {"parameter payload_Izz ", [](Params& p) { p.payload_Izz = -1.0; }},
-  };
-  for (const Case& c : cases) {
-    Params p;
-    c.spoil(p);
-    Model m;
-    std::string why;
-    EXPECT_EQ(make_model(p, m, &why), Status::InvalidParameter) << c.name;
-    EXPECT_NE(why.find(c.name), std::string::npos) << "message: " << why;
-  }
+// The machine's parameters are validated with the mechanism's (the cases are
+// in test_params.cpp); the travel must not be empty.
+TEST(MachineParams, TheTravelMustNotBeEmpty) {
   Params p;
   p.rho_max = p.rho_min;
   EXPECT_NE(validate(p).find("must exceed rho_min"), std::string::npos) << validate(p);

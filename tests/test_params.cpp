@@ -48,6 +48,19 @@ TEST(Params, ValidationNamesTheOffendingParameter) {
       {"parameter Izz_platform ", [](Params& p) { p.Izz_platform = 0; }},
       {"parameter gamma[3] ", [](Params& p) { p.gamma[2] = NAN; }},
       {"parameter g ", [](Params& p) { p.g = INFINITY; }},
+      // The machine around the mechanism (MODEL_SPEC).
+      {"parameter screw_lead ", [](Params& p) { p.screw_lead = 0.0; }},
+      {"parameter rotor_inertia ", [](Params& p) { p.rotor_inertia = -1e-6; }},
+      {"parameter friction_viscous ", [](Params& p) { p.friction_viscous = NAN; }},
+      {"parameter friction_coulomb ", [](Params& p) { p.friction_coulomb = -0.1; }},
+      {"parameter friction_velocity ", [](Params& p) { p.friction_velocity = 0.0; }},
+      {"parameter rho_max ", [](Params& p) { p.rho_max = -0.01; }},
+      {"parameter rho_min ", [](Params& p) { p.rho_min = INFINITY; }},
+      {"parameter stop_stiffness ", [](Params& p) { p.stop_stiffness = -1.0; }},
+      {"parameter stop_damping ", [](Params& p) { p.stop_damping = -1.0; }},
+      {"parameter payload_mass ", [](Params& p) { p.payload_mass = -0.1; }},
+      {"parameter payload_com[2] ", [](Params& p) { p.payload_com[1] = NAN; }},
+      {"parameter payload_Izz ", [](Params& p) { p.payload_Izz = -1.0; }},
   };
   for (const Case& c : cases) {
     Params p;

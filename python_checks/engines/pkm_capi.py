@@ -200,8 +200,9 @@ class Model:
     def advance(self, t_end, F=None, wrench=None):
         self._check(self.lib.pkm_advance(self.handle, t_end, _d4(F), _d4(wrench)), "pkm_advance")
 
-    def advance_fn(self, t_end, inputs, continuous=True):
-        """inputs(t) -> F[4] (N), or (F, wrench); evaluated at the integrator's own times."""
+    @staticmethod
+    def _input_callback(inputs):
+        """The C callback that writes inputs(t) -> F[4], or (F, wrench), into the C arrays."""
 
         def cb(_user, t, F, w):
             r = inputs(t)
@@ -212,7 +213,12 @@ class Model:
                 for k in range(4):
                     w[k] = wr[k]
 
-        self._callback = INPUT_FN(cb)  # kept alive for the call
+        return cb
+
+    def advance_fn(self, t_end, inputs, continuous=True):
+        """inputs(t) -> F[4] (N), or (F, wrench); evaluated at the integrator's own times."""
+
+        self._callback = INPUT_FN(self._input_callback(inputs))  # kept alive for the call
         self._check(self.lib.pkm_advance_fn(self.handle, t_end, self._callback, None, int(continuous)),
                     "pkm_advance_fn")
 
@@ -220,14 +226,7 @@ class Model:
         """inputs(t) -> F[4] (N), or (F, wrench); torques(t) -> tau[4] (N m);
         both evaluated at the integrator's own times (pkm_advance_fn_drives)."""
 
-        def cb(_user, t, F, w):
-            r = inputs(t)
-            f, wr = (r if isinstance(r, tuple) else (r, None))
-            for k in range(4):
-                F[k] = f[k]
-            if wr is not None:
-                for k in range(4):
-                    w[k] = wr[k]
+        cb = self._input_callback(inputs)
 
         def cb_tau(_user, t, tau):
             r = torques(t)
