@@ -55,7 +55,6 @@ class ModelData {
   virtual Status set_states(Context& ctx, const double x[]) { (void)ctx, (void)x; return Status::OK; }
   virtual Status get_derivatives(Context& ctx, double dx[]) { (void)ctx, (void)dx; return Status::OK; }
   virtual Status get_event_indicators(Context& ctx, double z[]) { (void)ctx, (void)z; return Status::OK; }
-  virtual void get_nominals(double x[]) const { (void)x; }
   /// Event mode: the discrete reaction to what the indicators located.
   /// terminate = true asks the importer to stop (with a logged reason).
   virtual Status event_update(Context& ctx, bool& terminate) { (void)ctx; terminate = false; return Status::OK; }

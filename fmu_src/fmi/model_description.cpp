@@ -122,6 +122,10 @@ std::string type_attributes(const ModelDefinition& d, const Variable& v, int ver
   } else {
     if (std::isfinite(v.min)) a += " min=\"" + exact_text(v.min) + "\"";
     if (std::isfinite(v.max)) a += " max=\"" + exact_text(v.max) + "\"";
+    // The states' scale. FMI 2.0 only: fmi-sim's reader (fmi-schema 0.8)
+    // refuses a nominal attribute on an FMI 3.0 Float64, and FMI 3.0
+    // importers take the nominals from fmi3GetNominalsOfContinuousStates.
+    if (version == 2 && v.state >= 0 && v.nominal != 1.0) a += " nominal=\"" + exact_text(v.nominal) + "\"";
   }
   if (v.has_start()) {
     if (v.type == VarType::Real)

@@ -123,7 +123,8 @@ Status Instance::get_nominals(double x[], std::size_t n) {
   const char* fn = PKM_FN2(fmi2GetNominalsOfContinuousStates, fmi3GetNominalsOfContinuousStates);
   if (!allowed(kMaskGetStates | kInstantiated, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
   if (!right_count(log_, fn, "nominals", n, def_.n_states, x)) return Status::Error;
-  data_->get_nominals(x);
+  for (std::size_t k = 0; k < def_.n_variables; ++k)
+    if (def_.variables[k].state >= 0) x[def_.variables[k].state] = def_.variables[k].nominal;
   return Status::OK;
 }
 

@@ -97,7 +97,6 @@ struct PlantData final : MechanismData {
   Status set_states(Context& ctx, const double x[]) override;
   Status get_derivatives(Context& ctx, double dx[]) override;
   Status get_event_indicators(Context& ctx, double z[]) override;
-  void get_nominals(double x[]) const override;
   Status event_update(Context& ctx, bool& terminate) override;
 
   /// A Plant for the current parameters (not yet initialised).
@@ -392,13 +391,6 @@ Status PlantData::get_event_indicators(Context& ctx, double z[]) {
   return Status::OK;
 }
 
-void PlantData::get_nominals(double x[]) const {
-  // Pose in m and rad, velocity in m/s and rad/s: the workspace spans
-  // centimetres, so 0.1 keeps an importer's absolute tolerance meaningful;
-  // the energy integrals in J (the auto-test's work is about 0.2 J).
-  for (int k = 0; k < kStates; ++k) x[k] = k == 3 || k == 7 ? 1.0 : 0.1;
-}
-
 Status PlantData::event_update(Context& ctx, bool& terminate) {
   terminate = false;
   double z[kIndicators];
@@ -470,6 +462,12 @@ bool PlantData::load(StateReader& r, Context& ctx) {
 #define PLANT_SCALAR(member) \
   [](ModelData& d, int) -> void* { return &static_cast<PlantData&>(d).member; }
 
+// The states' scales (nominal): the workspace spans centimetres, so 0.1 m
+// (and m/s) keeps an importer's absolute tolerance, rtol x nominal,
+// meaningful; the rotation 1 rad; the energy integrals 0.1 J (the auto-test
+// does about 0.2 J of work).
+constexpr double kNominalLength = 0.1, kNominalAngle = 1.0, kNominalEnergy = 0.1;
+
 // What the outputs depend on. Only the slider positions follow z (the
 // mechanism is otherwise invariant to a vertical translation), and through
 // them whatever the end stops act on; only the slider velocities follow dz,
@@ -492,16 +490,16 @@ constexpr Variable kVariables[] = {
   real_input(7, "Fe[3]", 0.0, "N", "External force on the platform at P, z component (base frame)", PLANT(u), 6, PLANT(du), kWrench),
   real_input(8, "Me_z", 0.0, "N.m", "External moment on the platform about z", PLANT(u), 7, PLANT(du), kWrench),
   // Outputs: 10..53; x..dphi are the continuous states (Model Exchange).
-  state_output(10, "x", "m", "Platform reference point P (centre of mass), x in the base frame", PLANT(pose), 0, 0, kOnPositions),
-  state_output(11, "y", "m", "Platform reference point P (centre of mass), y in the base frame", PLANT(pose), 1, 1, kOnPositions),
-  state_output(12, "z", "m", "Platform reference point P (centre of mass), z in the base frame", PLANT(pose), 2, 2, kOnHeight),
-  state_output(13, "phi", "rad", "Platform rotation about z of the base frame", PLANT(pose), 3, 3, kOnPositions),
-  state_output(14, "dx", "m/s", "Velocity of P, x component", PLANT(vel), 0, 4, kOnRates),
-  state_output(15, "dy", "m/s", "Velocity of P, y component", PLANT(vel), 1, 5, kOnRates),
-  state_output(16, "dz", "m/s", "Velocity of P, z component", PLANT(vel), 2, 6, kOnHeightRate),
-  state_output(17, "dphi", "rad/s", "Platform angular velocity about z", PLANT(vel), 3, 7, kOnRates),
-  state_output(18, "actuator_work", "J", "Work done on the machine since the start: integral of (F_i + (2 pi/screw_lead) tau_i) drho_i plus the external wrench's power", PLANT(energy), 0, 8, kOnEnergy),
-  state_output(19, "dissipated_energy", "J", "Energy dissipated since the start by joint friction and the end stops' damping", PLANT(energy), 1, 9, kOnEnergy),
+  state_output(10, "x", "m", "Platform reference point P (centre of mass), x in the base frame", PLANT(pose), 0, 0, kOnPositions, kNominalLength),
+  state_output(11, "y", "m", "Platform reference point P (centre of mass), y in the base frame", PLANT(pose), 1, 1, kOnPositions, kNominalLength),
+  state_output(12, "z", "m", "Platform reference point P (centre of mass), z in the base frame", PLANT(pose), 2, 2, kOnHeight, kNominalLength),
+  state_output(13, "phi", "rad", "Platform rotation about z of the base frame", PLANT(pose), 3, 3, kOnPositions, kNominalAngle),
+  state_output(14, "dx", "m/s", "Velocity of P, x component", PLANT(vel), 0, 4, kOnRates, kNominalLength),
+  state_output(15, "dy", "m/s", "Velocity of P, y component", PLANT(vel), 1, 5, kOnRates, kNominalLength),
+  state_output(16, "dz", "m/s", "Velocity of P, z component", PLANT(vel), 2, 6, kOnHeightRate, kNominalLength),
+  state_output(17, "dphi", "rad/s", "Platform angular velocity about z", PLANT(vel), 3, 7, kOnRates, kNominalAngle),
+  state_output(18, "actuator_work", "J", "Work done on the machine since the start: integral of (F_i + (2 pi/screw_lead) tau_i) drho_i plus the external wrench's power", PLANT(energy), 0, 8, kOnEnergy, kNominalEnergy),
+  state_output(19, "dissipated_energy", "J", "Energy dissipated since the start by joint friction and the end stops' damping", PLANT(energy), 1, 9, kOnEnergy, kNominalEnergy),
   real_output(20, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", PLANT(rho), 0, kSliders),
   real_output(21, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", PLANT(rho), 1, kSliders),
   real_output(22, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", PLANT(rho), 2, kSliders),

@@ -73,6 +73,7 @@ struct Variable {
   int state;        // rows that are continuous states: their index in the states; -1 otherwise
   int indicator = -1;  // rows that are event indicators (Model Exchange): their index; -1 otherwise
   std::uint8_t kind = kDependsNothing;  // inputs and states: which Depends bit names them
+  double nominal = 1.0;  // continuous states: their scale (nominal attribute, GetNominalsOfContinuousStates)
 
   constexpr bool has_start() const {
     return causality == Causality::Input || initial == Initial::Exact || initial == Initial::Approx;
@@ -109,9 +110,9 @@ constexpr Variable real_output(std::uint32_t vr, const char* name, const char* u
 /// A Real output that is continuous state number `state` (pose, velocity)
 /// of the given kind (kOnPositions, kOnHeight or kOnRates).
 constexpr Variable state_output(std::uint32_t vr, const char* name, const char* unit, const char* description,
-                                Ref value, int index, int state, std::uint8_t kind) {
+                                Ref value, int index, int state, std::uint8_t kind, double nominal) {
   return {vr,    name,  VarType::Real, Causality::Output, Variability::Continuous, Initial::Calculated, 0.0, unit,
-          description, value, index, nullptr, kNoMin, kNoMax, kOnOwnState, -1, state, -1, kind};
+          description, value, index, nullptr, kNoMin, kNoMax, kOnOwnState, -1, state, -1, kind, nominal};
 }
 /// der(x) of continuous state number `state_of` (a local variable).
 constexpr Variable state_derivative(std::uint32_t vr, const char* name, const char* unit, const char* description,
