@@ -10,10 +10,9 @@ namespace {
 constexpr int kActuated[kLegs] = {0, 3, 6, 9};
 constexpr int kUnactuated[kM] = {1, 2, 4, 5, 7, 8, 10, 11, 12, 13, 14, 15};
 
-}  // namespace
-
-Status actuator_forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& qdd,
-                       const Wrench& we, Vec4& F, Vec12& lambda) {
+/// Eqs. 10-11; with `passive`, on top of the joints' passive forces.
+Status forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& qdd, const Wrench& we, bool passive,
+              Vec4& F, Vec12& lambda) {
   if (!we.allFinite() || !qdd.allFinite()) return Status::NonFinite;
   Mat16 M;
   mass_matrix(m, q, M);
@@ -35,11 +34,18 @@ Status actuator_forces(const Model& m, const Vec16& q, const Vec16& qd, const Ve
   lambda = lu.solve(rhs);  // Eq. 10
   for (int i = 0; i < kLegs; ++i) {
     const int k = kActuated[i];
-    F[i] = inertial[k] + Cq.col(k).dot(lambda)  // Eq. 11
-           - passive_joint_force(m.p, q[k], qd[k]);
+    F[i] = inertial[k] + Cq.col(k).dot(lambda);  // Eq. 11
+    if (passive) F[i] -= passive_joint_force(m.p, q[k], qd[k]);
   }
   if (!F.allFinite() || !lambda.allFinite()) return Status::Singular;
   return Status::Ok;
+}
+
+}  // namespace
+
+Status actuator_forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& qdd,
+                       const Wrench& we, Vec4& F, Vec12& lambda) {
+  return forces(m, q, qd, qdd, we, /*passive=*/true, F, lambda);
 }
 
 unsigned joints_beyond_stops(const Params& p, const Vec16& q) {
@@ -53,11 +59,10 @@ unsigned joints_beyond_stops(const Params& p, const Vec16& q) {
 }
 
 Status holding_forces(const Model& m, const Vec16& q, const Wrench& we, Vec4& F) {
+  // At rest friction is zero; the end stops' springs are not counted on:
+  // no passive force at all (so that F does not follow rho through them).
   Vec12 lambda;
-  const Status s = actuator_forces(m, q, Vec16::Zero(), Vec16::Zero(), we, F, lambda);
-  if (s != Status::Ok) return s;
-  for (int i = 0; i < kLegs; ++i) F[i] += stop_force(m.p, q[leg_offset(i)], 0.0);  // not counted on
-  return Status::Ok;
+  return forces(m, q, Vec16::Zero(), Vec16::Zero(), we, /*passive=*/false, F, lambda);
 }
 
 Status inverse_dynamics(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,
