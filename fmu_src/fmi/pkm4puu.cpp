@@ -591,7 +591,7 @@ constexpr Variable kVariables[] = {
   real_parameter(141, "rk4_step", kDefaultSolver.rk4_step, "s",
                  "RK4 step: a communication step is split into whole steps no longer than this", PLANT_SCALAR(rk4_step), 0),
   real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance", PLANT_SCALAR(rtol), 0, 0.0, 1.0),
-  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, and velocity)", PLANT_SCALAR(atol), 0, 0.0),
+  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)", PLANT_SCALAR(atol), 0, 0.0),
   integer_parameter(144, "cvode_method", static_cast<int>(kDefaultSolver.cvode_method),
                     "CVODE method: 0 = Adams-Moulton (non-stiff), 1 = BDF", PLANT_SCALAR(cvode_method), 0, 1),
   integer_parameter(145, "formulation", static_cast<int>(kDefaultSolver.formulation),
