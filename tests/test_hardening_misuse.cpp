@@ -508,6 +508,26 @@ TEST_F(HardeningMisuse, AStepWhoseEndOverflowsIsAnError) {
             "yes: every variable bit-identical, time unchanged");
 }
 
+// Issue 17.7: at t = 1e15 a 1 ms step rounds away (the spacing of doubles
+// there is 0.125 s): answering OK would advance nothing.
+TEST_F(HardeningMisuse, AStepThatVanishesInTPlusHIsAnError) {
+  PlantFmu p;
+  ASSERT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 1e15, fmi2False, 0.0), fmi2OK);
+  ASSERT_EQ(p.enter(), fmi2OK);
+  ASSERT_EQ(p.exit(), fmi2OK);
+  ASSERT_EQ(1e15 + 1e-3, 1e15);  // the premise
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(1e15, 1e-3), fmi2Error);
+  EXPECT_TRUE(p.log.contains("vanishes at currentCommunicationPoint")) << p.log.dump();
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  // The instance stays usable: a step that does advance.
+  EXPECT_EQ(p.step(1e15, 1.0), fmi2OK) << p.log.dump();
+  EXPECT_EQ(p.last_successful_time(), 1e15 + 1.0);
+  table_row("startTime = 1e15, then fmi2DoStep(1e15, 1e-3): t + h == t in double precision",
+            "fmi2Error, \"communicationStepSize = 0.001 vanishes at currentCommunicationPoint = 1e+15 ...\"",
+            "yes: every variable bit-identical; a later step of 1 s succeeds");
+}
+
 TEST_F(HardeningMisuse, AStepTooLongForCvodeIsDiscarded) {
   PlantFmu p;
   p.initialize();

@@ -77,6 +77,12 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
                fn, t + h);
     return Status::Error;
   }
+  if (t + h == t) {
+    log_.error("%s: communicationStepSize = %.17g vanishes at currentCommunicationPoint = %.17g (t + h == t in "
+               "double precision): nothing would advance; the call has no effect",
+               fn, h, t);
+    return Status::Error;
+  }
   // Inputs interpolated with their derivatives must stay finite over the step
   // (only once a derivative was ever set: the loop is not free).
   for (std::size_t i = 0; input_derivatives_set_ && i < def_.n_variables; ++i) {
