@@ -242,6 +242,20 @@ Status Plant::derivative(double t, const Vec10& x, Vec10& xdot) {
   return s;
 }
 
+namespace {
+
+/// The energy audit's integrands: the power of the actuator forces plus the
+/// screws' (Fa) and of the external wrench, and the power dissipated by
+/// friction and the end stops `stops`.
+void energy_rates(const Params& p, unsigned stops, const Vec4& Fa, const Wrench& we, const Pose& pose_rate,
+                  const Vec4& rho, const Vec4& rhod, double& power, double& dissipation) {
+  power = Fa.dot(rhod) + we.dot(pose_rate);
+  dissipation = 0.0;
+  for (int i = 0; i < kLegs; ++i) dissipation += dissipated_power(p, i, stops, rho[i], rhod[i]);
+}
+
+}  // namespace
+
 Status Plant::machine_rates(const InputSignal& inputs, double t, const Vec10& x, unsigned stops, Vec10& xdot,
                             bool* inputs_fault) const {
   Vec4 F, tau;
@@ -259,11 +273,7 @@ Status Plant::machine_rates(const InputSignal& inputs, double t, const Vec10& x,
       state_derivative(model_, settings_.formulation, y, generalized_forces(Fa, we), ydot, nullptr, &jm, stops);
   if (s != Status::Ok) return s;
   xdot.head<8>() = ydot;
-  // The energy audit's integrands: the inputs' power and the dissipation.
-  xdot[8] = Fa.dot(jm.rhod) + we.dot(y.tail<4>());
-  double diss = 0.0;
-  for (int i = 0; i < kLegs; ++i) diss += dissipated_power(model_.p, i, stops, jm.rho[i], jm.rhod[i]);
-  xdot[9] = diss;
+  energy_rates(model_.p, stops, Fa, we, y.tail<4>(), jm.rho, jm.rhod, xdot[8], xdot[9]);
   return Status::Ok;
 }
 
@@ -515,6 +525,8 @@ Status Plant::machine_outputs(const InputSignal& inputs, MachineOutputs& out) co
   out.potential_energy = potential_energy(model_, q);
   out.actuator_work = energy_.actuator_work;
   out.dissipated_energy = energy_.dissipated;
+  energy_rates(p, kStopsFromState, F + model_.drive_ratio * tau, we, y_.tail<4>(), out.rho, out.rhod,
+               out.actuator_power, out.dissipation_rate);
   stop_indicators(p, out.rho, out.stop_indicators);
   return Status::Ok;
 }

@@ -75,6 +75,8 @@ struct MachineOutputs {
   double potential_energy = 0;         // J, gravity plus the stops' springs
   double actuator_work = 0;            // J, running integral
   double dissipated_energy = 0;        // J, running integral
+  double actuator_power = 0;           // W, d(actuator_work)/dt
+  double dissipation_rate = 0;         // W, d(dissipated_energy)/dt
   /// Event indicators (machine.hpp): rho_i - rho_min, then rho_max - rho_i.
   double stop_indicators[kStopIndicators] = {};
 };
