@@ -35,13 +35,6 @@ Params machine_params() {
   return p;
 }
 
-Model make(const Params& p) {
-  Model m;
-  std::string why;
-  EXPECT_EQ(make_model(p, m, &why), Status::Ok) << why;
-  return m;
-}
-
 ref::RefParams ref_params(const Params& p) {
   ref::RefParams r;
   r.g = p.g;
@@ -74,7 +67,7 @@ TEST(MachineParams, DefaultsAreTheSpecsAndLeaveTheIdealMechanism) {
   EXPECT_EQ(p.payload_com[0], 0.0);
   EXPECT_EQ(p.payload_com[1], 0.0);
   EXPECT_EQ(p.payload_Izz, 0.0);
-  const Model m = make(p);
+  const Model m = model_of(p);
   EXPECT_EQ(m.reflected_mass, 0.0);
   EXPECT_EQ(m.platform_mass, p.m_platform);
   EXPECT_EQ(m.platform_Izz, p.Izz_platform);
@@ -95,7 +88,7 @@ TEST(MachineParams, TheTravelMustNotBeEmpty) {
 
 TEST(MachineDynamics, MassMatrixIsTheHessianOfTheReferenceKineticEnergy) {
   const Params p = machine_params();
-  const Model m = make(p);
+  const Model m = model_of(p);
   const ref::RefParams r = ref_params(p);
   for (unsigned seed = 1; seed <= 4; ++seed) {
     const Vec16 q = random_state(m, seed).q;
@@ -119,7 +112,7 @@ TEST(MachineDynamics, MassMatrixIsTheHessianOfTheReferenceKineticEnergy) {
 
 TEST(MachineDynamics, VelocityAndGravityTermsMatchFiniteDifferencesOfTheReferenceLagrangian) {
   const Params p = machine_params();
-  const Model m = make(p);
+  const Model m = model_of(p);
   const ref::RefParams r = ref_params(p);
   auto momentum = [&](const Vec16& q, const Vec16& qd) {
     Vec16 out;
@@ -158,7 +151,7 @@ TEST(MachineDynamics, VelocityAndGravityTermsMatchFiniteDifferencesOfTheReferenc
 
 TEST(MachineDynamics, AllFormulationsAgreeWithEveryTermOn) {
   const Params p = machine_params();
-  const Model m = make(p);
+  const Model m = model_of(p);
   for (unsigned seed = 1; seed <= 6; ++seed) {
     const RandomState s = random_state(m, seed);
     Vec8 y;
@@ -196,7 +189,7 @@ TEST(MachineDynamics, FallAgainstViscousFrictionMatchesTheClosedForm) {
   p.friction_viscous = 20.0;
   p.payload_mass = 0.3;
   p.payload_Izz = 2e-4;
-  const Model m = make(p);
+  const Model m = model_of(p);
   const double m_tot = 0.45474 + 0.3 + 4 * (0.09331 + 0.06371);
   const double inertia = m_tot + 4 * 1e-7 * std::pow(2 * kPi / 0.004, 2);
   const double v = m_tot * 9.81 / (4 * 20.0), T = inertia / (4 * 20.0);
@@ -236,7 +229,7 @@ TEST(MachineDynamics, FallAgainstViscousFrictionMatchesTheClosedForm) {
 // configuration of each pose, both gradients by central differences.
 TEST(MachineDynamics, HoldingForcesFollowFromVirtualWork) {
   const Params p = machine_params();
-  const Model m = make(p);
+  const Model m = model_of(p);
   const ref::RefParams r = ref_params(p);
   const Pose poses[] = {Pose(0, 0, 0.05, 0), Pose(0.005, -0.005, 0.07, 4 * kPi / 180),
                         Pose(-0.004, 0.003, 0.06, -0.05)};
@@ -355,7 +348,7 @@ AuditRun audit(const Model& m, Solver solver) {
 }  // namespace
 
 TEST(MachineEnergy, AuditIsConstantAlongTheAutotestWithEveryTermOn) {
-  const Model m = make(machine_params());
+  const Model m = model_of(machine_params());
   for (Solver solver : {Solver::Rk4, Solver::Cvode}) {
     const AuditRun r = audit(m, solver);
     const char* name = solver == Solver::Rk4 ? "RK4 1 ms" : "CVODE";
@@ -372,7 +365,7 @@ TEST(MachineEnergy, AuditIsConstantAlongTheAutotestWithEveryTermOn) {
 // ---------------------------------------------------------------------------
 
 TEST(MachineAutotest, RoundTripStaysWithinTheAutotestBounds) {
-  const Model m = make(machine_params());
+  const Model m = model_of(machine_params());
   for (Solver solver : {Solver::Rk4, Solver::Cvode}) {
     AutotestOptions opt;
     opt.solver.solver = solver;
@@ -391,7 +384,7 @@ TEST(MachineAutotest, RoundTripStaysWithinTheAutotestBounds) {
 }
 
 TEST(MachineInverse, TorquesAreTheForcesOnTheScrewAndStopsAreReported) {
-  const Model m = make(machine_params());
+  const Model m = model_of(machine_params());
   InverseDynamicsResult r;
   ASSERT_EQ(inverse_dynamics(m, Pose(0.001, 0, 0.06, 0.01), Pose(0.01, 0, 0.02, 0.1), Pose(0.1, 0.2, 0.3, 1.0),
                              Wrench::Zero(), r), Status::Ok);
@@ -400,7 +393,7 @@ TEST(MachineInverse, TorquesAreTheForcesOnTheScrewAndStopsAreReported) {
   // A pose whose rho lie below rho_min: solved, and reported.
   Params p = machine_params();
   p.rho_min = 0.05;  // home's rho = 0.0443 m
-  const Model low = make(p);
+  const Model low = model_of(p);
   ASSERT_EQ(inverse_dynamics(low, Pose(0, 0, 0.05, 0), Pose::Zero(), Pose::Zero(), Wrench::Zero(), r), Status::Ok);
   EXPECT_EQ(r.beyond_stops, 0x0Fu);
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -14,12 +15,18 @@ namespace pkm_test {
 
 using namespace pkm;
 
+/// The model of valid parameters (a failure otherwise).
+inline Model model_of(const Params& p) {
+  Model m;
+  std::string why;
+  EXPECT_EQ(make_model(p, m, &why), Status::Ok) << why;
+  return m;
+}
+
 inline Model default_model(double g = 9.81) {
   Params p;
   p.g = g;
-  Model m;
-  EXPECT_EQ(make_model(p, m), Status::Ok);
-  return m;
+  return model_of(p);
 }
 
 /// A random pose inside the auto-test's neighbourhood of the workspace,
