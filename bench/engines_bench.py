@@ -7,7 +7,7 @@ step, through
                  FMU through the C harness (build/bench/pkm_comparison_bench,
                  plain C: no Python in any timed loop);
   MuJoCo         mj_step, RK4, 1 ms, the stiffest connect constraints
-                 (python_checks/engines/mujoco_model.py), timed in
+                 (pkm4puu.references.mujoco_model), timed in
                  mujoco.rollout (MuJoCo's own C loop) and, for context, in a
                  Python loop of mj_step;
   Pinocchio      constrained forward dynamics: fixed-step RK4 at 1 ms around
@@ -43,16 +43,15 @@ from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(REPO / "python_checks"))
+import mujoco
+import mujoco.rollout
+import pinocchio as pin
 
-import mujoco  # noqa: E402
-import mujoco.rollout  # noqa: E402
-import pinocchio as pin  # noqa: E402
-
-from engine_comparison import deviation, pinocchio_reference  # noqa: E402
-from engines import mujoco_model, spec  # noqa: E402
-from engines.pinocchio_model import PinocchioPKM  # noqa: E402
+from pkm4puu import motions, spec
+from pkm4puu.fmu import REPO
+from pkm4puu.references import mujoco_model
+from pkm4puu.references.engine_comparison import deviation, pinocchio_reference
+from pkm4puu.references.pinocchio_model import PinocchioPKM
 
 H = 1e-3
 STEPS_TIMED = 1000  # one simulated second
@@ -101,7 +100,7 @@ class MuJoCoBench:
         self.sp = mujoco.mjtState.mjSTATE_FULLPHYSICS
         self.s0 = np.empty(mujoco.mj_stateSize(self.model, self.sp))
         mujoco.mj_getState(self.model, self.data, self.s0, self.sp)
-        self.ctrl = np.array([spec.comparison_forces((k + 0.5) * H) for k in range(STEPS_TEST)])
+        self.ctrl = np.array([motions.comparison_forces((k + 0.5) * H) for k in range(STEPS_TEST)])
         self.rollout(1)  # warm-up
 
     def rollout(self, batches):
@@ -146,7 +145,7 @@ class PinocchioBench:
         pm.setup_constraint_dynamics()
         self.pm = pm
         self.q0, self.v0 = pm.q_from_pose(spec.P0), np.zeros(16)
-        self.tau = [pm.S @ spec.comparison_forces(j * H / 2) for j in range(2 * STEPS_TEST + 1)]
+        self.tau = [pm.S @ motions.comparison_forces(j * H / 2) for j in range(2 * STEPS_TEST + 1)]
         self.run(10)  # warm-up
 
     def run(self, n, keep=False):

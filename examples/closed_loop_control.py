@@ -46,8 +46,12 @@ from dataclasses import dataclass
 import matplotlib
 import numpy as np
 
-from example_common import (DRHO, F, H, POSE, RHO, RK4, RUN_COLUMNS, START_P0, T_MOVE,
-                            VEL, ACC, Fmu, Log, add_common_args, find_fmus, motion, write_run_csv)
+from pkm4puu.cli import add_common_args, find_fmus, Log
+from pkm4puu.drawing import RUN_COLUMNS, write_run_csv
+from pkm4puu.fmu import Fmu
+from pkm4puu.interface import ACC, DRHO, F, POSE, RHO, RK4, START_P0, VEL
+from pkm4puu.motions import motion
+from pkm4puu.spec import STEP as H, T_MOVE
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402

@@ -21,7 +21,7 @@ process writes and extracts them to its own temporary directory the first time
 it needs them (keyed by their SHA-256), and every task instantiates its own
 FMU instances there: no shared file system is needed. The workers need this
 project's Python packages (fmpy, numpy); the functions of this module and of
-python_checks/fmu_helpers.py travel by value (cloudpickle), so the workers do
+the pkm4puu package travel by value (cloudpickle), so the workers do
 not need this repository. Progress (runs done, elapsed, estimated time left)
 is printed on stderr as the runs finish.
 
@@ -47,9 +47,12 @@ from pathlib import Path
 
 import numpy as np
 
-import example_common
-from example_common import (ACC, F, H, M_PLATFORM, POSE, RK4, START_P0, VEL, Fmu, Log,
-                            add_common_args, find_fmus, motion)
+import pkm4puu
+from pkm4puu.cli import add_common_args, find_fmus, Log
+from pkm4puu.fmu import Fmu
+from pkm4puu.interface import ACC, F, POSE, RK4, START_P0, VEL
+from pkm4puu.motions import motion
+from pkm4puu.spec import M_PLATFORM, STEP as H
 
 N_MASS, N_DURATION = 20, 20
 MASS_MAX = 0.5  # kg: payloads 0 .. 0.5 kg (the platform itself is 0.455 kg)
@@ -208,15 +211,23 @@ def run_serial(plant_fmu, inverse_fmu, masses, durations, log=None):
 
 
 def ship_by_value():
-    """Functions of this module and of fmu_helpers/example_common are pickled
-    by value, so the workers need not import them (a remote cluster does not
+    """Functions of this module and of the pkm4puu package are pickled by
+    value, so the workers need not import them (a remote cluster does not
     have this repository). When run as a script this module is __main__,
     which cloudpickle ships by value anyway."""
     import cloudpickle
-    import fmu_helpers
-    for mod in (example_common, fmu_helpers, sys.modules[__name__]):
+    for mod in (pkm4puu, sys.modules[__name__]):
         if mod.__name__ != "__main__":
             cloudpickle.register_pickle_by_value(mod)
+
+
+def upload_this_module(client):
+    """Imported as a module (by a test, say), this file's objects that Dask
+    pickles by reference (the FmuBlob instances, the results) name the module
+    `dask_sweep`: the workers get this file so that the name resolves there.
+    As a script it is __main__, which Dask ships by value anyway."""
+    if __name__ != "__main__":
+        client.upload_file(__file__)
 
 
 def run_dask(client, plant_fmu, inverse_fmu, masses, durations, log=None):
@@ -224,6 +235,7 @@ def run_dask(client, plant_fmu, inverse_fmu, masses, durations, log=None):
     (payload, duration)."""
     from dask.distributed import as_completed
     ship_by_value()
+    upload_this_module(client)
     plant, inverse = FmuBlob(plant_fmu), FmuBlob(inverse_fmu)
     # The FMUs (~0.4 MB) go to every worker once; tasks refer to them.
     plant_f, inverse_f = client.scatter([plant, inverse], broadcast=True)

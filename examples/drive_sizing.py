@@ -33,8 +33,11 @@ from dataclasses import dataclass
 import matplotlib
 import numpy as np
 
-from example_common import ACC, DRHO, F, H, POSE, RHO, T_MOVE, VEL, Fmu, Log, add_common_args, arr, find_fmus, \
-    motion
+from pkm4puu.cli import add_common_args, find_fmus, Log
+from pkm4puu.fmu import Fmu
+from pkm4puu.interface import ACC, arr, DRHO, F, POSE, RHO, VEL
+from pkm4puu.motions import motion
+from pkm4puu.spec import STEP as H, T_MOVE
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402

@@ -4,14 +4,14 @@ run, as an animated GIF and as a still of several frames (like the paper's
 Fig. 7).
 
 Every point is computed from the CSV's joint values and pose with
-MODEL_SPEC's formulas (example_common.mechanism_points): the legs from the DH
+MODEL_SPEC's formulas (pkm4puu.drawing.mechanism_points): the legs from the DH
 chain of Table I (slider's U joint O2 at height rho + h on the prismatic axis
 through B_i, rod to O3 = O2 + l x3, offset h' along z3 to the leg's end Q_i),
 the platform from the pose (p + Rz(phi) r_Qi). The two meet where the loop
 closes, which the drawing shows and test_examples_render.py checks.
 
 The CSV has the columns t_s, x, y, z, phi, rho[1..4], theta1[1..4],
-theta2[1..4] (example_common.write_run_csv; closed_loop_control.py writes one
+theta2[1..4] (pkm4puu.drawing.write_run_csv; closed_loop_control.py writes one
 as closed_loop_run.csv). Without --csv, the auto-test is run through the FMUs
 first (the inverse FMU's forces, held at each 1 ms step's midpoint, drive the
 plant open loop) and written as robot_run.csv.
@@ -29,8 +29,13 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 
-from example_common import (ACC, F, GEOMETRY, H, POSE, RK4, RUN_COLUMNS, START_P0, T_MOVE, VEL, Fmu, Log,
-                            add_common_args, find_fmus, mechanism_points, motion, read_run_csv, write_run_csv)
+from pkm4puu.cli import add_common_args, find_fmus, Log
+from pkm4puu.drawing import mechanism_points, read_run_csv, RUN_COLUMNS, write_run_csv
+from pkm4puu.fmu import Fmu
+from pkm4puu.interface import ACC, F, POSE, RK4, START_P0, VEL
+from pkm4puu.motions import motion
+from pkm4puu.spec import STEP as H, T_MOVE
+from pkm4puu.spec import R_B
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -91,22 +96,22 @@ def _platform_outline(pts):
     return np.vstack([pts["Qp"], pts["Qp"][:1]])
 
 
-def draw(ax, row, geo=GEOMETRY, ghost=None, trace=None, title=None):
+def draw(ax, row, ghost=None, trace=None, title=None):
     """Draws the mechanism at `row` (a dict with RUN_COLUMNS) on a 3-D axes.
     ghost: another row whose platform is drawn faintly (e.g. the start pose);
     trace: (n, 3) path of P drawn dotted."""
-    pts = mechanism_points(row, geo)
+    pts = mechanism_points(row)
     _setup_axes(ax, title)
     # base: the circle through the prismatic axes, and the axes themselves
     a = np.linspace(0.0, 2 * math.pi, 73)
-    rb = geo["r_b"]
+    rb = R_B
     ax.plot(rb * np.cos(a), rb * np.sin(a), 0.0 * a, color="0.35", lw=1.2)
     ax.add_collection3d(_poly([np.c_[rb * np.cos(a), rb * np.sin(a), 0.0 * a]], "0.85", 0.5))
     for i in range(4):
         B = pts["B"][i]
         ax.plot([B[0], B[0]], [B[1], B[1]], [0.0, Z_TOP], color="0.45", lw=1.0, ls="-")
     if ghost is not None:
-        g = _platform_outline(mechanism_points(ghost, geo))
+        g = _platform_outline(mechanism_points(ghost))
         ax.plot(g[:, 0], g[:, 1], g[:, 2], color="0.6", lw=0.9, ls="--")
     if trace is not None:
         ax.plot(trace[:, 0], trace[:, 1], trace[:, 2], color="k", lw=0.8, ls=":")
@@ -205,10 +210,10 @@ def write_still(t, rows, path, n_frames=4):
     return path
 
 
-def closure_error(rows, geo=GEOMETRY):
+def closure_error(rows):
     """max |Q_i (from the legs' joints) - (p + Rz(phi) r_Qi) (from the pose)| over rows (m)."""
     return max(float(np.abs(pts["Q"] - pts["Qp"]).max())
-               for pts in (mechanism_points(r, geo) for r in rows))
+               for pts in (mechanism_points(r) for r in rows))
 
 
 def main(argv=None):

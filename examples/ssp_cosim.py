@@ -29,7 +29,7 @@ the midpoint of the plant's next step, and the SSP's initial values (seen
 during libcosim's initialisation, which transfers them before the first step)
 are the motion at h/2. The plant then holds over every step [t_k, t_k + h] the
 force F(t_k + h/2): exactly the midpoint-held case of
-python_checks/fmu_autotest.py, whose max pose error over the 2 s is O(h^2):
+pkm4puu.autotest, whose max pose error over the 2 s is O(h^2):
 ~1.1e-8 m with CVODE. With no lead (inputs at t_k) the plant would hold
 F(t_k - h) over [t_k, t_k + h], a lag of 3h/2: an O(h) error of ~3e-5 m.
 
@@ -51,17 +51,20 @@ from xml.sax.saxutils import quoteattr
 import matplotlib
 import numpy as np
 
-from example_common import (ACC, F, H, INVERSE_FMU, PLANT_FMU, POSE, START_P0, T_MOVE, VEL, Log,
-                            add_common_args, find_fmus, motion, pose)
+from pkm4puu.cli import add_common_args, find_fmus, Log
+from pkm4puu.interface import ACC, F, POSE, START_P0, VEL
+from pkm4puu.motions import motion, p
+from pkm4puu.spec import STEP as H, T_MOVE
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+PLANT_FMU, INVERSE_FMU = "PKM4PUU.fmu", "PKM4PUU_Inverse.fmu"  # their names inside the SSP
 H_NS = 1_000_000  # libcosim counts time in integer nanoseconds: 1 ms
 N_STEPS = round(T_MOVE / H)
 LEAD = 1.5  # steps: the inverse FMU's inputs lead the plant by 3h/2 (see the module's doc)
 SOLVERS = {"cvode": 0, "rk4": 1}
-# What test_examples_ssp.py requires: the bound python_checks/fmu_autotest.py
+# What test_examples_ssp.py requires: the bound pkm4puu.autotest
 # holds the midpoint-held case to (the libcosim run is that case), and
 # agreement with that fmpy run to rounding.
 TOL_POS = 5e-8  # m
@@ -166,7 +169,7 @@ def write_ssp(plant_fmu, inverse_fmu, path, solver="cvode", lead=LEAD):
 @dataclass
 class SspRun:
     """Communication times t (s), the plant's pose (x, y, z, phi) there and
-    the prescribed pose; pos_err (m) and phi_err (rad) as in fmu_autotest."""
+    the prescribed pose; pos_err (m) and phi_err (rad) as in pkm4puu.autotest."""
     t: np.ndarray
     pose: np.ndarray
     ref: np.ndarray
@@ -224,7 +227,7 @@ def run_ssp(ssp_path, lead=LEAD, n_steps=N_STEPS, log=None):
     now = execution.status().current_time
     if now != n_steps * H_NS:
         raise RuntimeError(f"libcosim stopped at {now} ns, not {n_steps * H_NS} ns")
-    return SspRun(t, poses, np.array([pose(ti) for ti in t]))
+    return SspRun(t, poses, np.array([p(ti) for ti in t]))
 
 
 def write_csv(runs, path):

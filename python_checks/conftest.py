@@ -1,18 +1,14 @@
 """Shared fixtures: where the FMUs are and where results go.
 
-The FMUs are taken from $PKM_BUILD_DIR (default <repo>/build). A missing FMU
-is a failure, not a skip: these checks exist to test the built FMUs.
+The FMUs are taken from $PKM_BUILD_DIR (default <repo>/build, see
+pkm4puu.build_dir). A missing FMU is a failure, not a skip: these checks
+exist to test the built FMUs.
 """
-import os
 from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parent.parent
-
-
-def build_dir() -> Path:
-    return Path(os.environ.get("PKM_BUILD_DIR", REPO / "build")).resolve()
+from pkm4puu.fmu import REPO, build_dir
 
 
 def _require_fmu(name: str) -> Path:

@@ -26,8 +26,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from engines import mujoco_model, spec
-from engines.pinocchio_model import PinocchioPKM
+from pkm4puu import motions, spec
+from pkm4puu.references import mujoco_model
+from pkm4puu.references.pinocchio_model import PinocchioPKM
 
 RNG = np.random.default_rng(20261121)
 
@@ -164,7 +165,7 @@ def test_capi_binding_matches_pkm_h():
     """engines/pkm_capi.py's ctypes structs against fmu_src/capi/pkm.h: the same
     fields at the same offsets (fields appended to pkm.h later must fit in the
     binding's reserve)."""
-    from engines import pkm_capi
+    from pkm4puu import capi as pkm_capi
     bad = pkm_capi.binding_mismatches()
     assert not bad, "\n".join(bad)
 

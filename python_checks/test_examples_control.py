@@ -2,16 +2,14 @@
 off-centre payload in a 1 kHz joint-space PD loop, with the inverse FMU's
 computed-force feed-forward given the plant's friction (compensation), not
 given it, and without feed-forward at all."""
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
+from pkm4puu.spec import G, M_PLATFORM, M_ROD, M_SLIDER, TOTAL_WEIGHT
+from example_scripts import load_example
 
-import closed_loop_control as clc  # noqa: E402
-from fmu_helpers import G, M_PLATFORM, M_ROD, M_SLIDER, TOTAL_WEIGHT  # noqa: E402  (MODEL_SPEC)
+clc = load_example("closed_loop_control")
 
 PARAMS = clc.machine()
 

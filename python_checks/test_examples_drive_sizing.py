@@ -1,17 +1,16 @@
 """examples/drive_sizing.py: motor torques and speeds from the inverse FMU
 along the auto-test with rotor inertia, friction and a payload."""
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
+from pkm4puu.fmu import Fmu
+from pkm4puu.interface import START_P0, arr
+from pkm4puu.spec import G, TOTAL_WEIGHT
+from example_scripts import load_example
 
-import drive_sizing as ds  # noqa: E402
-from example_common import START_P0  # noqa: E402
-from fmu_helpers import G, TOTAL_WEIGHT, Fmu, arr  # noqa: E402  (MODEL_SPEC)
+ds = load_example("drive_sizing")
 
 M = ds.MACHINE
 P = M["screw_lead"]

@@ -2,16 +2,14 @@
 run is rendered; the frames must change as the platform moves, a static pose
 must render identically twice, and the drawn legs must meet the drawn
 platform (the DH chain from the FMU's joint outputs against the pose)."""
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
+from pkm4puu.drawing import read_run_csv, RUN_COLUMNS, write_run_csv
+from example_scripts import load_example
 
-import render_robot as rr  # noqa: E402
-from example_common import RUN_COLUMNS, read_run_csv, write_run_csv  # noqa: E402
+rr = load_example("render_robot")
 
 T_SHORT = 0.6  # s: the auto-test's motion done in 0.6 s, a short run
 N_FRAMES = 4

@@ -1,17 +1,16 @@
 """examples/ssp_cosim.py: the auto-test as an SSP system (inverse.F ->
 plant.F) loaded and run by libcosim (libcosimpy)."""
-import sys
 import xml.etree.ElementTree as ET
 import zipfile
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
+from pkm4puu.fmu import Fmu, inverse_forces, run
+from pkm4puu.interface import F, POSE
+from example_scripts import load_example
 
-import ssp_cosim  # noqa: E402
-from fmu_helpers import F, POSE, Fmu, inverse_forces, run  # noqa: E402
+ssp_cosim = load_example("ssp_cosim")
 
 H = ssp_cosim.H
 N = ssp_cosim.N_STEPS
@@ -33,7 +32,7 @@ def compensated(ssp_file):
 
 
 def fmpy_midpoint_run(plant_fmu, inverse_fmu):
-    """The midpoint-held auto-test through fmpy (python_checks/fmu_autotest.py's
+    """The midpoint-held auto-test through fmpy (pkm4puu.autotest's
     'midpoint' case, CVODE): the plant holds F(t_k + h/2) over [t_k, t_k + h]."""
     with Fmu(inverse_fmu) as inv:
         Fm = inverse_forces(inv, (np.arange(N) + 0.5) * H)
@@ -57,7 +56,7 @@ def test_ssp_archive_structure(ssp_file):
 def test_libcosim_reproduces_the_autotest(compensated, plant_fmu, inverse_fmu):
     """With the inverse FMU's inputs leading by 3h/2 the plant holds
     F(t_k + h/2) over every step: the midpoint-held auto-test, whose bound
-    python_checks/fmu_autotest.py sets at 5e-8 m / 5e-8 rad (measured 1.1e-8 m,
+    pkm4puu.autotest sets at 5e-8 m / 5e-8 rad (measured 1.1e-8 m,
     1.4e-8 rad with CVODE). It is the same computation as fmpy's, so the two
     runs agree to rounding: 6e-14 m measured, from the step times, which
     libcosim counts in integer nanoseconds, differing from fmpy's k * 1e-3 in

@@ -1,15 +1,13 @@
 """examples/dask_sweep.py: a payload x duration sweep of the auto-test on
 Dask. A small sweep on a LocalCluster of 2 worker processes must give exactly
 the results of the same runs done serially in this process."""
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from example_scripts import load_example
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
+dask_sweep = load_example("dask_sweep")
 
-import dask_sweep  # noqa: E402
 
 MASSES = [0.0, 0.25, 0.5]  # kg
 DURATIONS = [0.5, 0.75, 1.0]  # s: short motions keep the test quick

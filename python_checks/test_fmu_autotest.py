@@ -4,7 +4,7 @@ driven open loop by those forces at a 1 ms communication step for 2 s, must
 reproduce the prescribed pose.
 
 The runner, the three input modes (a) midpoint, (b) first order, (c) zero-order
-hold, and the result writers are in fmu_autotest.py (the main job runs the
+hold, and the result writers are in pkm4puu.autotest (the main job runs the
 same code); the checks are here:
 
 (a) and (b) must reproduce the prescribed motion to TOL_POS / TOL_PHI with
@@ -17,9 +17,11 @@ same code); the checks are here:
 import numpy as np
 import pytest
 
-from fmu_autotest import (BOUNDED_MODES, SOLVERS, TOL_PHI, TOL_POS, format_table, half_step_forces, run_all,
+from pkm4puu.autotest import (BOUNDED_MODES, SOLVERS, TOL_PHI, TOL_POS, format_table, half_step_forces, run_all,
                           write_results)
-from fmu_helpers import P0, P1, POSE, STATIC_FORCE_P0, TOTAL_WEIGHT, Fmu, arr, inverse_forces
+from pkm4puu.fmu import Fmu, inverse_forces
+from pkm4puu.interface import arr, POSE
+from pkm4puu.spec import P0, P1, STATIC_FORCE_P0, TOTAL_WEIGHT
 
 
 @pytest.fixture(scope="module")

@@ -33,8 +33,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import build_dir
-from fmu_helpers import F, POSE, STATIC_FORCE_P0, Fmu
+from pkm4puu.fmu import build_dir
+from pkm4puu.fmu import Fmu
+from pkm4puu.interface import F, POSE
+from pkm4puu.spec import STATIC_FORCE_P0
 
 # The motion of test_fmu_flavours.py: F[1] 4.4 mN above the holding force, a
 # small force along x and moment about z, so that all four coordinates move.

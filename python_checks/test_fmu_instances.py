@@ -7,7 +7,9 @@ import shutil
 import numpy as np
 from fmpy import extract
 
-from fmu_helpers import F, G, M_ROD, M_SLIDER, POSE, VEL, Fmu, arr
+from pkm4puu.fmu import Fmu
+from pkm4puu.interface import arr, F, POSE, VEL
+from pkm4puu.spec import G, M_ROD, M_SLIDER
 
 H = 1e-3
 N = 500  # 0.5 s

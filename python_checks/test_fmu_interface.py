@@ -6,7 +6,8 @@ import math
 import pytest
 from fmpy import read_model_description
 
-from fmu_helpers import ACC, POSE, VEL, arr
+from pkm4puu.interface import ACC, arr, POSE, VEL
+from pkm4puu.spec import PARAMETER_DEFAULTS, SOLVER_DEFAULTS
 
 WRENCH = arr("Fe", 3) + ["Me_z"]
 GEOMETRY = ["h", "l", "h_prime", "r_b", "r_Q"] + arr("beta", 4) + arr("gamma", 4)
@@ -24,18 +25,6 @@ INVERSE = {
     "output": arr("F", 4) + arr("rho", 4) + arr("drho", 4) + arr("lambda", 12),
     "parameter": GEOMETRY + MASSES,
 }
-
-_G = math.radians(65.0)
-DEFAULTS = {  # MODEL_SPEC, in SI units
-    "h": 0.06634, "l": 0.080, "h_prime": 0.075, "r_b": 0.09273, "r_Q": 0.075,
-    "beta[1]": 0.0, "beta[2]": math.pi / 2, "beta[3]": math.pi, "beta[4]": 3 * math.pi / 2,
-    "gamma[1]": _G, "gamma[2]": -_G, "gamma[3]": _G, "gamma[4]": -_G,
-    "m_slider": 0.09331, "m_rod": 0.06371,
-    "I_rod[1]": 3.83e-6, "I_rod[2]": 49.86e-6, "I_rod[3]": 52.64e-6,
-    "m_platform": 0.45474, "Izz_platform": 2874.21e-6, "g": 9.81,
-}
-SOLVER_DEFAULTS = {"solver": 0, "rk4_step": 1e-3, "rtol": 1e-8, "atol": 1e-10}
-
 
 def _variables(path):
     return {v.name: v for v in read_model_description(str(path)).modelVariables}
@@ -77,7 +66,7 @@ def test_inverse_contract(inverse_fmu):
 
 @pytest.mark.parametrize("which", ["plant_fmu", "inverse_fmu"])
 def test_parameter_defaults_are_the_spec(which, request):
-    _check_defaults(request.getfixturevalue(which), DEFAULTS)
+    _check_defaults(request.getfixturevalue(which), PARAMETER_DEFAULTS)
 
 
 def test_plant_solver_defaults(plant_fmu):

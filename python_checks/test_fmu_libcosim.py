@@ -4,7 +4,8 @@ forces at a 1 ms step, and ends where fmpy's run of the same case ends."""
 import numpy as np
 import pytest
 
-from fmu_helpers import F, POSE, Fmu, run
+from pkm4puu.fmu import Fmu, run
+from pkm4puu.interface import F, POSE
 
 H_NS = 1_000_000  # 1 ms, libcosim counts time in nanoseconds
 DURATION_NS = 1_000_000_000  # 1 s

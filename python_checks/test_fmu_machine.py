@@ -10,7 +10,10 @@ import math
 import numpy as np
 import pytest
 
-from fmu_helpers import F, M_PLATFORM, M_ROD, M_SLIDER, G, P0, POSE, STATIC_FORCE_P0, T_MOVE, Fmu, arr, inverse_forces, p
+from pkm4puu.fmu import Fmu, inverse_forces
+from pkm4puu.interface import arr, F, POSE
+from pkm4puu.motions import p
+from pkm4puu.spec import G, M_PLATFORM, M_ROD, M_SLIDER, P0, STATIC_FORCE_P0, T_MOVE
 
 SCREW_LEAD = 0.004  # m, the default
 MACHINE = {

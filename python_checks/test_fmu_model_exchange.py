@@ -22,7 +22,10 @@ import pytest
 from fmpy import simulate_fmu
 from fmpy.fmi1 import FMICallException
 
-from fmu_helpers import F, P0, POSE, STATIC_FORCE_P0, T_MOVE, Fmu, arr, inverse_forces, p, run
+from pkm4puu.fmu import Fmu, inverse_forces, run
+from pkm4puu.interface import arr, F, POSE
+from pkm4puu.motions import p
+from pkm4puu.spec import P0, STATIC_FORCE_P0, T_MOVE
 
 H = 1e-3  # s, the interval of the held forces and the communication step
 N = round(T_MOVE / H)

@@ -11,7 +11,9 @@ import math
 import numpy as np
 import pytest
 
-from fmu_helpers import F, POSE, STATIC_FORCE_P0, VEL, Fmu, arr
+from pkm4puu.fmu import Fmu
+from pkm4puu.interface import arr, F, POSE, VEL
+from pkm4puu.spec import STATIC_FORCE_P0
 
 H = 1e-3
 T_SAVE, T_END = 1.0, 1.5

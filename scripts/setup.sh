@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what building and testing need, and only what is missing:
 # Debian packages (apt-get) and the Python virtualenv .venv with
-# python_checks/requirements.txt. Idempotent and non-interactive (CI-safe).
+# python_checks/requirements.txt, and this project's package python/pkm4puu.
+# Idempotent and non-interactive (CI-safe).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 log() { echo "setup: $*" >&2; }
@@ -46,5 +47,13 @@ if [ ! -f "$stamp" ] || [ "$req" -nt "$stamp" ]; then
   touch "$stamp"
 else
   log "Python requirements up to date"
+fi
+# 3. This project's Python package (python/pkm4puu), editable: the checks,
+# examples and benchmarks import it, and it follows the working tree.
+if ! .venv/bin/python -c "import pkm4puu, sys; sys.exit(pkm4puu.__file__ != '$PWD/python/pkm4puu/__init__.py')" 2>/dev/null; then
+  log "installing the pkm4puu package (editable) from python/"
+  .venv/bin/pip install --disable-pip-version-check -q --no-deps --no-build-isolation -e python
+else
+  log "pkm4puu package installed"
 fi
 log "done"

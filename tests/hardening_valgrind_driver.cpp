@@ -1,6 +1,6 @@
 // A small co-simulation master for valgrind memcheck (ctest
 // hardening_valgrind): the paper's full 2-s auto-test through the built
-// FMUs, as python_checks/fmu_autotest.py does it -- PKM4PUU_Inverse.so turns
+// FMUs, as python/pkm4puu/autotest.py does it -- PKM4PUU_Inverse.so turns
 // the prescribed motion into F1..F4 at each 1-ms step's midpoint,
 // PKM4PUU.so is driven by them open loop -- with RK4 and with CVODE; plus
 // the paths an importer may take around it: FMU states (get, set,

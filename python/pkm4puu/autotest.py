@@ -16,7 +16,7 @@ the accuracy; three ways are compared:
     ~ (h/2) x velocity ~ 1e-5 m here. It is reported, not bounded.
 
 This module holds the runner and the writers; the checks are in
-test_fmu_autotest.py. Run as a script it is part of the main job
+test_fmu_autotest.py. Run as a module it is part of the main job
 (run_autotest.sh): it runs every (input mode, solver) case, prints the table
 of max errors and writes to --out DIR:
 
@@ -26,7 +26,7 @@ of max errors and writes to --out DIR:
                             (midpoint input, CVODE)
   fmu_autotest_forces.png   F1..F4 from the inverse FMU
 
-usage: fmu_autotest.py [--build DIR] [--out DIR]
+usage: python -m pkm4puu.autotest [--build DIR] [--out DIR]
 """
 import argparse
 import csv
@@ -37,17 +37,16 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 
-import autotest_plots
-from fmu_helpers import ACC, F, P0, POSE, T_MOVE, VEL, Fmu, inverse_forces, p, run
+from . import plots
+from .cli import Log, add_common_args, find_fmus
+from .fmu import Fmu, inverse_forces, run
+from .interface import ACC, F, POSE, START_P0, VEL
+from .motions import p
+from .spec import STEP as H, T_MOVE
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-REPO = Path(__file__).resolve().parent.parent
-PLANT_FMU = "PKM4PUU.fmu"
-INVERSE_FMU = "PKM4PUU_Inverse.fmu"
-
-H = 1e-3  # s, communication step (the paper's RK4 step)
 N = round(T_MOVE / H)
 # Bounds that test_fmu_autotest.py asserts for the BOUNDED_MODES; the ZOH mode
 # is only required to be worse than the midpoint hold.
@@ -56,7 +55,7 @@ TOL_PHI = 5e-8  # rad
 SOLVERS = {"CVODE": {"solver": 0}, "RK4": {"solver": 1, "rk4_step": 1e-3}}
 MODES = ("midpoint", "first_order", "zoh")
 BOUNDED_MODES = ("midpoint", "first_order")
-START = {"x0": P0[0], "y0": P0[1], "z0": P0[2], "phi0": P0[3]}
+START = START_P0
 # The case shown in fmu_autotest_pose.png.
 POSE_PLOT_CASE = ("midpoint", "CVODE")
 
@@ -252,7 +251,7 @@ def plot_pose(runs, path, case=POSE_PLOT_CASE):
     """Prescribed vs FMU-simulated x, y, z, phi for one case."""
     r = runs[case]
     m, s = case
-    autotest_plots.plot_pose(
+    plots.plot_pose(
         r.t, r.ref, r.pose, "plant FMU p(t)",
         "Auto-test through the FMUs: prescribed motion and the plant FMU driven open loop\n"
         f"by the inverse FMU's forces ({m} input, {s}, {H * 1e3:g} ms step; max error "
@@ -261,7 +260,7 @@ def plot_pose(runs, path, case=POSE_PLOT_CASE):
 
 def plot_forces(Fh, F_static, path):
     """F1..F4 from the inverse FMU at the half-step times, and their dynamic part."""
-    autotest_plots.plot_forces(half_step_times(), Fh, F_static,
+    plots.plot_forces(half_step_times(), Fh, F_static,
                                "Auto-test: actuator forces from the inverse FMU (PKM4PUU_Inverse)", path)
 
 
@@ -281,31 +280,14 @@ def write_results(runs, Fh, inverse_fmu, out_dir):
 
 
 # --- command line ---------------------------------------------------------------------------
-def find_fmus(build, prog):
-    """(plant, inverse) paths in `build`, or None after saying on stderr what is missing."""
-    paths = [Path(build) / PLANT_FMU, Path(build) / INVERSE_FMU]
-    missing = [str(q) for q in paths if not q.is_file()]
-    if missing:
-        print(f"{prog}: error: {', '.join(missing)} not found: build the FMUs first "
-              f"(./scripts/build.sh builds them into build/) or pass --build DIR", file=sys.stderr)
-        return None
-    return paths
-
-
 def main(argv=None):
-    prog = "fmu_autotest"
-    ap = argparse.ArgumentParser(prog=prog, description="The paper's auto-test (section 5.1) through the FMUs: "
-                                 "inverse FMU -> F1..F4 -> plant FMU, open loop, 1 ms communication step, 2 s.")
-    ap.add_argument("--build", type=Path, default=REPO / "build",
-                    help=f"directory holding {PLANT_FMU} and {INVERSE_FMU} (default: %(default)s)")
-    ap.add_argument("--out", type=Path, default=REPO / "results",
-                    help="directory for the CSV and PNG files (default: %(default)s)")
+    ap = argparse.ArgumentParser(prog="python -m pkm4puu.autotest",
+                                 description="The paper's auto-test (section 5.1) through the FMUs: inverse FMU "
+                                 "-> F1..F4 -> plant FMU, open loop, 1 ms communication step, 2 s.")
+    add_common_args(ap)
     args = ap.parse_args(argv)
-
-    def log(msg):
-        print(f"{prog}: {msg}", file=sys.stderr, flush=True)
-
-    fmus = find_fmus(args.build, prog)
+    log = Log("autotest")
+    fmus = find_fmus(args.build, log)
     if fmus is None:
         return 1
     plant, inverse = fmus

@@ -1,5 +1,5 @@
 """The auto-test's two standard figures, shared by the C++ core's plots
-(plot_autotest.py) and the FMU run's (fmu_autotest.py): actuator forces with
+(plot_cpp_autotest.py) and the FMU run's (autotest.py): actuator forces with
 their dynamic part (in the spirit of the paper's Fig. 5) and prescribed
 versus simulated platform motion (Fig. 6)."""
 import math

@@ -10,10 +10,9 @@ directory is $PKM_BUILD_DIR (default <repo>/build), as for the FMU checks.
         out = m.outputs(F)
 """
 import ctypes as ct
-import os
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[2]
+from .fmu import REPO, build_dir
 
 PKM_OK = 0
 PKM_SOLVER_CVODE, PKM_SOLVER_RK4 = 0, 1
@@ -78,8 +77,7 @@ TORQUE_FN = ct.CFUNCTYPE(None, ct.c_void_p, ct.c_double, ct.POINTER(ct.c_double)
 
 
 def library_path(build=None):
-    build = Path(build) if build else Path(os.environ.get("PKM_BUILD_DIR", REPO / "build"))
-    return build.resolve() / "fmu_src" / "libpkm.so"
+    return (Path(build).resolve() if build else build_dir()) / "fmu_src" / "libpkm.so"
 
 
 def load(path=None):

@@ -43,7 +43,7 @@ What is compared:
   (pkm_inverse_dynamics_machine against Pinocchio's RNEA with armature,
   payload and friction).
 
-usage: engine_comparison.py [--build DIR] [--out DIR]
+usage: python -m pkm4puu.references.engine_comparison [--build DIR] [--out DIR]
 """
 import argparse
 import csv
@@ -58,13 +58,14 @@ import mujoco
 import pinocchio as pin
 from scipy.integrate import solve_ivp
 
-from engines import mujoco_model, pkm_capi, spec
-from engines.pinocchio_model import PinocchioPKM
+from pkm4puu import capi as pkm_capi, motions, spec
+from pkm4puu.references import mujoco_model
+from pkm4puu.references.pinocchio_model import PinocchioPKM
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-REPO = Path(__file__).resolve().parent.parent
+from pkm4puu.fmu import REPO  # noqa: E402
 
 H = 1e-3  # s, output grid and communication step
 N = round(spec.CMP_DURATION / H)
@@ -100,7 +101,7 @@ def _rows_from_q(Q):
             "constraint": np.array([np.linalg.norm(spec.constraint_residual(q)) for q in Q])}
 
 
-def pinocchio_reference(force_law="exact", machine=None, g=0.0, forces=spec.comparison_forces):
+def pinocchio_reference(force_law="exact", machine=None, g=0.0, forces=motions.comparison_forces):
     """The comparison test with Pinocchio's constrained forward dynamics
     (PinocchioPKM.forward_dynamics, the KKT system), state (q, v) in the 16
     coordinates, DOP853 at REF_RTOL / REF_ATOL. force_law "exact": F(t) at
@@ -149,7 +150,7 @@ def pinocchio_reference(force_law="exact", machine=None, g=0.0, forces=spec.comp
     return out
 
 
-def pinocchio_rk4(h=5e-4, machine=None, g=0.0, forces=spec.comparison_forces):
+def pinocchio_rk4(h=5e-4, machine=None, g=0.0, forces=motions.comparison_forces):
     """Cross-check of the reference: fixed-step RK4 at h on the manifold's
     coordinates, accelerations from pinocchio.constraintDynamics (Pinocchio's
     own constrained dynamics, RigidConstraintModel CONTACT_3D), exact F at
@@ -185,7 +186,7 @@ def pinocchio_inverse(times=AUTOTEST_TIMES):
     pm = PinocchioPKM(g=spec.G)
     F, lam = np.empty((len(times), 4)), np.empty((len(times), 12))
     for k, t in enumerate(times):
-        F[k], lam[k], _ = pm.inverse_dynamics(*spec.autotest_motion(t))
+        F[k], lam[k], _ = pm.inverse_dynamics(*motions.autotest_motion(t))
     return F, lam
 
 
@@ -202,18 +203,18 @@ def capi_inverse(lib, times=AUTOTEST_TIMES):
     F, lam = np.empty((len(times), 4)), np.empty((len(times), 12))
     with pkm_capi.Model(lib) as m:
         for k, t in enumerate(times):
-            r = m.inverse_dynamics(*spec.autotest_motion(t))
+            r = m.inverse_dynamics(*motions.autotest_motion(t))
             F[k], lam[k] = r.F, r.lambda_
     return F, lam
 
 
 def fmu_inverse(inverse_fmu, times=AUTOTEST_TIMES):
-    from fmu_helpers import Fmu, inverse_forces
+    from pkm4puu.fmu import Fmu, inverse_forces
     with Fmu(inverse_fmu) as inv:
         return inverse_forces(inv, times)
 
 
-def capi_run(lib, settings, machine=None, g=0.0, forces=spec.comparison_forces, torques=None):
+def capi_run(lib, settings, machine=None, g=0.0, forces=motions.comparison_forces, torques=None):
     """The comparison test through the C API: pkm_advance_fn to each 1 ms
     point with the forces from a callback at the integrator's own times
     (continuous: CVODE is not restarted), outputs read at each point.
@@ -258,7 +259,7 @@ def capi_run(lib, settings, machine=None, g=0.0, forces=spec.comparison_forces, 
 def fmu_runs(plant_fmu):
     """The comparison test through the plant FMU (fmu_comparison's runner:
     1 ms communication step, midpoint-held forces), CVODE and RK4."""
-    import fmu_comparison
+    from pkm4puu import comparison as fmu_comparison
     out = {}
     for name in fmu_comparison.SOLVERS:
         t0 = time.perf_counter()
@@ -270,7 +271,7 @@ def fmu_runs(plant_fmu):
 
 
 # --- MuJoCo -------------------------------------------------------------------------------------------
-def mujoco_run(g=0.0, forces=spec.comparison_forces, machine=None, **kw):
+def mujoco_run(g=0.0, forces=motions.comparison_forces, machine=None, **kw):
     """The comparison test in MuJoCo (engines/mujoco_model.py; keyword
     arguments go to its mjcf()): mj_step at 1 ms, midpoint-held forces.
     "constraint" is ||C(q)|| from the spec's formula on MuJoCo's qpos.
@@ -364,14 +365,14 @@ class MachineCase:
 
     def forces(self, t):
         """F1..F4 (N) at t, as the engines see them."""
-        return self.hold + spec.comparison_forces(t)
+        return self.hold + motions.comparison_forces(t)
 
     def capi_inputs(self):
         """(forces(t), torques(t) or None) for the C API."""
         if not self.use_torques:
             return self.forces, None
         lead = self.machine.screw_lead
-        return (lambda t: self.hold.copy()), (lambda t: spec.comparison_forces(t) * lead / (2.0 * math.pi))
+        return (lambda t: self.hold.copy()), (lambda t: motions.comparison_forces(t) * lead / (2.0 * math.pi))
 
     def without_machine(self):
         """The same test on the ideal machine (its own holding forces): what the terms change."""
@@ -438,7 +439,7 @@ def pinocchio_inverse_machine(machine, times=AUTOTEST_TIMES, g=spec.G):
     pm = PinocchioPKM(g=g, machine=machine)
     F, lam = np.empty((len(times), 4)), np.empty((len(times), 12))
     for k, t in enumerate(times):
-        F[k], lam[k], _ = pm.inverse_dynamics(*spec.autotest_motion(t))
+        F[k], lam[k], _ = pm.inverse_dynamics(*motions.autotest_motion(t))
     return F, lam
 
 
@@ -449,7 +450,7 @@ def capi_inverse_machine(lib, machine, times=AUTOTEST_TIMES):
     flags = np.empty(len(times), dtype=int)
     with pkm_capi.Model(lib, machine=machine.capi_params()) as m:
         for k, t in enumerate(times):
-            r = m.inverse_dynamics_machine(*spec.autotest_motion(t))
+            r = m.inverse_dynamics_machine(*motions.autotest_motion(t))
             F[k], tau[k], lam[k], flags[k] = r.F, r.tau, r.lambda_, r.beyond_stops
     return {"F": F, "tau": tau, "lambda": lam, "beyond_stops": flags}
 

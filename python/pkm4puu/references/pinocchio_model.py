@@ -1,5 +1,5 @@
 """An independent model of the 4-PUU mechanism in Pinocchio, built from
-MODEL_SPEC's numbers only (engines/spec.py), used as the reference for the
+MODEL_SPEC's numbers only (pkm4puu.spec), used as the reference for the
 project's dynamics.
 
 Structure (a kinematic tree plus loop closures):
@@ -52,7 +52,7 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from . import spec
+from .. import spec
 
 NQ = 16
 LEG_ROWS = [3 * i for i in range(4)]  # index of rho_i in q

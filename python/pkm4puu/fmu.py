@@ -1,71 +1,60 @@
-"""Small helpers for the FMU checks: the spec's trajectory and constants, and a
-thin, always-cleaning-up wrapper around fmpy's FMU2Slave and FMU3Slave.
+"""Opening and driving the project's FMUs from Python: a thin, always
+cleaning-up wrapper around fmpy's FMU2Slave and FMU3Slave that speaks the
+interface's names.
 
-Every number here is copied from /work/shared/MODEL_SPEC.md (the authoritative
-definition of the mechanism), never from an output of the code under test.
+    from pkm4puu import Fmu
+    with Fmu.open("PKM4PUU", start={"solver": 1}) as plant:
+        result = plant.simulate(0.5, 1e-3, inputs={"F[1]": 2.7}, outputs=["x", "z"])
 """
-import math
+from __future__ import annotations
+
+import os
 import shutil
+from pathlib import Path
+from typing import Callable, Mapping, Sequence, Union
 
 import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
-# --- MODEL_SPEC "Auto-test": rest-to-rest quintic from P0 to P1 in 2 s -------
-T_MOVE = 2.0  # s
-P0 = np.array([0.0, 0.0, 0.05, 0.0])  # x, y, z (m), phi (rad)
-P1 = np.array([0.005, -0.005, 0.07, math.radians(4.0)])
+from .interface import ACC, F, POSE, VEL
+from .motions import autotest_motion
 
-# --- MODEL_SPEC "Bodies" (Table III) and "Geometry defaults" (Table II) ------
-M_SLIDER = 0.09331  # kg
-M_ROD = 0.06371  # kg
-M_PLATFORM = 0.45474  # kg
-L_ROD = 0.080  # m
-G = 9.81  # m/s^2
-# "A check anyone can derive": each actuator's share of the weight at P0.
-STATIC_FORCE_P0 = 2.655616050  # N
-TOTAL_WEIGHT = 10.622464200  # N
-
-POSE = ["x", "y", "z", "phi"]
-VEL = ["dx", "dy", "dz", "dphi"]
-ACC = ["ddx", "ddy", "ddz", "ddphi"]
+REPO = Path(__file__).resolve().parents[2]
+MODELS = ("PKM4PUU", "PKM4PUU_Inverse")
 
 
-def arr(name, n):
-    """FMI array names, 1-based: arr('F', 4) -> ['F[1]', ..., 'F[4]']."""
-    return [f"{name}[{i}]" for i in range(1, n + 1)]
+def build_dir() -> Path:
+    """Where the FMUs are built: $PKM_BUILD_DIR, else the repository's build/."""
+    return Path(os.environ.get("PKM_BUILD_DIR", REPO / "build")).resolve()
 
 
-F = arr("F", 4)
+def find_fmu(model: str = "PKM4PUU", fmi: int = 2, build: Union[str, Path, None] = None) -> Path:
+    """The archive of `model` (PKM4PUU, the plant, or PKM4PUU_Inverse) for FMI
+    version `fmi` (2 or 3) in `build` (default: build_dir()); FileNotFoundError
+    saying how to build it when it is not there."""
+    if model not in MODELS:
+        raise ValueError(f"unknown model {model!r}: one of {', '.join(MODELS)}")
+    if fmi not in (2, 3):
+        raise ValueError(f"fmi must be 2 or 3, not {fmi!r}")
+    root = Path(build) if build is not None else build_dir()
+    path = root / ("fmi3" if fmi == 3 else "") / f"{model}.fmu"
+    if not path.is_file():
+        raise FileNotFoundError(f"{path} does not exist: build the FMUs first (./scripts/build.sh builds them "
+                                f"into build/), or set PKM_BUILD_DIR to the directory that holds them")
+    return path
 
 
-def blend(tau):
-    """s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5 and its first two derivatives,
-    held at rest before tau = 0 and after tau = 1 (the motion is rest to rest)."""
-    if tau <= 0.0:
-        return 0.0, 0.0, 0.0
-    if tau >= 1.0:
-        return 1.0, 0.0, 0.0
-    s = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
-    ds = 30.0 * tau**2 * (1.0 - tau) ** 2
-    dds = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau)
-    return s, ds, dds
+class Result:
+    """A run's outputs at the communication points: `t` and one column per
+    output name (`result["x"]`, or `result.values` as an n x m array)."""
 
+    def __init__(self, t: np.ndarray, names: Sequence[str], values: np.ndarray):
+        self.t, self.names, self.values = t, list(names), values
 
-def p(t):
-    """Prescribed pose (x, y, z, phi) at time t."""
-    return P0 + (P1 - P0) * blend(t / T_MOVE)[0]
-
-
-def pd(t):
-    """Prescribed velocity at time t."""
-    return (P1 - P0) * blend(t / T_MOVE)[1] / T_MOVE
-
-
-def pdd(t):
-    """Prescribed acceleration at time t."""
-    return (P1 - P0) * blend(t / T_MOVE)[2] / T_MOVE**2
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.values[:, self.names.index(name)]
 
 
 class Fmu:
@@ -84,7 +73,8 @@ class Fmu:
     setFloat64, getFMUstate / getFMUState, ...); `fmu.fmu` is fmpy's object.
     """
 
-    def __init__(self, path, start=None, instance_name="instance", unzipdir=None, start_time=0.0):
+    def __init__(self, path, start: Mapping[str, float] | None = None, instance_name: str = "instance",
+                 unzipdir: str | None = None, start_time: float = 0.0):
         self.path = str(path)
         self.start = dict(start or {})
         self.instance_name = instance_name
@@ -97,6 +87,11 @@ class Fmu:
         self.fmu = None
         self._instantiated = False
         self._initialized = False
+
+    @classmethod
+    def open(cls, model: str = "PKM4PUU", fmi: int = 2, build=None, **kwargs) -> "Fmu":
+        """An instance of `model` (see find_fmu), for use in a with block."""
+        return cls(find_fmu(model, fmi, build), **kwargs)
 
     # -- life cycle ---------------------------------------------------------
     def __enter__(self):
@@ -199,6 +194,26 @@ class Fmu:
     def do_step(self, t, h, no_set_prior=True):
         self.fmu.doStep(t, h, noSetFMUStatePriorToCurrentPoint=no_set_prior)
 
+    def simulate(self, stop_time: float, step: float,
+                 inputs: Mapping[str, float] | Callable[[float], Mapping[str, float]] | None = None,
+                 outputs: Sequence[str] = POSE) -> Result:
+        """Steps from the start time to stop_time by `step`. `inputs` maps
+        input names to values: fixed, or a function of the step's start time
+        called before each step. Returns the outputs at every communication
+        point, the start included."""
+        n = round((stop_time - self.start_time) / step)
+        if n < 1 or not np.isclose(self.start_time + n * step, stop_time, rtol=0, atol=1e-9 * step):
+            raise ValueError(f"stop_time {stop_time} is not a whole number of steps of {step} after "
+                             f"the start time {self.start_time}")
+
+        def apply(fmu, k, t):
+            values = inputs(t) if callable(inputs) else inputs
+            if values:
+                fmu.set(list(values), list(values.values()))
+
+        t, Y = run(self, self.start_time, step, n, apply, outputs)
+        return Result(t, outputs, Y)
+
     # -- FMU state ----------------------------------------------------------
     def get_state(self):
         return self.fmu.getFMUState() if self.fmi3 else self.fmu.getFMUstate()
@@ -238,9 +253,7 @@ def inverse_forces(inv, times):
     """Actuator forces F1..F4 from the inverse FMU on the prescribed motion at
     each of `times` (no external wrench): one row per time."""
     out = np.empty((len(times), 4))
-    vr_in = inv.vrs(POSE + VEL + ACC)
-    vr_out = inv.vrs(F)
     for i, t in enumerate(times):
-        inv.fmu.setReal(vr_in, [*p(t), *pd(t), *pdd(t)])
-        out[i] = inv.fmu.getReal(vr_out)
+        inv.set(POSE + VEL + ACC, np.concatenate(autotest_motion(t)))
+        out[i] = inv.get(F)
     return out

@@ -1,14 +1,13 @@
-"""The mechanism's numbers, copied from /work/shared/MODEL_SPEC.md (the
-authoritative definition), for the independent engine models (Pinocchio,
-MuJoCo). Nothing here is read from this project's code or outputs.
+"""The mechanism's numbers, copied once from MODEL_SPEC.md (the project's
+authoritative definition), and the geometry they define: for the checks, the
+independent reference models (Pinocchio, MuJoCo) and the examples. Nothing
+here is read from this project's code or outputs.
 
 SI units: the spec's Tables II-III are already converted there (m, kg, kg m^2).
 """
 import math
 
 import numpy as np
-
-from fmu_helpers import blend  # the spec's quintic s(tau), shared with the FMU checks
 
 # --- Geometry defaults (Table II) -----------------------------------------------
 H = 0.06634  # m, offset of the prismatic joint (d1 = rho + h)
@@ -29,8 +28,10 @@ M_PLATFORM = 0.45474  # kg
 IZZ_PLATFORM = 2874.21e-6  # kg m^2 (Ixx = Iyy = 0)
 G = 9.81  # m/s^2 along -z_G
 
-# "A check anyone can derive": each actuator's share of the weight at P0.
+# "A check anyone can derive": each actuator's share of the weight at P0, and
+# the weight of everything that moves.
 STATIC_FORCE_P0 = 2.655616050  # N
+TOTAL_WEIGHT = 10.622464200  # N
 
 # --- Auto-test (paper 5.1) ----------------------------------------------------------------
 T_MOVE = 2.0  # s
@@ -41,18 +42,8 @@ P1 = np.array([0.005, -0.005, 0.07, math.radians(4.0)])
 CMP_DURATION = 1.5  # s
 CMP_AMPLITUDE = 0.02  # N
 
-
-def autotest_motion(t):
-    """Prescribed platform pose, velocity and acceleration (x, y, z, phi) at t."""
-    s, ds, dds = blend(t / T_MOVE)
-    d = P1 - P0
-    return P0 + d * s, d * ds / T_MOVE, d * dds / T_MOVE**2
-
-
-def comparison_forces(t):
-    """F1..F4 (N) of the comparison test at time t: F1 = -F4 = 0.02 sin(2 pi t / 1.5), F2 = F3 = 0."""
-    f = CMP_AMPLITUDE * math.sin(2.0 * math.pi * t / CMP_DURATION)
-    return np.array([f, 0.0, 0.0, -f])
+# The paper's RK4 step, and the communication step of the tests and examples.
+STEP = 1e-3  # s
 
 
 def rz(a):
@@ -153,3 +144,14 @@ class Machine:
                 "friction_viscous": self.friction_viscous, "friction_coulomb": self.friction_coulomb,
                 "friction_velocity": self.friction_velocity, "payload_mass": self.payload_mass,
                 "payload_com": self.payload_com, "payload_Izz": self.payload_Izz}
+
+
+# --- The FMUs' parameter defaults (MODEL_SPEC "FMU interface contract") -------------------------
+PARAMETER_DEFAULTS = {
+    "h": H, "l": L, "h_prime": H_PRIME, "r_b": R_B, "r_Q": R_Q,
+    **{f"beta[{i + 1}]": BETA[i] for i in range(4)},
+    **{f"gamma[{i + 1}]": GAMMA[i] for i in range(4)},
+    "m_slider": M_SLIDER, "m_rod": M_ROD, **{f"I_rod[{k + 1}]": I_ROD[k] for k in range(3)},
+    "m_platform": M_PLATFORM, "Izz_platform": IZZ_PLATFORM, "g": G,
+}
+SOLVER_DEFAULTS = {"solver": 0, "rk4_step": 1e-3, "rtol": 1e-8, "atol": 1e-10}

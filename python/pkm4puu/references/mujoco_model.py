@@ -1,5 +1,5 @@
 """An independent model of the 4-PUU mechanism in MuJoCo (MJCF), built from
-MODEL_SPEC's numbers only (engines/spec.py).
+MODEL_SPEC's numbers only (pkm4puu.spec).
 
 Bodies (the same tree as engines/pinocchio_model.py):
 - leg i: body "slider{i}" at B_i + h z, oriented Rz(beta_i), with a slide
@@ -40,7 +40,7 @@ import contextlib
 import numpy as np
 import mujoco
 
-from . import spec
+from .. import motions, spec
 
 # The stiffest setting (engine_comparison.py prints a sweep around it): the
 # smallest time constant MuJoCo accepts with refsafe on (2 timesteps), critical
@@ -143,7 +143,7 @@ def set_pose(model, data, pose):
     mujoco.mj_forward(model, data)
 
 
-def run_comparison(model, data, duration=spec.CMP_DURATION, forces=spec.comparison_forces):
+def run_comparison(model, data, duration=spec.CMP_DURATION, forces=motions.comparison_forces):
     """The comparison test with mj_step at model.opt.timestep; forces (F1..F4
     as a function of t, default the spec's) held over each step at the
     step's midpoint value. Returns (t, qpos rows)."""

@@ -3,7 +3,7 @@ through the plant FMU: 1.5 s from rest at P0, gravity off, F2 = F3 = 0,
 F1(t) = 0.02 N sin(2 pi t / 1.5 s) = -F4(t), midpoint-held at a 1 ms step.
 
 This module holds the runner, the quantities the checks look at and the
-result writers; the checks are in test_fmu_comparison.py. Run as a script it
+result writers; the checks are in test_fmu_comparison.py. Run as a module it
 is part of the main job (run_autotest.sh): it runs the plant FMU with CVODE
 and with RK4, prints the table of the quantities below and writes to --out DIR:
 
@@ -19,7 +19,7 @@ The quantities (each bounded by test_fmu_comparison.py):
 - CVODE vs RK4: two different integrators must agree;
 - max |delta rho1|: the motion must be non-trivial.
 
-usage: fmu_comparison.py [--build DIR] [--out DIR]
+usage: python -m pkm4puu.comparison [--build DIR] [--out DIR]
 """
 import argparse
 import csv
@@ -31,18 +31,17 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 
-from fmu_helpers import F, L_ROD, M_PLATFORM, M_ROD, M_SLIDER, P0, POSE, Fmu, arr, run
+from .cli import Log, add_common_args, find_fmus
+from .fmu import Fmu, run
+from .interface import F, POSE, START_P0, arr
+from .motions import comparison_forces
+from .spec import CMP_AMPLITUDE, CMP_DURATION, L as L_ROD, M_PLATFORM, M_ROD, M_SLIDER, STEP
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-REPO = Path(__file__).resolve().parent.parent
-PLANT_FMU = "PKM4PUU.fmu"
-
-H = 1e-3
-DURATION = 1.5
-N = round(DURATION / H)
-AMPLITUDE = 0.02  # N
+H = STEP
+N = round(CMP_DURATION / H)
 TOL_POS = 1e-8  # m, CVODE vs RK4; also the integration accuracy trusted below
 TOL_PHI = 1e-7  # rad
 # The two bounds below are written out in test_fmu_comparison.py's assertions;
@@ -50,7 +49,7 @@ TOL_PHI = 1e-7  # rad
 TOL_CONSTRAINT = 1e-12  # m, max ||C(q)||
 MIN_DELTA_RHO1 = 1e-5  # m, below this the forces barely moved the machine
 OUT = POSE + arr("rho", 4) + arr("theta2", 4) + ["constraint_residual"]
-START = {"g": 0.0, "x0": P0[0], "y0": P0[1], "z0": P0[2], "phi0": P0[3]}
+START = {"g": 0.0, **START_P0}
 # Integrators. RK4 at 1 ms is the paper's. CVODE's rtol bounds only the local
 # error of each internal step, relative to |y| (~0.05 m, and phi swings to
 # ~0.15 rad here); the FMU restarts CVODE at every 1 ms step, so over 1500
@@ -61,13 +60,8 @@ START = {"g": 0.0, "x0": P0[0], "y0": P0[1], "z0": P0[2], "phi0": P0[3]}
 SOLVERS = {"CVODE": {"solver": 0, "rtol": 1e-10, "atol": 1e-12}, "RK4": {"solver": 1, "rk4_step": 1e-3}}
 
 
-def forces(t):
-    f = AMPLITUDE * math.sin(2.0 * math.pi * t / DURATION)
-    return [f, 0.0, 0.0, -f]
-
-
 def midpoint_held(fmu, k, t):
-    fmu.set(F, forces(t + H / 2))
+    fmu.set(F, comparison_forces(t + H / 2))
 
 
 # --- running ---------------------------------------------------------------------------
@@ -142,8 +136,8 @@ def solver_difference(a, b):
 
 def format_table(runs, errors=None):
     """The table of max errors per solver and of CVODE vs RK4, with the bounds."""
-    lines = [f"FMU comparison test (paper section 5.2): plant FMU, g = 0, F1 = -F4 = {AMPLITUDE:g} N "
-             f"sin(2 pi t / {DURATION:g} s), F2 = F3 = 0, {H * 1e3:g} ms communication step, {DURATION:g} s",
+    lines = [f"FMU comparison test (paper section 5.2): plant FMU, g = 0, F1 = -F4 = {CMP_AMPLITUDE:g} N "
+             f"sin(2 pi t / {CMP_DURATION:g} s), F2 = F3 = 0, {H * 1e3:g} ms communication step, {CMP_DURATION:g} s",
              f"{'solver':<6} {'max ||C(q)|| (m)':>17} {'vertical COM drift (m)':>23} {'max |delta rho1| (m)':>21}"]
     for name in SOLVERS:
         if name in runs:
@@ -208,23 +202,16 @@ def write_results(runs, out_dir):
 
 # --- command line ---------------------------------------------------------------------------
 def main(argv=None):
-    prog = "fmu_comparison"
-    ap = argparse.ArgumentParser(prog=prog, description="The paper's comparison test (section 5.2) through the "
-                                 "plant FMU, with CVODE and with RK4.")
-    ap.add_argument("--build", type=Path, default=REPO / "build",
-                    help=f"directory holding {PLANT_FMU} (default: %(default)s)")
-    ap.add_argument("--out", type=Path, default=REPO / "results",
-                    help="directory for the CSV and PNG files (default: %(default)s)")
+    ap = argparse.ArgumentParser(prog="python -m pkm4puu.comparison",
+                                 description="The paper's comparison test (section 5.2) through the plant FMU, "
+                                 "with CVODE and with RK4.")
+    add_common_args(ap)
     args = ap.parse_args(argv)
-
-    def log(msg):
-        print(f"{prog}: {msg}", file=sys.stderr, flush=True)
-
-    plant = args.build / PLANT_FMU
-    if not plant.is_file():
-        log(f"error: {plant} not found: build the FMUs first (./scripts/build.sh builds them into build/) "
-            "or pass --build DIR")
+    log = Log("comparison")
+    fmus = find_fmus(args.build, log, models=("PKM4PUU",))
+    if fmus is None:
         return 1
+    plant = fmus[0]
     errors = {}
     runs = run_all(plant, log=log, errors=errors)
     bad = [name for name, r in runs.items() if nonfinite_outputs(r)]

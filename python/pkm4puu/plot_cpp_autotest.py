@@ -3,7 +3,7 @@
 pkm_autotest: actuator forces (in the spirit of the paper's Fig. 5), the
 prescribed and simulated platform motion (Fig. 6) and the round-trip error.
 
-usage: plot_autotest.py RESULTS_DIR
+usage: python -m pkm4puu.plot_cpp_autotest RESULTS_DIR
 """
 import sys
 from pathlib import Path
@@ -14,7 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from autotest_plots import plot_forces, plot_pose  # noqa: E402
+from .plots import plot_forces, plot_pose  # noqa: E402
 
 
 def load(path):

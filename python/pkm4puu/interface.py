@@ -1,0 +1,30 @@
+"""Names of the FMUs' variables (MODEL_SPEC "FMU interface contract") and the
+start values the tests and examples use most."""
+from .spec import P0, STEP
+
+
+def arr(name, n):
+    """FMI array names, 1-based: arr('F', 4) -> ['F[1]', ..., 'F[4]']."""
+    return [f"{name}[{i}]" for i in range(1, n + 1)]
+
+
+POSE = ["x", "y", "z", "phi"]
+VEL = ["dx", "dy", "dz", "dphi"]
+ACC = ["ddx", "ddy", "ddz", "ddphi"]
+F = arr("F", 4)
+WRENCH = arr("Fe", 3) + ["Me_z"]
+RHO = arr("rho", 4)
+DRHO = arr("drho", 4)
+THETA1 = arr("theta1", 4)
+THETA2 = arr("theta2", 4)
+
+
+def start_pose(pose):
+    """The plant's initial-pose parameters x0, y0, z0, phi0 for `pose`."""
+    return dict(zip(("x0", "y0", "z0", "phi0"), (float(v) for v in pose)))
+
+
+START_P0 = start_pose(P0)
+# Fixed-step RK4 inside the plant at the paper's step: one RK4 step per 1 ms
+# communication step, deterministic and cheap.
+RK4 = {"solver": 1, "rk4_step": STEP}
