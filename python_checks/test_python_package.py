@@ -1,0 +1,67 @@
+"""The Python package pkm4puu (python/pkm4puu): the README's session runs as
+written, and the wrapper opens the FMUs by name, runs them with named inputs
+and outputs, and says clearly what is wrong with a bad request."""
+import re
+
+import matplotlib
+import numpy as np
+import pytest
+
+import pkm4puu as pkm
+from pkm4puu.fmu import REPO
+
+MARKER = "The auto-test in a few lines:"
+
+
+def readme_session():
+    text = (REPO / "README.md").read_text()
+    m = re.search(re.escape(MARKER) + r"\s*```python\n(.*?)```", text, re.S)
+    assert m, f"README.md has no python block after {MARKER!r}"
+    return m.group(1)
+
+
+def test_readme_session_runs_the_auto_test(plant_fmu, inverse_fmu, capsys, monkeypatch):
+    """Executed as written (plt.show on a non-interactive backend); the error
+    it prints is the FMU auto-test's bound (MODEL_SPEC: the pose follows the
+    prescribed path to 5e-8 with midpoint-held forces, test_fmu_autotest)."""
+    matplotlib.use("Agg")
+    monkeypatch.setenv("PKM_BUILD_DIR", str(plant_fmu.parent))
+    scope = {}
+    exec(compile(readme_session(), "README.md session", "exec"), scope)
+    out = capsys.readouterr().out
+    m = re.search(r"largest position error (\S+) m", out)
+    assert m, out
+    assert float(m.group(1)) < 5e-8
+    assert scope["run"].t[-1] == pytest.approx(pkm.T_MOVE)
+
+
+def test_open_by_name_and_version(plant_fmu, plant_fmu3):
+    assert pkm.find_fmu("PKM4PUU", 2, plant_fmu.parent) == plant_fmu
+    assert pkm.find_fmu("PKM4PUU", 3, plant_fmu.parent) == plant_fmu3
+    with pytest.raises(ValueError, match="unknown model 'PKM'"):
+        pkm.find_fmu("PKM")
+    with pytest.raises(ValueError, match="fmi must be 2 or 3"):
+        pkm.find_fmu("PKM4PUU", 1)
+    with pytest.raises(FileNotFoundError, match="build the FMUs first"):
+        pkm.find_fmu("PKM4PUU", 2, REPO / "no-such-build")
+
+
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_simulate_with_named_inputs_and_parameters(plant_fmu, fmi):
+    """Holding the static forces at P0 (MODEL_SPEC's check anyone can derive)
+    keeps the platform at rest: the pose stays P0 to within the integration's
+    rounding, in both FMI versions, through named start values and inputs."""
+    hold = dict(zip(pkm.F, [pkm.STATIC_FORCE_P0] * 4))
+    with pkm.Fmu.open("PKM4PUU", fmi, plant_fmu.parent, start={**pkm.START_P0, **pkm.RK4}) as plant:
+        r = plant.simulate(0.1, pkm.STEP, inputs=hold, outputs=pkm.POSE + ["dz"])
+    assert r.values.shape == (101, 5) and r.names == pkm.POSE + ["dz"]
+    assert np.abs(r.values[:, :4] - pkm.P0).max() < 1e-9
+    assert np.abs(r["dz"]).max() < 1e-8
+
+
+def test_simulate_refuses_a_stop_time_off_the_step_grid(plant_fmu):
+    with pkm.Fmu.open("PKM4PUU", build=plant_fmu.parent) as plant:
+        with pytest.raises(ValueError, match="not a whole number of steps"):
+            plant.simulate(0.0105, pkm.STEP)
+        with pytest.raises(KeyError, match="no variable named 'F5'"):
+            plant.simulate(0.001, pkm.STEP, inputs={"F5": 1.0})
