@@ -17,7 +17,9 @@
  * solver = 0 (CVODE, rtol 1e-8, atol 1e-10):
  *   (a) fmi2SetReal(4 inputs) + fmi2DoStep
  *   (b) (a) + fmi2GetReal(x, y, z, phi)
- *   (c) (b) + fmi2GetReal(every Real output)
+ *   (c) (a) + fmi2GetReal of a controller's 12 outputs (pose, rates, rho[1..4])
+ *   (d) (b) + fmi2GetReal(every Real output)
+ * and what (c) adds to (a), in percent (issue 16's target: at most 10 % with RK4).
  * A batch is 1 s of simulated time (1000 steps) from the home pose (the FMU
  * state saved after initialisation is restored before each batch, outside
  * the timed region, so every batch integrates the same second); one
@@ -126,12 +128,12 @@ static int parse_model_description(const char* text, ModelDescription* md) {
 /* ------------------------------------------------------------- the runs */
 
 typedef struct {
-  fmi2ValueReference F[4], pose[4], solver, rk4_step, rtol, atol;
+  fmi2ValueReference F[4], pose[4], control[12], solver, rk4_step, rtol, atol;
 } References;
 
 static int batches = BATCHES; /* PKM_FMU_BENCH_BATCHES */
 
-typedef enum { CASE_STEP, CASE_POSE, CASE_ALL } Case;
+typedef enum { CASE_STEP, CASE_POSE, CASE_CONTROL, CASE_ALL } Case;
 
 typedef struct {
   double median_us, min_us;
@@ -151,7 +153,13 @@ static int batch(const Fmu* f, fmi2Component c, const References* r, const Model
     u[0] = force1[k];
     CHECK(f->fmi2SetReal(c, r->F, 4, u));
     CHECK(f->fmi2DoStep(c, t, COMM_STEP, fmi2True));
-    if (kind != CASE_STEP) CHECK(f->fmi2GetReal(c, r->pose, 4, pose));
+    if (kind == CASE_CONTROL) {
+      double control[12];
+      CHECK(f->fmi2GetReal(c, r->control, 12, control));
+      memcpy(pose, control, 4 * sizeof pose[0]);
+    } else if (kind != CASE_STEP) {
+      CHECK(f->fmi2GetReal(c, r->pose, 4, pose));
+    }
     if (kind == CASE_ALL) CHECK(f->fmi2GetReal(c, md->outputs, md->n_outputs, all));
   }
   t1 = now_seconds();
@@ -162,7 +170,7 @@ static int batch(const Fmu* f, fmi2Component c, const References* r, const Model
 
 static int run(const Fmu* f, const ModelDescription* md, const References* r, int solver, Case kind,
                Result* result) {
-  static const char* names[] = {"step", "step+pose", "step+all"};
+  static const char* names[] = {"step", "step+pose", "step+control", "step+all"};
   fmi2CallbackFunctions callbacks = {logger, allocate_memory, free, NULL, NULL};
   double force1[STEPS_PER_BATCH], per_step[BATCHES], seconds = 0.0;
   fmi2FMUstate home = NULL;
@@ -229,8 +237,10 @@ static int lookup(const ModelDescription* md, const char* name, fmi2ValueReferen
 int main(int argc, char** argv) {
   static const char* force_names[] = {"F[1]", "F[2]", "F[3]", "F[4]"};
   static const char* pose_names[] = {"x", "y", "z", "phi"};
+  static const char* control_names[] = {"x", "y", "z", "phi", "dx", "dy", "dz", "dphi",
+                                        "rho[1]", "rho[2]", "rho[3]", "rho[4]"};
   static const char* case_names[] = {"(a) SetReal(F) + DoStep", "(b) (a) + GetReal(x,y,z,phi)",
-                                     "(c) (b) + GetReal(all outputs)"};
+                                     "(c) (a) + GetReal(12 controller outputs)", "(d) (b) + GetReal(all outputs)"};
   const char* so = argc > 1 ? argv[1] : PKM_FMU_PLANT_SO;
   char* xml_path = argc > 2 ? NULL : default_xml_path(so);
   const char* xml = argc > 2 ? argv[2] : xml_path;
@@ -268,6 +278,7 @@ int main(int argc, char** argv) {
   }
   if (!parse_model_description(text, &md)) return 1;
   for (i = 0; i < 4; ++i) ok &= lookup(&md, force_names[i], &r.F[i]) & lookup(&md, pose_names[i], &r.pose[i]);
+  for (i = 0; i < 12; ++i) ok &= lookup(&md, control_names[i], &r.control[i]);
   ok &= lookup(&md, "solver", &r.solver) & lookup(&md, "rk4_step", &r.rk4_step) & lookup(&md, "rtol", &r.rtol) &
         lookup(&md, "atol", &r.atol);
   if (!ok || !load_fmu(so, &f)) return 1;
@@ -285,12 +296,17 @@ int main(int argc, char** argv) {
 
   for (solver = first_solver; ok && solver >= last_solver; --solver) {
     const char* solver_name = solver == 1 ? "RK4 (rk4_step 1e-3)" : "CVODE (rtol 1e-8, atol 1e-10)";
+    double step_us = 0.0;
     for (kind = CASE_STEP; ok && kind <= CASE_ALL; ++kind) {
       Result res;
       ok = run(&f, &md, &r, solver, (Case)kind, &res);
       if (!ok) break;
       printf("%-34s %-34s %10.3f %10.3f %11.0fx %11.0fx\n", solver_name, case_names[kind], res.median_us,
              res.min_us, COMM_STEP * 1e6 / res.median_us, COMM_STEP * 1e6 / res.min_us);
+      if (kind == CASE_STEP) step_us = res.median_us;
+      if (kind == CASE_CONTROL)
+        printf("%-34s   reading the 12 controller outputs adds %.1f %% to the step (median)\n", "",
+               100.0 * (res.median_us - step_us) / step_us);
       if (kind == CASE_ALL)
         printf("%-34s   pose after 1 s: x %.6e m, y %.6e m, z %.6f m, phi %.6e rad\n", "", res.pose[0],
                res.pose[1], res.pose[2], res.pose[3]);

@@ -15,7 +15,7 @@ Status expand_state(const Model& m, const Vec8& y, Vec16& q, Vec16& qd) {
   ReducedDynamics rd;
   const PlatformConfig pc = platform_config(pose);
   for (int i = 0; i < kLegs; ++i) {
-    s = rd.prepare_leg(m, i, leg_config_from_q(q, i), pc);
+    s = rd.prepare_leg_kinematics(m, i, leg_config_from_q(q, i), pc);
     if (s != Status::Ok) return s;
     qd.segment<3>(leg_offset(i)) = rd.leg_velocity(i, y.tail<4>());
   }

@@ -482,7 +482,10 @@ const Vec4& Plant::theta1_ref() const {
 
 void Plant::update_theta1_ref() const {
   Vec16 q;
-  if (closed_form_position(model_, y_.head<4>(), q) != Status::Ok) return;
+  if (closed_form_position(model_, y_.head<4>(), q) == Status::Ok) refresh_theta1_ref(q);
+}
+
+void Plant::refresh_theta1_ref(const Vec16& q) const {
   for (int i = 0; i < kLegs; ++i) theta1_ref_[i] = unwrap_near(q[leg_offset(i) + 1], theta1_ref_[i]);
   theta1_stale_ = false;
 }
@@ -496,10 +499,23 @@ Status Plant::mechanism(const InputSignal& inputs, MechanismState& out) const {
   const Status s = state_derivative(model_, settings_.formulation, y_, generalized_forces(model_, F, tau, we),
                                     ydot, &out);
   if (s != Status::Ok) return s;
+  unwrap_theta1(out.q);
+  return Status::Ok;
+}
+
+void Plant::unwrap_theta1(Vec16& q) const {
   for (int i = 0; i < kLegs; ++i) {
-    double& th1 = out.q[leg_offset(i) + 1];
+    double& th1 = q[leg_offset(i) + 1];
     th1 = unwrap_near(th1, theta1_ref()[i]);
   }
+}
+
+Status Plant::coordinates(Vec16& q, Vec16& qd) const {
+  if (!initialized_) return Status::NotInitialized;
+  const Status s = expand_state(model_, y_, q, qd);
+  if (s != Status::Ok) return s;
+  if (theta1_stale_) refresh_theta1_ref(q);  // the closed form update_theta1_ref would evaluate again
+  unwrap_theta1(q);
   return Status::Ok;
 }
 

@@ -147,6 +147,9 @@ class Plant {
   /// q, qd, qdd and lambda at the current time, for the inputs at that time
   /// (evaluated on demand; theta1 continuous in time). Reading changes nothing.
   Status mechanism(const InputSignal& inputs, MechanismState& out) const;
+  /// q and qd at the current state (closed form, theta1 continuous): the
+  /// legs without the dynamics.
+  Status coordinates(Vec16& q, Vec16& qd) const;
   /// theta1 of each leg at the current time, unwrapped continuously since
   /// initialisation. Brought up to date when read (not in every advance:
   /// that would cost four atan2 per step); continuity holds as long as theta1
@@ -184,6 +187,10 @@ class Plant {
   /// failure error_ describes it.
   Status guard(const Vec8& y, double t);
   void update_theta1_ref() const;
+  /// The references from the closed-form q of the current state.
+  void refresh_theta1_ref(const Vec16& q) const;
+  /// theta1 of every leg in q moved by whole turns next to its reference (continuity).
+  void unwrap_theta1(Vec16& q) const;
 
   Model model_;
   SolverSettings settings_;

@@ -7,6 +7,14 @@ namespace pkm {
 
 Status ReducedDynamics::prepare_leg(const Model& m, int leg, const LegConfig& c,
                                     const PlatformConfig& pc) {
+  const Status s = prepare_leg_kinematics(m, leg, c, pc);
+  if (s != Status::Ok) return s;
+  legs_[leg].M = leg_mass_matrix(m, c);
+  return Status::Ok;
+}
+
+Status ReducedDynamics::prepare_leg_kinematics(const Model& m, int leg, const LegConfig& c,
+                                               const PlatformConfig& pc) {
   if (leg_singularity_measure(m.p, c) < kLegSingularFloor) return Status::Singular;
   Leg& L = legs_[leg];
   L.c = c;
@@ -28,7 +36,6 @@ Status ReducedDynamics::prepare_leg(const Model& m, int leg, const LegConfig& c,
   // A_i = L_i^{-1} P_i with P_i = [I3, e_z x Rz(phi) r_Qi].
   L.A.leftCols<3>() = L.Linv;
   L.A.col(3) = L.Linv.col(1) * L.attach.x() - L.Linv.col(0) * L.attach.y();
-  L.M = leg_mass_matrix(m, c);
   cphi_ = pc.cphi;
   sphi_ = pc.sphi;
   return Status::Ok;

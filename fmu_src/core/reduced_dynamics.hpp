@@ -21,6 +21,9 @@ class ReducedDynamics {
   /// Leg i's configuration-dependent terms. Status::Singular at a leg
   /// singularity.
   Status prepare_leg(const Model& m, int leg, const LegConfig& c, const PlatformConfig& pc);
+  /// Only what leg_velocity needs (L_i^{-1}, A_i), without the leg's mass
+  /// matrix: the legs' rates from the platform's.
+  Status prepare_leg_kinematics(const Model& m, int leg, const LegConfig& c, const PlatformConfig& pc);
 
   /// qd_i = A_i pd (valid after prepare_leg).
   Vec3 leg_velocity(int leg, const Pose& pd) const { return legs_[leg].A * pd; }

@@ -161,14 +161,17 @@ std::string describe_configuration_failure(const Model& m, const Pose& pose, con
   }
 }
 
-Status guard_indicators(const Model& m, const Pose& pose, const GuardLimits& lim, double z[kGuardIndicators]) {
+Status guard_indicators(const Model& m, const Pose& pose, const GuardLimits& lim, double z[kGuardIndicators],
+                        double* condition) {
   if (!pose.allFinite()) return Status::NonFinite;
   Mat4 J;
   Vec4 measure2;
   if (actuator_rows(m, pose, J, measure2) >= 0) return Status::Unreachable;
   // 1 / cond is finite everywhere (0 at a parallel singularity), so the
   // indicator never overflows; it changes sign where cond crosses the limit.
-  z[0] = 1.0 / exact_condition(J) - 1.0 / lim.max_jacobian_condition;
+  const double cond = exact_condition(J);
+  if (condition) *condition = cond;
+  z[0] = 1.0 / cond - 1.0 / lim.max_jacobian_condition;
   for (int i = 0; i < kLegs; ++i) z[1 + i] = std::sqrt(measure2[i]) - lim.min_leg_measure;
   return Status::Ok;
 }

@@ -60,7 +60,10 @@ std::string describe_configuration_failure(const Model& m, const Pose& pose, con
 /// limits, zero on a limit, negative beyond it. z[0] = 1/cond(J) -
 /// 1/max_jacobian_condition; z[1 + i] = |cos theta2 sin theta2| of leg i -
 /// min_leg_measure. Status::Unreachable (z unchanged) if a leg cannot reach.
+/// `condition`, if given, receives the condition number itself (+inf at a
+/// parallel singularity): the one SVD serves both.
 constexpr int kGuardIndicators = 5;
-Status guard_indicators(const Model& m, const Pose& pose, const GuardLimits& lim, double z[kGuardIndicators]);
+Status guard_indicators(const Model& m, const Pose& pose, const GuardLimits& lim, double z[kGuardIndicators],
+                        double* condition = nullptr);
 
 }  // namespace pkm

@@ -201,7 +201,7 @@ bool Instance::load(const std::vector<unsigned char>& bytes, const char* functio
   stop_time_ = stop_time;
   time_ = time;
   last_successful_time_ = last_time;
-  outputs_valid_ = false;
+  valid_groups_ = 0;
   data_->reset();
   Context ctx = context();
   const bool ok = data_->load(r, ctx) && r.ok() && r.at_end();

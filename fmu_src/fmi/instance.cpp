@@ -156,7 +156,7 @@ Status Instance::enter_initialization_mode() {
   if (!allowed(kMaskEnterInitialization, fn)) return Status::Error;
   mode_ = kInitializationMode;
   time_ = last_successful_time_ = start_time_;
-  outputs_valid_ = false;
+  valid_groups_ = 0;
   data_->set_time(start_time_);
   log_.event("%s: initialization mode at t = %.17g", fn, start_time_);
   return Status::OK;
@@ -167,7 +167,7 @@ Status Instance::exit_initialization_mode() {
   if (!allowed(kMaskExitInitialization, fn)) return Status::Error;
   Context ctx = context();
   const Status s = data_->exit_initialization(ctx);
-  outputs_valid_ = false;
+  valid_groups_ = 0;
   if (succeeded(s)) {
     mode_ = interface_ == Interface::CoSimulation ? kStepMode : kEventMode;
     time_ = last_successful_time_ = start_time_;
@@ -197,7 +197,7 @@ Status Instance::reset() {
   start_time_ = stop_time_ = time_ = last_successful_time_ = 0.0;
   stop_time_defined_ = false;
   terminated_ = false;
-  outputs_valid_ = false;
+  valid_groups_ = 0;
   log_.event("%s: back to the instantiated state with the start values", fn);
   return Status::OK;
 }

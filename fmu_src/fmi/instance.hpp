@@ -141,7 +141,8 @@ class Instance {
     return Context{log_, interface_, mode_ == kInitializationMode, start_time_};
   }
   void apply_start_values();
-  Status ensure_outputs(const char* function);
+  /// Brings the output groups `needed` up to date (those not already).
+  Status ensure_outputs(const char* function, unsigned needed);
   template <class T>
   Status get_values(const char* function, VarType type, const std::uint32_t vr[], std::size_t n, T value[]);
   template <class T>
@@ -167,7 +168,7 @@ class Instance {
   double time_ = 0.0;                   // current time (CS: communication point)
   double last_successful_time_ = 0.0;   // CS
   bool terminated_ = false;             // CS: set after a discarded step
-  bool outputs_valid_ = false;          // computed variables up to date
+  unsigned valid_groups_ = 0;           // output groups (Variable::group) up to date
   bool input_derivatives_set_ = false;  // SetRealInputDerivatives was used (or a state restored)
   std::unordered_set<SavedState*> states_;  // FMU states this instance created and nobody freed yet
 

@@ -33,9 +33,11 @@ class ModelData {
   /// ExitInitializationMode: build the model from the parameters and set the
   /// initial state at ctx.start_time. Error with a logged message if impossible.
   virtual Status exit_initialization(Context& ctx) = 0;
-  /// Writes every computed variable for the current time, state, parameters
-  /// and inputs. Called lazily, before a get that needs them.
-  virtual Status update_outputs(Context& ctx) = 0;
+  /// Writes the computed variables of the output groups `groups` (bits of
+  /// Variable::group) for the current time, state, parameters and inputs.
+  /// Called lazily, before a get that reads them, once per group until
+  /// anything changes. A model may write more than it is asked for.
+  virtual Status update_outputs(Context& ctx, unsigned groups) = 0;
   /// The model's state beyond the table's values.
   virtual void save(StateWriter& w) const = 0;
   /// Reads what save() wrote, after the table's values were restored; false

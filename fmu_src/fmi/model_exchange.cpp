@@ -22,7 +22,7 @@ Status Instance::event_update(bool* discrete_states_need_update, bool* terminate
   Context ctx = context();
   bool stop = false;
   const Status s = data_->event_update(ctx, stop);
-  outputs_valid_ = false;
+  valid_groups_ = 0;
   if (discrete_states_need_update) *discrete_states_need_update = false;
   if (terminate) *terminate = stop;
   if (nominals_changed) *nominals_changed = false;
@@ -58,7 +58,7 @@ Status Instance::set_time(double t) {
   }
   time_ = t;
   data_->set_time(t);
-  outputs_valid_ = false;
+  valid_groups_ = 0;
   return Status::OK;
 }
 
@@ -91,7 +91,7 @@ Status Instance::set_continuous_states(const double x[], std::size_t n) {
   }
   Context ctx = context();
   const Status s = data_->set_states(ctx, x);
-  outputs_valid_ = false;
+  valid_groups_ = 0;
   return s;
 }
 

@@ -15,8 +15,11 @@
 // continues bit-identically. After a step the inputs hold their
 // extrapolated values u + du h, the inputs at the new time.
 //
-// Outputs are computed lazily, on the first get after anything changed:
-// the accelerations, hence lambda, depend on the inputs at the current time.
+// Outputs are computed lazily by group (the state's copies, the legs, the
+// dynamics, the machine, the health measures: kGroup* below), each on the
+// first get that reads it after anything changed, so that a controller
+// reading the pose and the sliders does not pay for the multipliers. The
+// accelerations, hence lambda, depend on the inputs at the current time.
 //
 // Model Exchange: the continuous states are the pose and its velocity (the
 // outputs x..dphi) and the energy audit's two running integrals
@@ -49,6 +52,16 @@ constexpr int kInputs = 12;  // F[1..4], Fe[1..3], Me_z, tau[1..4]
 // weight at the default initial pose, the start value of F[1..4] (so that a
 // plant nothing drives stays where it is).
 constexpr double kHoldingForce = 2.655616050;
+
+// The output groups (Variable::group): a get computes only the groups it
+// reads, each once until the state, time or inputs change.
+enum : std::uint8_t {
+  kGroupState = 1u << 0,     // pose, velocity, energy integrals, der(pose): copies of the state
+  kGroupJoints = 1u << 1,    // rho, drho, theta1, theta2: the legs in closed form
+  kGroupDynamics = 1u << 2,  // accelerations and multipliers: the full forward dynamics
+  kGroupMachine = 1u << 3,   // end stops, holding forces, energies and their rates
+  kGroupHealth = 1u << 4,    // loop-closure residual, Jacobian condition, guard indicators
+};
 
 struct PlantData final : MechanismData {
   // Parameters beyond the mechanism's: initial state and solver settings.
@@ -86,7 +99,7 @@ struct PlantData final : MechanismData {
   void reset() override { plant.reset(); }
   Status exit_initialization(Context& ctx) override;
   Status do_step(Context& ctx, double t, double h, double& t_reached) override;
-  Status update_outputs(Context& ctx) override;
+  Status update_outputs(Context& ctx, unsigned groups) override;
   void save(StateWriter& w) const override;
   bool load(StateReader& r, Context& ctx) override;
 
@@ -271,58 +284,84 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
   }
 }
 
-Status PlantData::update_outputs(Context& ctx) {
+Status PlantData::update_outputs(Context& ctx, unsigned groups) {
   const Status st = ready(ctx, "get");
   if (st != Status::OK) return st;
-  pkm::MechanismState ms;
-  const pkm::Status s = plant->mechanism(inputs(plant->time()).signal(), ms);
-  if (s != pkm::Status::Ok) {
-    ctx.log.error("get: the mechanism cannot be evaluated at t = %.17g: %s", plant->time(), pkm::status_name(s));
-    return Status::Error;
+  const double t = plant->time();
+  bool finite = true;
+  auto all_finite = [&finite](const double* v, int n) {
+    for (int i = 0; i < n; ++i) finite = finite && std::isfinite(v[i]);
+  };
+  if (groups & kGroupState) {  // copies of the state
+    const pkm::Vec8& y = plant->state();
+    for (int i = 0; i < 4; ++i) {
+      pose[i] = y[i];
+      vel[i] = dy[i] = y[4 + i];
+    }
+    energy[0] = plant->energy_integrals().actuator_work;
+    energy[1] = plant->energy_integrals().dissipated;
   }
-  const pkm::Vec8& y = plant->state();
-  for (int i = 0; i < 4; ++i) {
-    pose[i] = y[i];
-    vel[i] = y[4 + i];
-    dy[i] = y[4 + i];
-    dy[4 + i] = ms.qdd[12 + i];
-    const int o = pkm::leg_offset(i);
-    rho[i] = ms.q[o];
-    drho[i] = ms.qd[o];
-    theta1[i] = ms.q[o + 1];
-    theta2[i] = ms.q[o + 2];
+  if (groups & kGroupJoints) {
+    pkm::Vec16 q, qd;
+    const pkm::Status s = plant->coordinates(q, qd);
+    if (s != pkm::Status::Ok) {
+      ctx.log.error("get: the legs cannot be assembled at t = %.17g: %s", t, pkm::status_name(s));
+      return Status::Error;
+    }
+    for (int i = 0; i < 4; ++i) {
+      const int o = pkm::leg_offset(i);
+      rho[i] = q[o];
+      drho[i] = qd[o];
+      theta1[i] = q[o + 1];
+      theta2[i] = q[o + 2];
+    }
+    for (const double* block : {rho, drho, theta1, theta2}) all_finite(block, 4);
   }
-  for (int k = 0; k < 12; ++k) lambda[k] = ms.lambda[k];
-  pkm::MachineOutputs mo;
-  const pkm::Status sm = plant->machine_outputs(inputs(plant->time()).signal(), mo);
-  if (sm != pkm::Status::Ok) {
-    ctx.log.error("get: the machine's outputs cannot be evaluated at t = %.17g: %s", plant->time(),
-                  pkm::status_name(sm));
-    return Status::Error;
+  if (groups & kGroupDynamics) {  // Eqs. 12-13 and the multipliers
+    pkm::MechanismState ms;
+    const pkm::Status s = plant->mechanism(inputs(t).signal(), ms);
+    if (s != pkm::Status::Ok) {
+      ctx.log.error("get: the mechanism cannot be evaluated at t = %.17g: %s", t, pkm::status_name(s));
+      return Status::Error;
+    }
+    for (int i = 0; i < 4; ++i) dy[4 + i] = ms.qdd[12 + i];
+    for (int k = 0; k < 12; ++k) lambda[k] = ms.lambda[k];
+    all_finite(dy + 4, 4);
+    all_finite(lambda, 12);
   }
-  for (int i = 0; i < 4; ++i) {
-    F_hold[i] = mo.F_hold[i];
-    stop_force[i] = mo.stop_force[i];
+  if (groups & kGroupMachine) {
+    pkm::MachineOutputs mo;
+    const pkm::Status s = plant->machine_outputs(inputs(t).signal(), mo);
+    if (s != pkm::Status::Ok) {
+      ctx.log.error("get: the machine's outputs cannot be evaluated at t = %.17g: %s", t, pkm::status_name(s));
+      return Status::Error;
+    }
+    for (int i = 0; i < 4; ++i) {
+      F_hold[i] = mo.F_hold[i];
+      stop_force[i] = mo.stop_force[i];
+    }
+    kinetic = mo.kinetic_energy;
+    potential = mo.potential_energy;
+    dy[8] = mo.actuator_power;
+    dy[9] = mo.dissipation_rate;
+    for (int k = 0; k < pkm::kStopIndicators; ++k) z[pkm::kGuardIndicators + k] = mo.stop_indicators[k];
+    for (const double* block : {F_hold, stop_force}) all_finite(block, 4);
+    for (double v : {kinetic, potential, dy[8], dy[9]}) finite = finite && std::isfinite(v);
   }
-  kinetic = mo.kinetic_energy;
-  potential = mo.potential_energy;
-  energy[0] = mo.actuator_work;
-  energy[1] = mo.dissipated_energy;
-  dy[8] = mo.actuator_power;
-  dy[9] = mo.dissipation_rate;
-  for (int k = 0; k < pkm::kStopIndicators; ++k) z[pkm::kGuardIndicators + k] = mo.stop_indicators[k];
-  // From the q just evaluated: one closed-form expansion serves every output.
-  residual = pkm::constraints(plant->model(), ms.q).norm();
-  condition = pkm::actuator_jacobian_condition(plant->model(), ms.q);  // +inf at a singularity, never NaN
-  bool finite = std::isfinite(residual) && !std::isnan(condition);
-  for (const double* block : {pose, vel, rho, drho, theta1, theta2, dy + 4, F_hold, stop_force})
-    for (int i = 0; i < 4; ++i) finite = finite && std::isfinite(block[i]);
-  for (double v : {kinetic, potential, energy[0], energy[1], dy[8], dy[9]}) finite = finite && std::isfinite(v);
-  for (double v : lambda) finite = finite && std::isfinite(v);
-  if (pkm::guard_indicators(plant->model(), y.head<4>(), plant->solver().limits(), z) != pkm::Status::Ok)
-    finite = false;
+  if (groups & kGroupHealth) {  // one SVD for the condition number and its guard indicator
+    pkm::Vec16 q, qd;
+    pkm::Status s = plant->coordinates(q, qd);
+    if (s == pkm::Status::Ok)
+      s = pkm::guard_indicators(plant->model(), plant->state().head<4>(), plant->solver().limits(), z, &condition);
+    if (s != pkm::Status::Ok) {
+      ctx.log.error("get: the legs cannot be assembled at t = %.17g: %s", t, pkm::status_name(s));
+      return Status::Error;
+    }
+    residual = pkm::constraints(plant->model(), q).norm();
+    finite = finite && std::isfinite(residual) && !std::isnan(condition);  // +inf at a singularity, never NaN
+  }
   if (!finite) {
-    ctx.log.error("get: non-finite outputs at t = %.17g (singular configuration?)", plant->time());
+    ctx.log.error("get: non-finite outputs at t = %.17g (singular configuration?)", t);
     return Status::Error;
   }
   return Status::OK;
@@ -490,85 +529,85 @@ constexpr Variable kVariables[] = {
   real_input(7, "Fe[3]", 0.0, "N", "External force on the platform at P, z component (base frame)", PLANT(u), 6, PLANT(du), kWrench),
   real_input(8, "Me_z", 0.0, "N.m", "External moment on the platform about z", PLANT(u), 7, PLANT(du), kWrench),
   // Outputs: 10..53; x..dphi are the continuous states (Model Exchange).
-  state_output(10, "x", "m", "Platform reference point P (centre of mass), x in the base frame", PLANT(pose), 0, 0, kOnPositions, kNominalLength),
-  state_output(11, "y", "m", "Platform reference point P (centre of mass), y in the base frame", PLANT(pose), 1, 1, kOnPositions, kNominalLength),
-  state_output(12, "z", "m", "Platform reference point P (centre of mass), z in the base frame", PLANT(pose), 2, 2, kOnHeight, kNominalLength),
-  state_output(13, "phi", "rad", "Platform rotation about z of the base frame", PLANT(pose), 3, 3, kOnPositions, kNominalAngle),
-  state_output(14, "dx", "m/s", "Velocity of P, x component", PLANT(vel), 0, 4, kOnRates, kNominalSpeed),
-  state_output(15, "dy", "m/s", "Velocity of P, y component", PLANT(vel), 1, 5, kOnRates, kNominalSpeed),
-  state_output(16, "dz", "m/s", "Velocity of P, z component", PLANT(vel), 2, 6, kOnHeightRate, kNominalSpeed),
-  state_output(17, "dphi", "rad/s", "Platform angular velocity about z", PLANT(vel), 3, 7, kOnRates, kNominalAngularSpeed),
-  state_output(18, "actuator_work", "J", "Work done on the machine since the start: integral of (F_i + (2 pi/screw_lead) tau_i) drho_i plus the external wrench's power", PLANT(energy), 0, 8, kOnEnergy, kNominalEnergy),
-  state_output(19, "dissipated_energy", "J", "Energy dissipated since the start by joint friction and the end stops' damping", PLANT(energy), 1, 9, kOnEnergy, kNominalEnergy),
-  real_output(20, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", PLANT(rho), 0, kSliders),
-  real_output(21, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", PLANT(rho), 1, kSliders),
-  real_output(22, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", PLANT(rho), 2, kSliders),
-  real_output(23, "rho[4]", "m", "Actuated prismatic joint of leg 4 (slider position)", PLANT(rho), 3, kSliders),
-  real_output(24, "drho[1]", "m/s", "Slider velocity of leg 1", PLANT(drho), 0, kOnPositions | kOnRates | kOnHeightRate),
-  real_output(25, "drho[2]", "m/s", "Slider velocity of leg 2", PLANT(drho), 1, kOnPositions | kOnRates | kOnHeightRate),
-  real_output(26, "drho[3]", "m/s", "Slider velocity of leg 3", PLANT(drho), 2, kOnPositions | kOnRates | kOnHeightRate),
-  real_output(27, "drho[4]", "m/s", "Slider velocity of leg 4", PLANT(drho), 3, kOnPositions | kOnRates | kOnHeightRate),
-  real_output(28, "theta1[1]", "rad", "First revolute joint of leg 1 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 0, kOnPositions),
-  real_output(29, "theta1[2]", "rad", "First revolute joint of leg 2 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 1, kOnPositions),
-  real_output(30, "theta1[3]", "rad", "First revolute joint of leg 3 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 2, kOnPositions),
-  real_output(31, "theta1[4]", "rad", "First revolute joint of leg 4 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 3, kOnPositions),
-  real_output(32, "theta2[1]", "rad", "Second revolute joint of leg 1 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 0, kOnPositions),
-  real_output(33, "theta2[2]", "rad", "Second revolute joint of leg 2 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 1, kOnPositions),
-  real_output(34, "theta2[3]", "rad", "Second revolute joint of leg 3 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 2, kOnPositions),
-  real_output(35, "theta2[4]", "rad", "Second revolute joint of leg 4 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 3, kOnPositions),
-  real_output(36, "stop_force[1]", "N", "End-stop force on the slider of leg 1, along +z (0 within its travel)", PLANT(stop_force), 0, kEverything & ~kOnInputs),
-  real_output(37, "stop_force[2]", "N", "End-stop force on the slider of leg 2, along +z", PLANT(stop_force), 1, kEverything & ~kOnInputs),
-  real_output(38, "stop_force[3]", "N", "End-stop force on the slider of leg 3, along +z", PLANT(stop_force), 2, kEverything & ~kOnInputs),
-  real_output(39, "stop_force[4]", "N", "End-stop force on the slider of leg 4, along +z", PLANT(stop_force), 3, kEverything & ~kOnInputs),
-  real_output(40, "lambda[1]", "N", "Lagrange multiplier of leg 1's loop closure, x row (Eq. 1)", PLANT(lambda), 0, kEverything),
-  real_output(41, "lambda[2]", "N", "Lagrange multiplier of leg 1's loop closure, y row (Eq. 1)", PLANT(lambda), 1, kEverything),
-  real_output(42, "lambda[3]", "N", "Lagrange multiplier of leg 1's loop closure, z row (Eq. 1)", PLANT(lambda), 2, kEverything),
-  real_output(43, "lambda[4]", "N", "Lagrange multiplier of leg 2's loop closure, x row (Eq. 1)", PLANT(lambda), 3, kEverything),
-  real_output(44, "lambda[5]", "N", "Lagrange multiplier of leg 2's loop closure, y row (Eq. 1)", PLANT(lambda), 4, kEverything),
-  real_output(45, "lambda[6]", "N", "Lagrange multiplier of leg 2's loop closure, z row (Eq. 1)", PLANT(lambda), 5, kEverything),
-  real_output(46, "lambda[7]", "N", "Lagrange multiplier of leg 3's loop closure, x row (Eq. 1)", PLANT(lambda), 6, kEverything),
-  real_output(47, "lambda[8]", "N", "Lagrange multiplier of leg 3's loop closure, y row (Eq. 1)", PLANT(lambda), 7, kEverything),
-  real_output(48, "lambda[9]", "N", "Lagrange multiplier of leg 3's loop closure, z row (Eq. 1)", PLANT(lambda), 8, kEverything),
-  real_output(49, "lambda[10]", "N", "Lagrange multiplier of leg 4's loop closure, x row (Eq. 1)", PLANT(lambda), 9, kEverything),
-  real_output(50, "lambda[11]", "N", "Lagrange multiplier of leg 4's loop closure, y row (Eq. 1)", PLANT(lambda), 10, kEverything),
-  real_output(51, "lambda[12]", "N", "Lagrange multiplier of leg 4's loop closure, z row (Eq. 1)", PLANT(lambda), 11, kEverything),
-  real_output(52, "constraint_residual", "m", "Norm of the loop closures ||C(q)|| (Eq. 15) at the current state", PLANT_SCALAR(residual), 0, kOnPositions),
-  real_output(53, "jacobian_condition", "", "Condition number of the 4x4 actuator Jacobian d(rho)/d(x, y, z, phi), its phi column divided by 0.1 m", PLANT_SCALAR(condition), 0, kOnPositions),
-  real_output(54, "F_hold[1]", "N", "Actuator force of leg 1 that would hold the current pose at rest under gravity, the payload and the current external wrench", PLANT(F_hold), 0, kOnPositions | kOnWrench),
-  real_output(55, "F_hold[2]", "N", "The same for leg 2", PLANT(F_hold), 1, kOnPositions | kOnWrench),
-  real_output(56, "F_hold[3]", "N", "The same for leg 3", PLANT(F_hold), 2, kOnPositions | kOnWrench),
-  real_output(57, "F_hold[4]", "N", "The same for leg 4", PLANT(F_hold), 3, kOnPositions | kOnWrench),
-  real_output(58, "kinetic_energy", "J", "Kinetic energy of the mechanism, the payload and the rotors", PLANT_SCALAR(kinetic), 0, kSliderRates),
-  real_output(59, "potential_energy", "J", "Potential energy: gravity plus the end stops' springs", PLANT_SCALAR(potential), 0, kSliders),
+  state_output(10, "x", "m", "Platform reference point P (centre of mass), x in the base frame", PLANT(pose), 0, 0, kOnPositions, kNominalLength, kGroupState),
+  state_output(11, "y", "m", "Platform reference point P (centre of mass), y in the base frame", PLANT(pose), 1, 1, kOnPositions, kNominalLength, kGroupState),
+  state_output(12, "z", "m", "Platform reference point P (centre of mass), z in the base frame", PLANT(pose), 2, 2, kOnHeight, kNominalLength, kGroupState),
+  state_output(13, "phi", "rad", "Platform rotation about z of the base frame", PLANT(pose), 3, 3, kOnPositions, kNominalAngle, kGroupState),
+  state_output(14, "dx", "m/s", "Velocity of P, x component", PLANT(vel), 0, 4, kOnRates, kNominalSpeed, kGroupState),
+  state_output(15, "dy", "m/s", "Velocity of P, y component", PLANT(vel), 1, 5, kOnRates, kNominalSpeed, kGroupState),
+  state_output(16, "dz", "m/s", "Velocity of P, z component", PLANT(vel), 2, 6, kOnHeightRate, kNominalSpeed, kGroupState),
+  state_output(17, "dphi", "rad/s", "Platform angular velocity about z", PLANT(vel), 3, 7, kOnRates, kNominalAngularSpeed, kGroupState),
+  state_output(18, "actuator_work", "J", "Work done on the machine since the start: integral of (F_i + (2 pi/screw_lead) tau_i) drho_i plus the external wrench's power", PLANT(energy), 0, 8, kOnEnergy, kNominalEnergy, kGroupState),
+  state_output(19, "dissipated_energy", "J", "Energy dissipated since the start by joint friction and the end stops' damping", PLANT(energy), 1, 9, kOnEnergy, kNominalEnergy, kGroupState),
+  real_output(20, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", PLANT(rho), 0, kSliders, kGroupJoints),
+  real_output(21, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", PLANT(rho), 1, kSliders, kGroupJoints),
+  real_output(22, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", PLANT(rho), 2, kSliders, kGroupJoints),
+  real_output(23, "rho[4]", "m", "Actuated prismatic joint of leg 4 (slider position)", PLANT(rho), 3, kSliders, kGroupJoints),
+  real_output(24, "drho[1]", "m/s", "Slider velocity of leg 1", PLANT(drho), 0, kOnPositions | kOnRates | kOnHeightRate, kGroupJoints),
+  real_output(25, "drho[2]", "m/s", "Slider velocity of leg 2", PLANT(drho), 1, kOnPositions | kOnRates | kOnHeightRate, kGroupJoints),
+  real_output(26, "drho[3]", "m/s", "Slider velocity of leg 3", PLANT(drho), 2, kOnPositions | kOnRates | kOnHeightRate, kGroupJoints),
+  real_output(27, "drho[4]", "m/s", "Slider velocity of leg 4", PLANT(drho), 3, kOnPositions | kOnRates | kOnHeightRate, kGroupJoints),
+  real_output(28, "theta1[1]", "rad", "First revolute joint of leg 1 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 0, kOnPositions, kGroupJoints),
+  real_output(29, "theta1[2]", "rad", "First revolute joint of leg 2 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 1, kOnPositions, kGroupJoints),
+  real_output(30, "theta1[3]", "rad", "First revolute joint of leg 3 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 2, kOnPositions, kGroupJoints),
+  real_output(31, "theta1[4]", "rad", "First revolute joint of leg 4 (axis parallel to the prismatic axis), continuous", PLANT(theta1), 3, kOnPositions, kGroupJoints),
+  real_output(32, "theta2[1]", "rad", "Second revolute joint of leg 1 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 0, kOnPositions, kGroupJoints),
+  real_output(33, "theta2[2]", "rad", "Second revolute joint of leg 2 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 1, kOnPositions, kGroupJoints),
+  real_output(34, "theta2[3]", "rad", "Second revolute joint of leg 3 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 2, kOnPositions, kGroupJoints),
+  real_output(35, "theta2[4]", "rad", "Second revolute joint of leg 4 (horizontal axis), elbow-down: -pi/2 < theta2 < 0", PLANT(theta2), 3, kOnPositions, kGroupJoints),
+  real_output(36, "stop_force[1]", "N", "End-stop force on the slider of leg 1, along +z (0 within its travel)", PLANT(stop_force), 0, kEverything & ~kOnInputs, kGroupMachine),
+  real_output(37, "stop_force[2]", "N", "End-stop force on the slider of leg 2, along +z", PLANT(stop_force), 1, kEverything & ~kOnInputs, kGroupMachine),
+  real_output(38, "stop_force[3]", "N", "End-stop force on the slider of leg 3, along +z", PLANT(stop_force), 2, kEverything & ~kOnInputs, kGroupMachine),
+  real_output(39, "stop_force[4]", "N", "End-stop force on the slider of leg 4, along +z", PLANT(stop_force), 3, kEverything & ~kOnInputs, kGroupMachine),
+  real_output(40, "lambda[1]", "N", "Lagrange multiplier of leg 1's loop closure, x row (Eq. 1)", PLANT(lambda), 0, kEverything, kGroupDynamics),
+  real_output(41, "lambda[2]", "N", "Lagrange multiplier of leg 1's loop closure, y row (Eq. 1)", PLANT(lambda), 1, kEverything, kGroupDynamics),
+  real_output(42, "lambda[3]", "N", "Lagrange multiplier of leg 1's loop closure, z row (Eq. 1)", PLANT(lambda), 2, kEverything, kGroupDynamics),
+  real_output(43, "lambda[4]", "N", "Lagrange multiplier of leg 2's loop closure, x row (Eq. 1)", PLANT(lambda), 3, kEverything, kGroupDynamics),
+  real_output(44, "lambda[5]", "N", "Lagrange multiplier of leg 2's loop closure, y row (Eq. 1)", PLANT(lambda), 4, kEverything, kGroupDynamics),
+  real_output(45, "lambda[6]", "N", "Lagrange multiplier of leg 2's loop closure, z row (Eq. 1)", PLANT(lambda), 5, kEverything, kGroupDynamics),
+  real_output(46, "lambda[7]", "N", "Lagrange multiplier of leg 3's loop closure, x row (Eq. 1)", PLANT(lambda), 6, kEverything, kGroupDynamics),
+  real_output(47, "lambda[8]", "N", "Lagrange multiplier of leg 3's loop closure, y row (Eq. 1)", PLANT(lambda), 7, kEverything, kGroupDynamics),
+  real_output(48, "lambda[9]", "N", "Lagrange multiplier of leg 3's loop closure, z row (Eq. 1)", PLANT(lambda), 8, kEverything, kGroupDynamics),
+  real_output(49, "lambda[10]", "N", "Lagrange multiplier of leg 4's loop closure, x row (Eq. 1)", PLANT(lambda), 9, kEverything, kGroupDynamics),
+  real_output(50, "lambda[11]", "N", "Lagrange multiplier of leg 4's loop closure, y row (Eq. 1)", PLANT(lambda), 10, kEverything, kGroupDynamics),
+  real_output(51, "lambda[12]", "N", "Lagrange multiplier of leg 4's loop closure, z row (Eq. 1)", PLANT(lambda), 11, kEverything, kGroupDynamics),
+  real_output(52, "constraint_residual", "m", "Norm of the loop closures ||C(q)|| (Eq. 15) at the current state", PLANT_SCALAR(residual), 0, kOnPositions, kGroupHealth),
+  real_output(53, "jacobian_condition", "", "Condition number of the 4x4 actuator Jacobian d(rho)/d(x, y, z, phi), its phi column divided by 0.1 m", PLANT_SCALAR(condition), 0, kOnPositions, kGroupHealth),
+  real_output(54, "F_hold[1]", "N", "Actuator force of leg 1 that would hold the current pose at rest under gravity, the payload and the current external wrench", PLANT(F_hold), 0, kOnPositions | kOnWrench, kGroupMachine),
+  real_output(55, "F_hold[2]", "N", "The same for leg 2", PLANT(F_hold), 1, kOnPositions | kOnWrench, kGroupMachine),
+  real_output(56, "F_hold[3]", "N", "The same for leg 3", PLANT(F_hold), 2, kOnPositions | kOnWrench, kGroupMachine),
+  real_output(57, "F_hold[4]", "N", "The same for leg 4", PLANT(F_hold), 3, kOnPositions | kOnWrench, kGroupMachine),
+  real_output(58, "kinetic_energy", "J", "Kinetic energy of the mechanism, the payload and the rotors", PLANT_SCALAR(kinetic), 0, kSliderRates, kGroupMachine),
+  real_output(59, "potential_energy", "J", "Potential energy: gravity plus the end stops' springs", PLANT_SCALAR(potential), 0, kSliders, kGroupMachine),
   // Derivatives of the continuous states: 60..67.
-  state_derivative(60, "der(x)", "m/s", "Derivative of x", PLANT(dy), 0, 0, kOnRates),
-  state_derivative(61, "der(y)", "m/s", "Derivative of y", PLANT(dy), 1, 1, kOnRates),
-  state_derivative(62, "der(z)", "m/s", "Derivative of z", PLANT(dy), 2, 2, kOnRates),
-  state_derivative(63, "der(phi)", "rad/s", "Derivative of phi", PLANT(dy), 3, 3, kOnRates),
-  state_derivative(64, "der(dx)", "m/s2", "Acceleration of P, x component (Eq. 13)", PLANT(dy), 4, 4, kEverything),
-  state_derivative(65, "der(dy)", "m/s2", "Acceleration of P, y component (Eq. 13)", PLANT(dy), 5, 5, kEverything),
-  state_derivative(66, "der(dz)", "m/s2", "Acceleration of P, z component (Eq. 13)", PLANT(dy), 6, 6, kEverything),
-  state_derivative(67, "der(dphi)", "rad/s2", "Angular acceleration of the platform about z (Eq. 13)", PLANT(dy), 7, 7, kEverything),
-  state_derivative(68, "der(actuator_work)", "W", "Power of the actuators, drives and external wrench", PLANT(dy), 8, 8, kSliderRates | kOnInputs),
-  state_derivative(69, "der(dissipated_energy)", "W", "Power dissipated by friction and the end stops' damping", PLANT(dy), 9, 9, kEverything & ~kOnInputs),
+  state_derivative(60, "der(x)", "m/s", "Derivative of x", PLANT(dy), 0, 0, kOnRates, kGroupState),
+  state_derivative(61, "der(y)", "m/s", "Derivative of y", PLANT(dy), 1, 1, kOnRates, kGroupState),
+  state_derivative(62, "der(z)", "m/s", "Derivative of z", PLANT(dy), 2, 2, kOnRates, kGroupState),
+  state_derivative(63, "der(phi)", "rad/s", "Derivative of phi", PLANT(dy), 3, 3, kOnRates, kGroupState),
+  state_derivative(64, "der(dx)", "m/s2", "Acceleration of P, x component (Eq. 13)", PLANT(dy), 4, 4, kEverything, kGroupDynamics),
+  state_derivative(65, "der(dy)", "m/s2", "Acceleration of P, y component (Eq. 13)", PLANT(dy), 5, 5, kEverything, kGroupDynamics),
+  state_derivative(66, "der(dz)", "m/s2", "Acceleration of P, z component (Eq. 13)", PLANT(dy), 6, 6, kEverything, kGroupDynamics),
+  state_derivative(67, "der(dphi)", "rad/s2", "Angular acceleration of the platform about z (Eq. 13)", PLANT(dy), 7, 7, kEverything, kGroupDynamics),
+  state_derivative(68, "der(actuator_work)", "W", "Power of the actuators, drives and external wrench", PLANT(dy), 8, 8, kSliderRates | kOnInputs, kGroupMachine),
+  state_derivative(69, "der(dissipated_energy)", "W", "Power dissipated by friction and the end stops' damping", PLANT(dy), 9, 9, kEverything & ~kOnInputs, kGroupMachine),
   // Event indicators (Model Exchange): 70..74.
   event_indicator(70, "guard_condition_margin", "",
                   "1/jacobian_condition - 1/max_jacobian_condition: event indicator of the parallel-singularity guard "
-                  "(positive within it)", PLANT(z), 0, 0, kOnPositions),
+                  "(positive within it)", PLANT(z), 0, 0, kOnPositions, kGroupHealth),
   event_indicator(71, "guard_leg_margin[1]", "",
                   "|cos(theta2) sin(theta2)| of leg 1 - min_leg_measure: event indicator of the leg-singularity guard "
-                  "(positive within it)", PLANT(z), 1, 1, kOnPositions),
-  event_indicator(72, "guard_leg_margin[2]", "", "The same for leg 2", PLANT(z), 2, 2, kOnPositions),
-  event_indicator(73, "guard_leg_margin[3]", "", "The same for leg 3", PLANT(z), 3, 3, kOnPositions),
-  event_indicator(74, "guard_leg_margin[4]", "", "The same for leg 4", PLANT(z), 4, 4, kOnPositions),
-  event_indicator(75, "stop_margin_lower[1]", "m", "rho[1] - rho_min: event indicator of leg 1's lower end stop (negative in contact)", PLANT(z), 5, 5, kSliders),
-  event_indicator(76, "stop_margin_lower[2]", "m", "rho[2] - rho_min", PLANT(z), 6, 6, kSliders),
-  event_indicator(77, "stop_margin_lower[3]", "m", "rho[3] - rho_min", PLANT(z), 7, 7, kSliders),
-  event_indicator(78, "stop_margin_lower[4]", "m", "rho[4] - rho_min", PLANT(z), 8, 8, kSliders),
-  event_indicator(79, "stop_margin_upper[1]", "m", "rho_max - rho[1]: event indicator of leg 1's upper end stop (negative in contact)", PLANT(z), 9, 9, kSliders),
-  event_indicator(80, "stop_margin_upper[2]", "m", "rho_max - rho[2]", PLANT(z), 10, 10, kSliders),
-  event_indicator(81, "stop_margin_upper[3]", "m", "rho_max - rho[3]", PLANT(z), 11, 11, kSliders),
-  event_indicator(82, "stop_margin_upper[4]", "m", "rho_max - rho[4]", PLANT(z), 12, 12, kSliders),
+                  "(positive within it)", PLANT(z), 1, 1, kOnPositions, kGroupHealth),
+  event_indicator(72, "guard_leg_margin[2]", "", "The same for leg 2", PLANT(z), 2, 2, kOnPositions, kGroupHealth),
+  event_indicator(73, "guard_leg_margin[3]", "", "The same for leg 3", PLANT(z), 3, 3, kOnPositions, kGroupHealth),
+  event_indicator(74, "guard_leg_margin[4]", "", "The same for leg 4", PLANT(z), 4, 4, kOnPositions, kGroupHealth),
+  event_indicator(75, "stop_margin_lower[1]", "m", "rho[1] - rho_min: event indicator of leg 1's lower end stop (negative in contact)", PLANT(z), 5, 5, kSliders, kGroupMachine),
+  event_indicator(76, "stop_margin_lower[2]", "m", "rho[2] - rho_min", PLANT(z), 6, 6, kSliders, kGroupMachine),
+  event_indicator(77, "stop_margin_lower[3]", "m", "rho[3] - rho_min", PLANT(z), 7, 7, kSliders, kGroupMachine),
+  event_indicator(78, "stop_margin_lower[4]", "m", "rho[4] - rho_min", PLANT(z), 8, 8, kSliders, kGroupMachine),
+  event_indicator(79, "stop_margin_upper[1]", "m", "rho_max - rho[1]: event indicator of leg 1's upper end stop (negative in contact)", PLANT(z), 9, 9, kSliders, kGroupMachine),
+  event_indicator(80, "stop_margin_upper[2]", "m", "rho_max - rho[2]", PLANT(z), 10, 10, kSliders, kGroupMachine),
+  event_indicator(81, "stop_margin_upper[3]", "m", "rho_max - rho[3]", PLANT(z), 11, 11, kSliders, kGroupMachine),
+  event_indicator(82, "stop_margin_upper[4]", "m", "rho_max - rho[4]", PLANT(z), 12, 12, kSliders, kGroupMachine),
   // Motor torques: 90..93.
   real_input(90, "tau[1]", 0.0, "N.m", "Motor torque of leg 1's drive: adds (2 pi/screw_lead) tau to F[1]", PLANT(u), 8, PLANT(du)),
   real_input(91, "tau[2]", 0.0, "N.m", "Motor torque of leg 2's drive", PLANT(u), 9, PLANT(du)),

@@ -45,7 +45,7 @@ struct InverseData final : MechanismData {
     t_reached = t + h;  // no dynamics: the outputs follow the inputs
     return Status::OK;
   }
-  Status update_outputs(Context& ctx) override;
+  Status update_outputs(Context& ctx, unsigned groups) override;
   void save(StateWriter& w) const override;
   bool load(StateReader& r, Context& ctx) override;
 
@@ -69,7 +69,7 @@ Status InverseData::exit_initialization(Context& ctx) {
   return Status::OK;
 }
 
-Status InverseData::update_outputs(Context& ctx) {
+Status InverseData::update_outputs(Context& ctx, unsigned) {  // one group: everything
   pkm::Model temporary;
   const pkm::Model* m = model.get();
   if (ctx.initialization_mode) {

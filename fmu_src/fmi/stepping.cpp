@@ -106,7 +106,7 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
   Context ctx = context();
   double reached = time_;
   const Status s = data_->do_step(ctx, t, h, reached);
-  outputs_valid_ = false;
+  valid_groups_ = 0;
   switch (s) {
     case Status::OK:
     case Status::Warning:

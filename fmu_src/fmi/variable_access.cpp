@@ -17,12 +17,13 @@ const Variable* Instance::lookup(const char* function, VarType type, std::uint32
   return v;
 }
 
-Status Instance::ensure_outputs(const char* function) {
-  if (outputs_valid_) return Status::OK;
+Status Instance::ensure_outputs(const char* function, unsigned needed) {
+  const unsigned missing = needed & ~valid_groups_;
+  if (!missing) return Status::OK;
   Context ctx = context();
-  const Status s = data_->update_outputs(ctx);
+  const Status s = data_->update_outputs(ctx, missing);
   if (succeeded(s)) {
-    outputs_valid_ = true;
+    valid_groups_ |= missing;
   } else {
     log_.call("%s: outputs not available", function);
   }
@@ -38,15 +39,15 @@ Status Instance::get_values(const char* function, VarType type, const std::uint3
     log_.error("%s: NULL value reference or value array", function);
     return Status::Error;
   }
-  bool computed = false;
+  unsigned needed = 0;  // the output groups this call reads
   for (std::size_t k = 0; k < n; ++k) {
     const Variable* v = lookup(function, type, vr[k]);
     if (!v) return Status::Error;
-    computed = computed || v->computed();
+    if (v->computed()) needed |= v->group;
   }
   Status s = Status::OK;
-  if (computed) {
-    s = ensure_outputs(function);
+  if (needed) {
+    s = ensure_outputs(function, needed);
     if (!succeeded(s)) return s;
   }
   for (std::size_t k = 0; k < n; ++k) {
@@ -103,7 +104,7 @@ Status Instance::set_values(const char* function, VarType type, const std::uint3
     if (v->derivative) *static_cast<double*>(v->derivative(*data_, v->index)) = 0.0;
     if (log_.enabled(LogCategory::Calls)) log_.call("%s: %s = %.17g", function, v->name, static_cast<double>(value[k]));
   }
-  outputs_valid_ = false;
+  valid_groups_ = 0;
   return Status::OK;
 }
 

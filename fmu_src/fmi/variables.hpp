@@ -51,6 +51,9 @@ enum Depends : std::uint8_t {
   kOnEnergy = 1u << 7,     // running-integral states (energy audit): nothing else depends on them
 };
 
+/// Computed variables without a group of their own: every group computes them.
+constexpr std::uint8_t kAllGroups = 0xFF;
+
 /// One row of a model's variable table: everything modelDescription.xml
 /// says about a variable, plus how to reach its value.
 struct Variable {
@@ -74,6 +77,9 @@ struct Variable {
   int indicator = -1;  // rows that are event indicators (Model Exchange): their index; -1 otherwise
   std::uint8_t kind = kDependsNothing;  // inputs and states: which Depends bit names them
   double nominal = 1.0;  // continuous states: their scale (nominal attribute, GetNominalsOfContinuousStates)
+  // Computed variables: the output group (a bit) that computes them, so that
+  // a get pays only for what it reads (ModelData::update_outputs).
+  std::uint8_t group = kAllGroups;
 
   constexpr bool has_start() const {
     return causality == Causality::Input || initial == Initial::Exact || initial == Initial::Approx;
@@ -103,28 +109,31 @@ constexpr Variable real_input(std::uint32_t vr, const char* name, double start, 
 }
 /// A continuous Real output computed by the model (initial calculated, no start).
 constexpr Variable real_output(std::uint32_t vr, const char* name, const char* unit, const char* description,
-                               Ref value, int index, std::uint8_t depends) {
+                               Ref value, int index, std::uint8_t depends, std::uint8_t group = kAllGroups) {
   return {vr,    name,  VarType::Real, Causality::Output, Variability::Continuous, Initial::Calculated, 0.0, unit,
-          description, value, index, nullptr, kNoMin, kNoMax, depends, -1, -1};
+          description, value, index, nullptr, kNoMin, kNoMax, depends, -1, -1, -1, kDependsNothing, 1.0, group};
 }
 /// A Real output that is continuous state number `state` (pose, velocity)
 /// of the given kind (kOnPositions, kOnHeight or kOnRates).
 constexpr Variable state_output(std::uint32_t vr, const char* name, const char* unit, const char* description,
-                                Ref value, int index, int state, std::uint8_t kind, double nominal) {
+                                Ref value, int index, int state, std::uint8_t kind, double nominal,
+                                std::uint8_t group = kAllGroups) {
   return {vr,    name,  VarType::Real, Causality::Output, Variability::Continuous, Initial::Calculated, 0.0, unit,
-          description, value, index, nullptr, kNoMin, kNoMax, kOnOwnState, -1, state, -1, kind, nominal};
+          description, value, index, nullptr, kNoMin, kNoMax, kOnOwnState, -1, state, -1, kind, nominal, group};
 }
 /// der(x) of continuous state number `state_of` (a local variable).
 constexpr Variable state_derivative(std::uint32_t vr, const char* name, const char* unit, const char* description,
-                                    Ref value, int index, int state_of, std::uint8_t depends) {
+                                    Ref value, int index, int state_of, std::uint8_t depends,
+                                    std::uint8_t group = kAllGroups) {
   return {vr,    name,  VarType::Real, Causality::Local, Variability::Continuous, Initial::Calculated, 0.0, unit,
-          description, value, index, nullptr, kNoMin, kNoMax, depends, state_of, -1};
+          description, value, index, nullptr, kNoMin, kNoMax, depends, state_of, -1, -1, kDependsNothing, 1.0, group};
 }
 /// Event indicator number `k` (a local variable, Model Exchange).
 constexpr Variable event_indicator(std::uint32_t vr, const char* name, const char* unit, const char* description,
-                                   Ref value, int index, int k, std::uint8_t depends) {
+                                   Ref value, int index, int k, std::uint8_t depends,
+                                   std::uint8_t group = kAllGroups) {
   return {vr,    name,  VarType::Real, Causality::Local, Variability::Continuous, Initial::Calculated, 0.0, unit,
-          description, value, index, nullptr, kNoMin, kNoMax, depends, -1, -1, k};
+          description, value, index, nullptr, kNoMin, kNoMax, depends, -1, -1, k, kDependsNothing, 1.0, group};
 }
 /// A fixed Real parameter (initial exact): settable before initialisation ends; [min, max] checked.
 constexpr Variable real_parameter(std::uint32_t vr, const char* name, double start, const char* unit,
