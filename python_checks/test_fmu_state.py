@@ -47,7 +47,12 @@ def _assert_identical(a, b, what):
 @pytest.mark.parametrize("solver", list(SOLVERS))
 @pytest.mark.parametrize("archive", ["plant_fmu", "plant_fmu3"])
 def test_state_restore_is_exact(archive, solver, request):
-    plant_fmu = request.getfixturevalue(archive)
+    check_state_restore(request.getfixturevalue(archive), solver)
+
+
+def check_state_restore(plant_fmu, solver):
+    """The check above on one archive (also run on the Windows binary through
+    fmpy's remoting, test_fmu_platforms.py)."""
     k_save, k_end = round(T_SAVE / H), round(T_END / H)
     with Fmu(plant_fmu, start=SOLVERS[solver]) as fmu:
         advance(fmu, 0, k_save)
@@ -74,4 +79,4 @@ def test_state_restore_is_exact(archive, solver, request):
             fresh.free_state(restored)
         _assert_identical(fresh.get(OUT)[None], at_save[None], f"{solver}: outputs after deSerializeFMUstate")
         _assert_identical(advance(fresh, k_save, k_end), first, f"{solver}: replay in a fresh instance")
-    print(f"\n{archive}, {solver}: state at t = {T_SAVE} s, {len(blob)} bytes serialized, replay bit-identical")
+    print(f"\n{plant_fmu.name}, {solver}: state at t = {T_SAVE} s, {len(blob)} bytes serialized, replay bit-identical")
