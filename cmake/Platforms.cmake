@@ -16,7 +16,7 @@ option(PKM_PLATFORMS "Cross-build the FMUs for Windows x64 and Linux aarch64, te
 if(NOT PKM_PLATFORMS OR CMAKE_CROSSCOMPILING)
   return()
 endif()
-if(NOT CMAKE_SYSTEM_NAME STREQUAL "Linux" OR NOT PKM_FMU3_PLATFORM STREQUAL "x86_64-linux")
+if(NOT CMAKE_SYSTEM_NAME STREQUAL "Linux" OR NOT CMAKE_SYSTEM_PROCESSOR MATCHES "^(x86_64|AMD64|amd64)$")
   message(FATAL_ERROR "PKM_PLATFORMS cross-builds from Linux x86-64 only; configure with -DPKM_PLATFORMS=OFF")
 endif()
 foreach(_tool x86_64-w64-mingw32-g++-posix wine aarch64-linux-gnu-g++ qemu-aarch64 x86_64-w64-mingw32-objdump)
@@ -28,6 +28,7 @@ endforeach()
 include(ExternalProject)
 
 set(PKM_PLATFORMS_DIR "${CMAKE_BINARY_DIR}/platforms")
+set(_pkm_previous)
 set(_pkm_wine_env WINEDEBUG=-all WINEDLLOVERRIDES=mscoree,mshtml=)
 
 # wine's prefix (in $HOME) once, before anything runs under wine: two first
@@ -64,8 +65,8 @@ foreach(_t IN ITEMS win64 aarch64)
     BUILD_ALWAYS ON
     BUILD_BYPRODUCTS ${_products}
     INSTALL_COMMAND ""
-    DEPENDS pkm_sundials_${_t}
-    JOB_POOL_BUILD pkm_platforms)
+    DEPENDS pkm_sundials_${_t} ${_pkm_previous})
+  set(_pkm_previous pkm_platform_${_t})  # one sub-build at a time: each runs -j2
   set(PKM_${_t}_BINARIES ${_products})
   if(PKM_BUILD_TESTS)
     # The sub-build's FMI tests under the emulator; the auto-test compares
@@ -75,7 +76,6 @@ foreach(_t IN ITEMS win64 aarch64)
     set_tests_properties(platform_${_t}_fmi_tests PROPERTIES FIXTURES_REQUIRED linux64_traces TIMEOUT 900)
   endif()
 endforeach()
-set_property(GLOBAL APPEND PROPERTY JOB_POOLS pkm_platforms=1)
 add_dependencies(pkm_platform_win64 pkm_wine_prefix)
 
 if(PKM_BUILD_TESTS)

@@ -5,8 +5,9 @@
 - the Windows x64 binary, run under wine through fmpy's remoting (a linux64
   client that talks over TCP to a win64 server process under wine), passes
   the auto-test through both FMUs and agrees with the linux64 binary to
-  1e-12 relative, and its FMU states replay bit for bit
-  (test_fmu_state.check_state_restore);
+  1e-12 relative (RK4; CVODE to its rtol). Its FMU states are tested under
+  wine in C++ (test_fmi_lifecycle): fmpy 0.3.32's remoting client does not
+  forward fmi2GetFMUstate (it answers Error);
 - the source code builds with `fmpy compile` (nothing but a C++17 compiler:
   Eigen inside, RK4 only), and the compiled FMU reproduces the binary's
   auto-test; solver = 0 (CVODE) is refused with a clear message.
@@ -27,15 +28,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fmpy import supported_platforms
 from fmpy.util import add_remoting
 
 from fmu_autotest import SOLVERS, TOL_PHI, TOL_POS, half_step_forces, run_case
 from fmu_helpers import Fmu
-from test_fmu_state import check_state_restore
 
 PLATFORMS = {2: {"linux64", "win64"}, 3: {"x86_64-linux", "x86_64-windows", "aarch64-linux"}}
-PLATFORM_RTOL = 1e-12  # issue 14: the Windows binary against linux64
+# The Windows binary against linux64, relative to each coordinate's largest
+# magnitude: RK4 to 1e-12 (the same operations; only the math library's last
+# bits differ); CVODE to its own tolerance rtol, as its step-size decisions
+# react to those bits (tests/test_fmi_autotest_chain.cpp says more).
+PLATFORM_RTOL = {"RK4": 1e-12, "CVODE": SOLVERS["CVODE"].get("rtol", 1e-8)}
 REAL_WINE64 = Path("/usr/lib/wine/wine64")
 
 
@@ -43,9 +46,9 @@ REAL_WINE64 = Path("/usr/lib/wine/wine64")
 @pytest.mark.parametrize("ident", ["PKM4PUU", "PKM4PUU_Inverse"])
 def test_merged_archive_holds_every_platform_and_validates(dist_fmus, version, ident):
     fmu = dist_fmus[(version, ident)]
-    assert set(supported_platforms(fmu)) == PLATFORMS[version] | {"c-code"}
     with zipfile.ZipFile(fmu) as z:
         names = z.namelist()
+    assert {n.split("/")[1] for n in names if n.startswith("binaries/")} == PLATFORMS[version]
     assert any(n == "sources/Eigen/Dense" for n in names), "Eigen is not inside the sources"
     if version == 3:
         assert "sources/buildDescription.xml" in names
@@ -87,12 +90,12 @@ def half_step_table(inverse_fmu):
     return half_step_forces(inverse_fmu)
 
 
-def _agree(a, b, what):
-    """Each pose coordinate within PLATFORM_RTOL of that coordinate's largest magnitude."""
+def _agree(a, b, rtol, what):
+    """Each pose coordinate within rtol of that coordinate's largest magnitude."""
     scale = np.abs(b).max(axis=0)
     rel = np.abs(a - b).max(axis=0) / scale
     print(f"\n{what}: max relative difference per coordinate (x, y, z, phi): {rel}")
-    assert np.all(rel <= PLATFORM_RTOL), f"{what}: {rel} > {PLATFORM_RTOL}"
+    assert np.all(rel <= rtol), f"{what}: {rel} > {rtol}"
 
 
 @pytest.mark.parametrize("solver", list(SOLVERS))
@@ -101,12 +104,13 @@ def test_windows_binary_auto_test_through_remoting(plant_win64_remoting, plant_f
     assert win.finite()
     assert win.pos_err.max() <= TOL_POS and win.phi_err.max() <= TOL_PHI
     linux = run_case(plant_fmu, "midpoint", solver, half_step_table)
-    _agree(win.pose, linux.pose, f"win64 (wine, remoting) vs linux64, {solver}")
+    _agree(win.pose, linux.pose, PLATFORM_RTOL[solver], f"win64 (wine, remoting) vs linux64, {solver}")
 
 
-@pytest.mark.parametrize("solver", list(SOLVERS))
-def test_windows_binary_state_round_trip_through_remoting(plant_win64_remoting, solver):
-    check_state_restore(plant_win64_remoting, solver)
+# `fmpy compile` builds the whole core (~2 min of one core): outside the
+# default test run's 15-minute budget; scripts/platform_checks.sh runs it.
+needs_compile = pytest.mark.skipif(os.environ.get("PKM_COMPILE_SOURCE_FMU") != "1",
+                                   reason="fmpy compile of the source FMU: scripts/platform_checks.sh")
 
 
 @pytest.fixture(scope="module")
@@ -125,13 +129,15 @@ def compiled_plant(dist_fmus, tmp_path_factory):
     return out
 
 
+@needs_compile
 def test_compiled_source_fmu_reproduces_the_auto_test(compiled_plant, plant_fmu3, half_step_table):
     built = run_case(compiled_plant, "midpoint", "RK4", half_step_table)
     assert built.pos_err.max() <= TOL_POS and built.phi_err.max() <= TOL_PHI
     binary = run_case(plant_fmu3, "midpoint", "RK4", half_step_table)
-    _agree(built.pose, binary.pose, "source build (fmpy compile) vs binary, RK4")
+    _agree(built.pose, binary.pose, PLATFORM_RTOL["RK4"], "source build (fmpy compile) vs binary, RK4")
 
 
+@needs_compile
 def test_compiled_source_fmu_refuses_cvode_clearly(compiled_plant, capfd):
     """solver = 0 fails the initialisation with a message that says why
     (through the FMI logger: fmpy's default logger prints it)."""

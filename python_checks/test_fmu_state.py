@@ -11,7 +11,9 @@ import math
 import numpy as np
 import pytest
 
-from fmu_helpers import F, POSE, STATIC_FORCE_P0, VEL, Fmu, arr
+from pkm4puu.fmu import Fmu
+from pkm4puu.interface import arr, F, POSE, VEL
+from pkm4puu.spec import STATIC_FORCE_P0
 
 H = 1e-3
 T_SAVE, T_END = 1.0, 1.5
@@ -47,12 +49,7 @@ def _assert_identical(a, b, what):
 @pytest.mark.parametrize("solver", list(SOLVERS))
 @pytest.mark.parametrize("archive", ["plant_fmu", "plant_fmu3"])
 def test_state_restore_is_exact(archive, solver, request):
-    check_state_restore(request.getfixturevalue(archive), solver)
-
-
-def check_state_restore(plant_fmu, solver):
-    """The check above on one archive (also run on the Windows binary through
-    fmpy's remoting, test_fmu_platforms.py)."""
+    plant_fmu = request.getfixturevalue(archive)
     k_save, k_end = round(T_SAVE / H), round(T_END / H)
     with Fmu(plant_fmu, start=SOLVERS[solver]) as fmu:
         advance(fmu, 0, k_save)
@@ -79,4 +76,4 @@ def check_state_restore(plant_fmu, solver):
             fresh.free_state(restored)
         _assert_identical(fresh.get(OUT)[None], at_save[None], f"{solver}: outputs after deSerializeFMUstate")
         _assert_identical(advance(fresh, k_save, k_end), first, f"{solver}: replay in a fresh instance")
-    print(f"\n{plant_fmu.name}, {solver}: state at t = {T_SAVE} s, {len(blob)} bytes serialized, replay bit-identical")
+    print(f"\n{archive}, {solver}: state at t = {T_SAVE} s, {len(blob)} bytes serialized, replay bit-identical")

@@ -9,8 +9,16 @@
 // qemu-user), it also compares platforms: with PKM_TRACE_OUT set it writes
 // the plant's pose after every step to PKM_TRACE_OUT/autotest_chain_<solver>.txt
 // (hex floats, exact); with PKM_TRACE_REFERENCE set it reads the file of the
-// same name there (the linux64 run's) and requires every pose coordinate to
-// agree to 1e-12 relative to that coordinate's largest magnitude over the run.
+// same name there (the linux64 run's) and compares every pose coordinate,
+// relative to that coordinate's largest magnitude over the run:
+//  - RK4 (fixed steps, the same operations everywhere): to 1e-12; what
+//    differs is only the math library's last bit (sin, cos, atan2: glibc on
+//    Linux, mingw-w64's x87-based ones on Windows). Measured: 1.2e-15 under
+//    wine, bit-identical under qemu (aarch64 built without FMA).
+//  - CVODE: to its own tolerance rtol. Its discrete decisions (step size and
+//    order, nonlinear iterations) react to those last bits; Windows takes a
+//    different, equally valid step sequence in the last 45 ms of the motion
+//    and differs there by 1.3e-12 (1e-15 before). Bit-identical on aarch64.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -32,13 +40,18 @@ constexpr double kH = 1e-3;           // s, the communication step
 constexpr int kSteps = 2000;          // the 2-s motion
 constexpr double kTolPos = 5e-8;      // m   (python_checks/fmu_autotest.py TOL_POS)
 constexpr double kTolPhi = 5e-8;      // rad (python_checks/fmu_autotest.py TOL_PHI)
-constexpr double kPlatformRtol = 1e-12;  // issue 14: the cross-built binaries against linux64
+constexpr double kPlatformRtolRk4 = 1e-12;  // issue 14: the cross-built binaries against linux64
 const char* const kPose[4] = {"x", "y", "z", "phi"};
 
 struct Solver {
   const char* name;
   int solver;
 };
+
+/// How closely another platform must reproduce the linux64 trace (see the top).
+double platform_rtol(const Solver& s) {
+  return s.solver == 1 ? kPlatformRtolRk4 : pkm_fmi::pkm4puu_definition().find("rtol")->start;
+}
 
 /// The plant's pose after each step (kSteps rows of x, y, z, phi) and the
 /// largest deviations from p(t).
@@ -132,8 +145,9 @@ TEST_P(AutoTestChain, PlantFollowsThePrescribedMotion) {
         diff = std::max(diff, std::fabs(t.pose[i] - ref[i]));
         identical += t.pose[i] == ref[i];
       }
-      std::printf("  %s %-3s: max |difference| / max |reference| = %.2e\n", s.name, kPose[j], diff / scale);
-      EXPECT_LE(diff, kPlatformRtol * scale) << kPose[j];
+      std::printf("  %s %-3s: max |difference| / max |reference| = %.2e (bound %.0e)\n", s.name, kPose[j],
+                  diff / scale, platform_rtol(s));
+      EXPECT_LE(diff, platform_rtol(s) * scale) << kPose[j];
     }
     std::printf("  %s: %d of %zu values bit-identical to the reference\n", s.name, identical, ref.size());
   }
