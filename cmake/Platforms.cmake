@@ -120,11 +120,10 @@ list(APPEND _src_args --eigen "${_eigen_inc}" --eigen-license "${_eigen_license}
 
 set(_merged)
 foreach(_id IN ITEMS PKM4PUU PKM4PUU_Inverse)
-  if(_id STREQUAL "PKM4PUU")
-    set(_def pkm_fmi::pkm4puu_definition)
-  else()
-    set(_def pkm_fmi::pkm4puu_inverse_definition)
-  endif()
+  # The model's table, as pkm_add_fmu compiled the binary with it.
+  get_target_property(_defs ${_id} COMPILE_DEFINITIONS)
+  list(FILTER _defs INCLUDE REGEX "^PKM_FMI_DEFINITION=")
+  string(REPLACE "PKM_FMI_DEFINITION=" "" _def "${_defs}")
   foreach(_v 2 3)
     set(_bins)
     foreach(_t IN ITEMS win64 aarch64)
