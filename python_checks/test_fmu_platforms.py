@@ -12,7 +12,7 @@
   Eigen inside, RK4 only), and the compiled FMU reproduces the binary's
   auto-test; solver = 0 (CVODE) is refused with a clear message.
 
-fmpy's remoting under Debian's wine, two catches (see docs/platforms.md):
+fmpy's remoting under Debian's wine, two catches:
 its client starts `wine64`, which Debian keeps in /usr/lib/wine, not on
 PATH; and it passes the server a third argument, a lock file, which the
 server under wine finds open already, so it exits and the client hangs. A
