@@ -57,3 +57,10 @@ def plant_fmu3() -> Path:
 def inverse_fmu3() -> Path:
     """fmi3/PKM4PUU_Inverse.fmu, the inverse dynamics as FMI 3.0."""
     return _require_fmu("fmi3/PKM4PUU_Inverse.fmu")
+
+
+@pytest.fixture(scope="session")
+def dist_fmus() -> dict:
+    """dist/fmi<v>/<id>.fmu: one archive per FMU and FMI version holding every
+    platform and the source code (cmake/Platforms.cmake), keyed (version, id)."""
+    return {(v, i): _require_fmu(f"dist/fmi{v}/{i}.fmu") for v in (2, 3) for i in ("PKM4PUU", "PKM4PUU_Inverse")}

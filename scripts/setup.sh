@@ -10,26 +10,45 @@ log() { echo "setup: $*" >&2; }
 # 1. Debian packages.
 packages=(build-essential cmake ninja-build libeigen3-dev libsundials-dev libgtest-dev
           python3 python3-venv python3-pip
-          clang libclang-rt-14-dev valgrind)  # hardening: libFuzzer + sanitizers (fuzz/), memcheck
+          clang libclang-rt-14-dev valgrind  # hardening: libFuzzer + sanitizers (fuzz/), memcheck
+          # every platform (cmake/Platforms.cmake): Windows x64 built with mingw-w64 and run
+          # under wine, Linux aarch64 built with gcc and run under qemu-user; dpkg-dev
+          # unpacks `apt-get source sundials` (scripts/cross_sundials.sh)
+          g++-mingw-w64-x86-64-posix gcc-mingw-w64-x86-64-posix wine wine64
+          g++-aarch64-linux-gnu gcc-aarch64-linux-gnu qemu-user dpkg-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
 done
-if [ "${#missing[@]}" -eq 0 ]; then
+sudo=()
+if [ "$(id -u)" -ne 0 ] && command -v sudo >/dev/null 2>&1; then
+  sudo=(sudo -n)
+fi
+export DEBIAN_FRONTEND=noninteractive
+# The source packages of the mirror apt already uses (deb-src entries made
+# from its deb entries), for `apt-get source sundials`; added only when apt
+# has no deb-src entry at all.
+need_update=0
+if ! ./scripts/deb_src.sh --check; then
+  log "adding deb-src entries for apt's own mirrors"
+  ./scripts/deb_src.sh | "${sudo[@]}" tee /etc/apt/sources.list.d/pkm-deb-src.sources >/dev/null
+  need_update=1
+fi
+if [ -z "$(apt-cache showsrc sundials 2>/dev/null)" ]; then
+  need_update=1
+fi
+if [ "${#missing[@]}" -eq 0 ] && [ "$need_update" -eq 0 ]; then
   log "all Debian packages present, nothing missing"
 else
-  log "installing missing Debian packages: ${missing[*]}"
-  if [ "$(id -u)" -eq 0 ]; then
-    sudo=()
-  elif command -v sudo >/dev/null 2>&1; then
-    sudo=(sudo -n)
-  else
+  if [ "$(id -u)" -ne 0 ] && [ "${#sudo[@]}" -eq 0 ]; then
     log "ERROR: not root and no sudo; install these packages by hand: ${missing[*]}"
     exit 1
   fi
-  export DEBIAN_FRONTEND=noninteractive
   "${sudo[@]}" apt-get update -q
-  "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+  if [ "${#missing[@]}" -gt 0 ]; then
+    log "installing missing Debian packages: ${missing[*]}"
+    "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+  fi
 fi
 
 # 2. Python virtualenv, on Debian's python3 (the one installed above) when present.

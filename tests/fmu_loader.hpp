@@ -1,12 +1,22 @@
-// The built FMU binaries (PKM4PUU.so, PKM4PUU_Inverse.so) loaded with dlopen
-// and driven through the raw FMI 2.0 functions, as an importer would: shared
-// by the tests/test_hardening_*.cpp suites. Value references come from the
-// models' variable tables (checked against modelDescription.xml by
-// test_fmi_model_description).
+// The built FMU binaries (PKM4PUU.so / .dll, PKM4PUU_Inverse.so / .dll)
+// loaded as an importer would (dlopen; LoadLibrary on Windows) and driven
+// through the raw FMI 2.0 functions: shared by the tests/test_fmi_*.cpp and
+// tests/test_hardening_*.cpp suites. Value references come from the models'
+// variable tables (checked against modelDescription.xml by
+// test_fmi_model_description). The helpers that run host programs (capture,
+// run_python) exist on POSIX only.
 #pragma once
 
+#ifdef _WIN32
+#ifndef NOMINMAX
+#define NOMINMAX
+#endif
+#define WIN32_LEAN_AND_MEAN
+#include <windows.h>
+#else
 #include <dlfcn.h>
 #include <unistd.h>
+#endif
 
 #include <cmath>
 #include <cstdarg>
@@ -32,27 +42,87 @@ namespace pkm_test {
 constexpr double kStaticForce = 2.655616050;  // MODEL_SPEC "A check anyone can derive"
 constexpr double kPi = 3.14159265358979323846;
 
+/// `path` as the platform's C library takes it. The build's paths are Linux
+/// ones ("/work/..."): under wine, a Windows program reaches them through the
+/// Z: drive (wine's view of the Linux root). A native Windows build has
+/// drive-letter paths and passes them as they are.
+inline std::string native_path(const std::string& path) {
+#ifdef _WIN32
+  if (!path.empty() && path[0] == '/') return "Z:" + path;
+#endif
+  return path;
+}
+
+/// A shared library opened by path, and its exported symbols.
+class SharedLibrary {
+ public:
+  explicit SharedLibrary(const char* path) {
+#ifdef _WIN32
+    const std::string p = native_path(path);
+    handle_ = LoadLibraryA(p.c_str());
+    if (!handle_) error_ = "LoadLibrary(" + p + ") failed: error " + std::to_string(GetLastError());
+#else
+    handle_ = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!handle_) error_ = dlerror();
+#endif
+  }
+  ~SharedLibrary() {
+#ifdef _WIN32
+    if (handle_) FreeLibrary(handle_);
+#else
+    if (handle_) dlclose(handle_);
+#endif
+  }
+  SharedLibrary(const SharedLibrary&) = delete;
+  SharedLibrary& operator=(const SharedLibrary&) = delete;
+
+  bool loaded() const { return handle_ != nullptr; }
+#ifndef _WIN32
+  void* native() const { return handle_; }
+#endif
+  const std::string& error() const { return error_; }
+  /// The exported function `name` as a pointer of type T*, or null.
+  template <class T>
+  T* function(const char* name) const {
+#ifdef _WIN32
+    return reinterpret_cast<T*>(reinterpret_cast<void*>(GetProcAddress(handle_, name)));
+#else
+    return reinterpret_cast<T*>(dlsym(handle_, name));
+#endif
+  }
+
+ private:
+#ifdef _WIN32
+  HMODULE handle_ = nullptr;
+#else
+  void* handle_ = nullptr;
+#endif
+  std::string error_;
+};
+
 struct FmuLibrary {
-  void* handle = nullptr;
+  SharedLibrary library;
+#ifndef _WIN32
+  void* handle = nullptr;  // dlopen's handle, for dlsym of functions not in the list below
+#endif
 #define PKM_TEST_DECLARE(name) name##TYPE* name = nullptr;
   PKM_FMI2_FUNCTIONS(PKM_TEST_DECLARE)
 #undef PKM_TEST_DECLARE
   std::string missing;
 
-  explicit FmuLibrary(const char* path) {
-    handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-    if (!handle) {
-      missing = dlerror();
+  explicit FmuLibrary(const char* path) : library(path) {
+    if (!library.loaded()) {
+      missing = library.error();
       return;
     }
-#define PKM_TEST_LOAD(name)                                   \
-  name = reinterpret_cast<name##TYPE*>(dlsym(handle, #name)); \
+#ifndef _WIN32
+    handle = library.native();
+#endif
+#define PKM_TEST_LOAD(name)                          \
+  name = library.function<name##TYPE>(#name);        \
   if (!name) missing += #name " ";
     PKM_FMI2_FUNCTIONS(PKM_TEST_LOAD)
 #undef PKM_TEST_LOAD
-  }
-  ~FmuLibrary() {
-    if (handle) dlclose(handle);
   }
   FmuLibrary(const FmuLibrary&) = delete;
   FmuLibrary& operator=(const FmuLibrary&) = delete;
@@ -223,6 +293,7 @@ inline bool all_finite(const std::vector<double>& v) {
 
 inline std::string force_name(int i) { return "F[" + std::to_string(i) + "]"; }
 
+#ifndef _WIN32
 /// Runs a command, returns its output (stdout and stderr).
 inline std::string capture(const std::string& command, int* status = nullptr) {
   std::string out;
@@ -260,5 +331,6 @@ inline std::string run_python(const std::string& script, int* status) {
   unlink(path);
   return out;
 }
+#endif  // _WIN32
 
 }  // namespace pkm_test

@@ -11,6 +11,9 @@
 #include <cstdio>
 
 namespace pkm {
+
+bool cvode_available() { return true; }
+
 namespace {
 
 Eigen::Map<Vec10> as_vec(N_Vector v) { return Eigen::Map<Vec10>(N_VGetArrayPointer(v)); }

@@ -21,6 +21,11 @@ namespace pkm {
 
 enum class CvodeMethod { Adams = 0, BDF = 1 };
 
+/// Whether this build has CVODE: true when linked with cvode_integrator.cpp
+/// (SUNDIALS), false with cvode_unavailable.cpp (the source-code FMUs,
+/// built with nothing but a C++17 compiler; solver = 1, RK4, only).
+bool cvode_available();
+
 /// CVODE's smallest step, s (see cvode_integrator.cpp).
 constexpr double kMinStep = 1e-12;
 

@@ -60,6 +60,8 @@ InputSignal LinearInputs::signal() { return {&eval_linear, this, &eval_linear_ta
 std::string validate(const SolverSettings& s) {
   char buf[160];
   if (s.solver != Solver::Cvode && s.solver != Solver::Rk4) return "solver must be 0 (CVODE) or 1 (RK4)";
+  if (s.solver == Solver::Cvode && !cvode_available())
+    return "solver = 0 (CVODE) is not in this build (a source-code FMU compiled without SUNDIALS): set solver = 1 (RK4)";
   if (!(s.rk4_step > 0.0) || !std::isfinite(s.rk4_step)) {
     std::snprintf(buf, sizeof buf, "rk4_step = %.17g s must be positive and finite", s.rk4_step);
     return buf;

@@ -53,9 +53,24 @@ int main(int argc, char** argv) {
       << def->identifier << "</h1>\n<p><b>" << pkm_fmi::xml_escape(def->title) << "</b></p>\n"
       << def->summary
       << "\n<p>FMI 2.0 (Co-Simulation and Model Exchange in one archive) and FMI 3.0 (Co-Simulation and Model "
-         "Exchange), binaries for x86_64 Linux. SI units on every variable (m, kg, s, rad, N, N.m). "
+         "Exchange). SI units on every variable (m, kg, s, rad, N, N.m). "
          "Parameters are fixed: they can be set before ExitInitializationMode only. Arrays follow the "
          "<code>name[i]</code> convention, 1-based; leg i = 1..4; the FMI 3.0 names are the FMI 2.0 ones.</p>\n";
+  out << "<h2>Platforms</h2>\n<table>\n<tr><th>platform</th><th>binaries/</th><th>built with</th>"
+         "<th>tested</th></tr>\n"
+         "<tr><td>Linux x86-64</td><td>linux64, x86_64-linux</td><td>gcc</td><td>natively: every C++ and "
+         "Python test of the project</td></tr>\n"
+         "<tr><td>Windows x64</td><td>win64, x86_64-windows</td><td>mingw-w64 (gcc), static: imports only "
+         "KERNEL32 and msvcrt</td><td>under wine: the FMI life-cycle, state and error tests and the auto-test "
+         "through both FMUs (equal to Linux x86-64 to 1e-12 relative); through fmpy's remoting: the "
+         "auto-test and the state round trip</td></tr>\n"
+         "<tr><td>Linux aarch64 (FMI 3.0)</td><td>aarch64-linux</td><td>gcc, no fused multiply-add</td>"
+         "<td>under qemu-user: the same FMI tests as Windows</td></tr>\n"
+         "<tr><td>any other</td><td>sources/ (buildDescription.xml, SourceFiles)</td><td>any C++17 compiler; "
+         "Eigen inside; RK4 only (solver = 1; solver = 0, CVODE, needs SUNDIALS and is refused)</td>"
+         "<td><code>fmpy compile</code> on Linux x86-64: the auto-test as the binary</td></tr>\n"
+         "</table>\n<p>Every platform is in the archives of <code>build/dist/</code>; "
+         "<code>build/*.fmu</code> hold the build machine's binary only.</p>\n";
   section(out, *def, pkm_fmi::Causality::Input, "Inputs");
   section(out, *def, pkm_fmi::Causality::Output, "Outputs");
   section(out, *def, pkm_fmi::Causality::Parameter, "Parameters");

@@ -1,0 +1,164 @@
+# Every platform (issue 14): the FMU binaries cross-built for Windows x64
+# (mingw-w64) and Linux aarch64 (gcc), each in a sub-build of this project
+# under ${CMAKE_BINARY_DIR}/platforms/<target> with the toolchain files of
+# cmake/toolchains/, against a static CVODE built for the target from
+# Debian's source package (scripts/cross_sundials.sh, cached in
+# platforms/sundials-<target>); the FMI tests run there under wine and
+# qemu-user; and one archive per FMU and FMI version holding every platform
+# and the source code (cmake/merge_fmu.py):
+#
+#   build/dist/fmi2/<id>.fmu   binaries/linux64, binaries/win64, sources/
+#   build/dist/fmi3/<id>.fmu   binaries/x86_64-linux, x86_64-windows, aarch64-linux, sources/
+#
+#   PKM_PLATFORMS  (option, ON) all of this; OFF: the host's FMUs only.
+include_guard(GLOBAL)
+option(PKM_PLATFORMS "Cross-build the FMUs for Windows x64 and Linux aarch64, test them under wine and qemu-user, merge every platform into one archive per FMU" ON)
+if(NOT PKM_PLATFORMS OR CMAKE_CROSSCOMPILING)
+  return()
+endif()
+if(NOT CMAKE_SYSTEM_NAME STREQUAL "Linux" OR NOT CMAKE_SYSTEM_PROCESSOR MATCHES "^(x86_64|AMD64|amd64)$")
+  message(FATAL_ERROR "PKM_PLATFORMS cross-builds from Linux x86-64 only; configure with -DPKM_PLATFORMS=OFF")
+endif()
+foreach(_tool x86_64-w64-mingw32-g++-posix wine aarch64-linux-gnu-g++ qemu-aarch64 x86_64-w64-mingw32-objdump)
+  find_program(_pkm_have_${_tool} ${_tool})
+  if(NOT _pkm_have_${_tool})
+    message(FATAL_ERROR "${_tool} not found: ./scripts/setup.sh installs the cross tools (or -DPKM_PLATFORMS=OFF)")
+  endif()
+endforeach()
+include(ExternalProject)
+
+set(PKM_PLATFORMS_DIR "${CMAKE_BINARY_DIR}/platforms")
+set(_pkm_previous)
+set(_pkm_wine_env WINEDEBUG=-all WINEDLLOVERRIDES=mscoree,mshtml=)
+
+# wine's prefix (in $HOME) once, before anything runs under wine: two first
+# starts at once would both try to create it.
+add_custom_target(pkm_wine_prefix
+  COMMAND ${CMAKE_COMMAND} -E env ${_pkm_wine_env} wine wineboot --init
+  COMMENT "wine prefix (created on the first run)" VERBATIM)
+
+# target: toolchain file, FMI 2.0 platform folder (none for aarch64: FMI 2.0
+# names no ARM platform), FMI 3.0 platform folder, binary suffix.
+set(_pkm_win64 mingw-w64-x86_64 win64 x86_64-windows .dll)
+set(_pkm_aarch64 aarch64-linux-gnu "" aarch64-linux .so)
+foreach(_t IN ITEMS win64 aarch64)
+  list(GET _pkm_${_t} 0 _toolchain)
+  list(GET _pkm_${_t} 3 _suffix)
+  set(_prefix "${PKM_PLATFORMS_DIR}/sundials-${_t}")
+  set(_bin "${PKM_PLATFORMS_DIR}/${_t}")
+  add_custom_target(pkm_sundials_${_t}
+    COMMAND ${PROJECT_SOURCE_DIR}/scripts/cross_sundials.sh ${_t} ${_prefix}
+    COMMENT "Static CVODE for ${_t} (cached in ${_prefix})" VERBATIM)
+  set(_products)
+  foreach(_id IN ITEMS PKM4PUU PKM4PUU_Inverse)
+    list(APPEND _products "${_bin}/fmu-binaries/${_id}${_suffix}")
+  endforeach()
+  ExternalProject_Add(pkm_platform_${_t}
+    SOURCE_DIR "${PROJECT_SOURCE_DIR}"
+    BINARY_DIR "${_bin}"
+    CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/cmake/toolchains/${_toolchain}.cmake
+               -DCMAKE_BUILD_TYPE=Release -DPKM_BUILD_BENCHMARKS=OFF -DPKM_PLATFORMS=OFF
+               -DPKM_CROSS_PREFIX=${_prefix} -DFMI2_HEADERS_DIR=${FMI2_HEADERS_DIR}
+               -DPKM_FMU_PYTHON=${PKM_FMU_PYTHON} -DPKM_TRACE_REFERENCE=${PKM_TRACE_DIR}
+    BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR> -j2
+                  --target PKM4PUU PKM4PUU_Inverse test_fmi_lifecycle test_fmi_autotest_chain
+    BUILD_ALWAYS ON
+    BUILD_BYPRODUCTS ${_products}
+    INSTALL_COMMAND ""
+    DEPENDS pkm_sundials_${_t} ${_pkm_previous})
+  set(_pkm_previous pkm_platform_${_t})  # one sub-build at a time: each runs -j2
+  set(PKM_${_t}_BINARIES ${_products})
+  if(PKM_BUILD_TESTS)
+    # The sub-build's FMI tests under the emulator; the auto-test compares
+    # with the linux64 run's trace (test_fmi_autotest_chain writes it).
+    add_test(NAME platform_${_t}_fmi_tests
+             COMMAND ${CMAKE_CTEST_COMMAND} --test-dir ${_bin} --output-on-failure --no-tests=error)
+    set_tests_properties(platform_${_t}_fmi_tests PROPERTIES FIXTURES_REQUIRED linux64_traces TIMEOUT 900)
+  endif()
+endforeach()
+add_dependencies(pkm_platform_win64 pkm_wine_prefix)
+
+if(PKM_BUILD_TESTS)
+  # The Windows DLLs need only system DLLs (libstdc++, libgcc, winpthread and
+  # CVODE linked in) and export exactly the FMI functions of fmi_functions.h.
+  add_test(NAME platform_win64_binaries_imports_and_exports
+           COMMAND ${CMAKE_COMMAND} -DOBJDUMP=x86_64-w64-mingw32-objdump
+                   "-DBINARIES=${PKM_win64_BINARIES}" -DFUNCTIONS=${PROJECT_SOURCE_DIR}/fmu_src/fmi/fmi_functions.h
+                   -P ${PROJECT_SOURCE_DIR}/cmake/check_windows_dll.cmake)
+endif()
+
+# ---------------------------------------------------------------- the merged archives
+# Source build: the core without SUNDIALS (cvode_unavailable.cpp for
+# cvode_integrator.cpp: RK4 only) and the FMI layer, Eigen inside.
+get_target_property(_core_src pkm_core SOURCES)
+get_target_property(_fmi_src pkm_fmi_models SOURCES)
+set(_sources)
+foreach(_f IN LISTS _core_src)
+  if(NOT _f STREQUAL "core/cvode_integrator.cpp")
+    list(APPEND _sources "${PROJECT_SOURCE_DIR}/fmu_src/${_f}")
+  endif()
+endforeach()
+list(APPEND _sources "${PROJECT_SOURCE_DIR}/fmu_src/core/cvode_unavailable.cpp")
+foreach(_f IN LISTS _fmi_src ITEMS fmu_binary.cpp)
+  list(APPEND _sources "${PROJECT_SOURCE_DIR}/fmu_src/fmi/${_f}")
+endforeach()
+file(GLOB _headers "${PROJECT_SOURCE_DIR}/fmu_src/core/*.hpp" "${PROJECT_SOURCE_DIR}/fmu_src/fmi/*.hpp"
+     "${PROJECT_SOURCE_DIR}/fmu_src/fmi/*.h")
+list(APPEND _headers "${PROJECT_SOURCE_DIR}/fmu_src/fmi/fmi2_functions.cpp"
+     "${PROJECT_SOURCE_DIR}/fmu_src/fmi/fmi3_functions.cpp")
+get_target_property(_eigen_inc Eigen3::Eigen INTERFACE_INCLUDE_DIRECTORIES)
+list(GET _eigen_inc 0 _eigen_inc)
+set(_eigen_license /usr/share/doc/libeigen3-dev/copyright)
+set(_src_args)
+foreach(_f IN LISTS _sources)
+  list(APPEND _src_args --source "${_f}")
+endforeach()
+foreach(_f IN LISTS _headers)
+  list(APPEND _src_args --header "${_f}")
+endforeach()
+list(APPEND _src_args --eigen "${_eigen_inc}" --eigen-license "${_eigen_license}")
+
+set(_merged)
+foreach(_id IN ITEMS PKM4PUU PKM4PUU_Inverse)
+  # The model's table, as pkm_add_fmu compiled the binary with it.
+  get_target_property(_defs ${_id} COMPILE_DEFINITIONS)
+  list(FILTER _defs INCLUDE REGEX "^PKM_FMI_DEFINITION=")
+  string(REPLACE "PKM_FMI_DEFINITION=" "" _def "${_defs}")
+  foreach(_v 2 3)
+    set(_bins)
+    foreach(_t IN ITEMS win64 aarch64)
+      list(GET _pkm_${_t} 3 _suffix)
+      if(_v EQUAL 2)
+        list(GET _pkm_${_t} 1 _platform)
+      else()
+        list(GET _pkm_${_t} 2 _platform)
+      endif()
+      if(_platform)
+        list(APPEND _bins --binary "${_platform}=${PKM_PLATFORMS_DIR}/${_t}/fmu-binaries/${_id}${_suffix}")
+      endif()
+    endforeach()
+    # The host's staged FMU and its archive (cmake/Fmu.cmake).
+    if(_v EQUAL 2)
+      set(_native "${CMAKE_BINARY_DIR}/fmu/${_id}")
+      set(_native_fmu "${CMAKE_BINARY_DIR}/${_id}.fmu")
+    else()
+      set(_native "${CMAKE_BINARY_DIR}/fmu3/${_id}")
+      set(_native_fmu "${CMAKE_BINARY_DIR}/fmi3/${_id}.fmu")
+    endif()
+    set(_out "${CMAKE_BINARY_DIR}/dist/fmi${_v}/${_id}.fmu")
+    add_custom_command(
+      OUTPUT "${_out}"
+      COMMAND ${CMAKE_COMMAND} -E make_directory "${CMAKE_BINARY_DIR}/dist/fmi${_v}"
+      COMMAND ${CMAKE_COMMAND} -E env SOURCE_DATE_EPOCH=${PKM_SOURCE_DATE_EPOCH}
+              "${PKM_FMU_PYTHON}" "${PROJECT_SOURCE_DIR}/cmake/merge_fmu.py" --out "${_out}"
+              --stage "${CMAKE_BINARY_DIR}/dist/stage/fmi${_v}/${_id}" --native-stage "${_native}"
+              --fmi-version ${_v} --id ${_id} --definition ${_def} ${_bins} ${_src_args}
+      DEPENDS "${_native_fmu}" ${PKM_win64_BINARIES} ${PKM_aarch64_BINARIES} ${_sources} ${_headers}
+              "${PROJECT_SOURCE_DIR}/cmake/merge_fmu.py" "${PKM_PACK_FMU}"
+      COMMENT "Merging every platform and the sources into ${_out}"
+      VERBATIM)
+    list(APPEND _merged "${_out}")
+  endforeach()
+endforeach()
+add_custom_target(pkm_dist_fmus ALL DEPENDS ${_merged})
+add_dependencies(pkm_dist_fmus pkm_platform_win64 pkm_platform_aarch64 pkm_fmus)
