@@ -46,9 +46,13 @@ if complete; then
   exit 0
 fi
 
-# 1. The source, once (shared by the targets).
+# 1. The source, once (shared by the targets). The build runs both targets'
+#    scripts at once (ninja -j2): a lock makes the second wait for the first
+#    one's download instead of finding a half-unpacked tree.
 src_parent="$work/src"
 mkdir -p "$src_parent"
+exec 9>"$work/.source.lock"
+flock 9
 src=$(find "$src_parent" -mindepth 1 -maxdepth 1 -type d -name 'sundials-*' | head -n1)
 if [ -z "$src" ] || [ ! -f "$src/CMakeLists.txt" ]; then
   log "apt-get source sundials (into $src_parent)"
@@ -57,6 +61,7 @@ if [ -z "$src" ] || [ ! -f "$src/CMakeLists.txt" ]; then
   src=$(find "$src_parent" -mindepth 1 -maxdepth 1 -type d -name 'sundials-*' | head -n1)
   [ -n "$src" ] && [ -f "$src/CMakeLists.txt" ] || { log "ERROR: no SUNDIALS source after apt-get source"; exit 1; }
 fi
+flock -u 9
 
 # 2. CVODE alone, static and position-independent (it goes into the FMU's
 #    shared library). mingw: ~32 -Woverflow warnings in sundials_hashmap.h

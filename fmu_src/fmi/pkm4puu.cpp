@@ -39,6 +39,7 @@
 #include "mechanism_parameters.hpp"
 #include "models.hpp"
 #include "plant.hpp"
+#include "servo_kinematics.hpp"
 #include "workspace_guard.hpp"
 
 namespace pkm_fmi {
@@ -57,10 +58,11 @@ constexpr double kHoldingForce = 2.655616050;
 // reads, each once until the state, time or inputs change.
 enum : std::uint8_t {
   kGroupState = 1u << 0,     // pose, velocity, energy integrals, der(pose): copies of the state
-  kGroupJoints = 1u << 1,    // rho, drho, theta1, theta2: the legs in closed form
+  kGroupJoints = 1u << 1,    // drho, theta1, theta2: the legs in closed form
   kGroupDynamics = 1u << 2,  // accelerations and multipliers: the full forward dynamics
   kGroupMachine = 1u << 3,   // end stops, holding forces, energies and their rates
   kGroupHealth = 1u << 4,    // loop-closure residual, Jacobian condition, guard indicators
+  kGroupSliders = 1u << 5,   // rho: the closed form without angles (what a joint-space controller reads)
 };
 
 struct PlantData final : MechanismData {
@@ -292,6 +294,10 @@ Status PlantData::update_outputs(Context& ctx, unsigned groups) {
   auto all_finite = [&finite](const double* v, int n) {
     for (int i = 0; i < n; ++i) finite = finite && std::isfinite(v[i]);
   };
+  auto cannot_assemble = [&ctx, t](pkm::Status s) {
+    ctx.log.error("get: the legs cannot be assembled at t = %.17g: %s", t, pkm::status_name(s));
+    return Status::Error;
+  };
   if (groups & kGroupState) {  // copies of the state
     const pkm::Vec8& y = plant->state();
     for (int i = 0; i < 4; ++i) {
@@ -305,17 +311,24 @@ Status PlantData::update_outputs(Context& ctx, unsigned groups) {
     pkm::Vec16 q, qd;
     const pkm::Status s = plant->coordinates(q, qd);
     if (s != pkm::Status::Ok) {
-      ctx.log.error("get: the legs cannot be assembled at t = %.17g: %s", t, pkm::status_name(s));
-      return Status::Error;
+      return cannot_assemble(s);
     }
     for (int i = 0; i < 4; ++i) {
       const int o = pkm::leg_offset(i);
-      rho[i] = q[o];
       drho[i] = qd[o];
       theta1[i] = q[o + 1];
       theta2[i] = q[o + 2];
     }
-    for (const double* block : {rho, drho, theta1, theta2}) all_finite(block, 4);
+    for (const double* block : {drho, theta1, theta2}) all_finite(block, 4);
+  }
+  if (groups & kGroupSliders) {
+    pkm::Vec4 r;
+    const pkm::Status s = pkm::closed_form_sliders(plant->model(), plant->state().head<4>(), r);
+    if (s != pkm::Status::Ok) {
+      return cannot_assemble(s);
+    }
+    for (int i = 0; i < 4; ++i) rho[i] = r[i];
+    all_finite(rho, 4);
   }
   if (groups & kGroupDynamics) {  // Eqs. 12-13 and the multipliers
     pkm::MechanismState ms;
@@ -354,8 +367,7 @@ Status PlantData::update_outputs(Context& ctx, unsigned groups) {
     if (s == pkm::Status::Ok)
       s = pkm::guard_indicators(plant->model(), plant->state().head<4>(), plant->solver().limits(), z, &condition);
     if (s != pkm::Status::Ok) {
-      ctx.log.error("get: the legs cannot be assembled at t = %.17g: %s", t, pkm::status_name(s));
-      return Status::Error;
+      return cannot_assemble(s);
     }
     residual = pkm::constraints(plant->model(), q).norm();
     finite = finite && std::isfinite(residual) && !std::isnan(condition);  // +inf at a singularity, never NaN
@@ -539,10 +551,10 @@ constexpr Variable kVariables[] = {
   state_output(17, "dphi", "rad/s", "Platform angular velocity about z", PLANT(vel), 3, 7, kOnRates, kNominalAngularSpeed, kGroupState),
   state_output(18, "actuator_work", "J", "Work done on the machine since the start: integral of (F_i + (2 pi/screw_lead) tau_i) drho_i plus the external wrench's power", PLANT(energy), 0, 8, kOnEnergy, kNominalEnergy, kGroupState),
   state_output(19, "dissipated_energy", "J", "Energy dissipated since the start by joint friction and the end stops' damping", PLANT(energy), 1, 9, kOnEnergy, kNominalEnergy, kGroupState),
-  real_output(20, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", PLANT(rho), 0, kSliders, kGroupJoints),
-  real_output(21, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", PLANT(rho), 1, kSliders, kGroupJoints),
-  real_output(22, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", PLANT(rho), 2, kSliders, kGroupJoints),
-  real_output(23, "rho[4]", "m", "Actuated prismatic joint of leg 4 (slider position)", PLANT(rho), 3, kSliders, kGroupJoints),
+  real_output(20, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", PLANT(rho), 0, kSliders, kGroupSliders),
+  real_output(21, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", PLANT(rho), 1, kSliders, kGroupSliders),
+  real_output(22, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", PLANT(rho), 2, kSliders, kGroupSliders),
+  real_output(23, "rho[4]", "m", "Actuated prismatic joint of leg 4 (slider position)", PLANT(rho), 3, kSliders, kGroupSliders),
   real_output(24, "drho[1]", "m/s", "Slider velocity of leg 1", PLANT(drho), 0, kOnPositions | kOnRates | kOnHeightRate, kGroupJoints),
   real_output(25, "drho[2]", "m/s", "Slider velocity of leg 2", PLANT(drho), 1, kOnPositions | kOnRates | kOnHeightRate, kGroupJoints),
   real_output(26, "drho[3]", "m/s", "Slider velocity of leg 3", PLANT(drho), 2, kOnPositions | kOnRates | kOnHeightRate, kGroupJoints),
