@@ -115,15 +115,18 @@ Status Instance::set_debug_logging(bool on, std::size_t n, const char* const cat
     return Status::Error;
   }
   // Check every name before changing anything.
+  bool named[kLogCategoryCount] = {};
   for (std::size_t k = 0; k < n; ++k) {
-    if (log_category(categories[k]) < 0) {
+    const int c = log_category(categories[k]);
+    if (c < 0) {
       log_.error("%s: unknown log category \"%s\" (known: logEvents, logStatusWarning, logStatusDiscard, "
                  "logStatusError, logStatusFatal, logCalls); nothing changed",
                  fn, categories[k] ? categories[k] : "(NULL)");
       return Status::Error;
     }
+    named[c] = true;
   }
-  for (std::size_t k = 0; k < n; ++k) log_.enable(static_cast<LogCategory>(log_category(categories[k])), on);
+  log_.select(named, on);
   return Status::OK;
 }
 
