@@ -1,21 +1,25 @@
 // What both FMUs share: the mechanism's parameters (MODEL_SPEC: Tables II
 // and III, leg placement, gravity) as FMI variables, stored straight in a
-// pkm::Params, with the core's defaults as start values.
+// pkm::Params, and the singularity guards' limits in a pkm::GuardLimits,
+// with the core's defaults as start values.
 #pragma once
 
 #include "model_data.hpp"
 #include "variables.hpp"
 #include "params.hpp"
+#include "workspace_guard.hpp"
 
 namespace pkm_fmi {
 
 /// Per-instance data of a model of the mechanism: its parameters.
 struct MechanismData : ModelData {
   pkm::Params params{};
+  pkm::GuardLimits limits{};
 };
 
 /// The core's defaults: the start values of the parameters.
 inline constexpr pkm::Params kDefaultParams{};
+inline constexpr pkm::GuardLimits kDefaultLimits{};
 
 }  // namespace pkm_fmi
 
@@ -75,6 +79,25 @@ inline constexpr pkm::Params kDefaultParams{};
   real_parameter(120, "g", kDefaultParams.g, "m/s2",                                                              \
                  "Gravitational acceleration, along -z of the base frame (0 switches gravity off)",               \
                  PKM_FMI_PARAM(g), 0)
+
+#define PKM_FMI_LIMIT(member) \
+  [](::pkm_fmi::ModelData& d, int) -> void* { return &static_cast<::pkm_fmi::MechanismData&>(d).limits.member; }
+
+// Value references 146..147, identical in both FMUs: the singularity guards
+// (workspace_guard.hpp). The plant discards a step that ends beyond one; the
+// inverse FMU answers Discard for a pose beyond one.
+#define PKM_FMI_GUARD_PARAMETERS                                                                                  \
+  real_parameter(146, "max_jacobian_condition", kDefaultLimits.max_jacobian_condition, "",                        \
+                 "Parallel-singularity guard: largest admissible condition number of the actuator Jacobian (phi " \
+                 "column divided by 0.1 m); a pose beyond it is refused (plant: the step is discarded, state "    \
+                 "kept, or in Model Exchange an event indicator ends the run; inverse: Discard, last good "        \
+                 "outputs kept); > 1",                                                                             \
+                 PKM_FMI_LIMIT(max_jacobian_condition), 0, 1.0),                                                   \
+  real_parameter(147, "min_leg_measure", kDefaultLimits.min_leg_measure, "",                                      \
+                 "Leg-singularity guard: smallest admissible |cos(theta2) sin(theta2)| of every leg (rod nearly "  \
+                 "horizontal or vertical below it); a pose beyond it is refused as for max_jacobian_condition; "  \
+                 "in [0, 0.5)",                                                                                    \
+                 PKM_FMI_LIMIT(min_leg_measure), 0, 0.0, 0.5)
 
 // Value references 150..160, identical in both FMUs: the machine around the
 // mechanism (MODEL_SPEC "The machine around the mechanism"). Every default

@@ -34,7 +34,9 @@ class ModelData {
   /// initial state at ctx.start_time. Error with a logged message if impossible.
   virtual Status exit_initialization(Context& ctx) = 0;
   /// Writes every computed variable for the current time, state, parameters
-  /// and inputs. Called lazily, before a get that needs them.
+  /// and inputs. Called lazily, before a get that needs them. Discard (reason
+  /// logged): the inputs lie outside the model's domain, the computed
+  /// variables are left as they were and the get hands those out.
   virtual Status update_outputs(Context& ctx) = 0;
   /// The model's state beyond the table's values.
   virtual void save(StateWriter& w) const = 0;

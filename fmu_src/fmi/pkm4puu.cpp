@@ -60,8 +60,6 @@ struct PlantData final : MechanismData {
   double atol = kDefaultSolver.atol;
   std::int32_t cvode_method = static_cast<std::int32_t>(kDefaultSolver.cvode_method);
   std::int32_t formulation = static_cast<std::int32_t>(kDefaultSolver.formulation);
-  double max_jacobian_condition = kDefaultSolver.max_jacobian_condition;
-  double min_leg_measure = kDefaultSolver.min_leg_measure;
   // Inputs u = [F1..F4, Fe1..Fe3, Me_z, tau1..tau4] at the current time, and du/dt.
   double u[kInputs] = {kHoldingForce, kHoldingForce, kHoldingForce, kHoldingForce};
   double du[kInputs] = {};
@@ -140,8 +138,8 @@ Status PlantData::make_plant(Context& ctx, const char* function, std::unique_ptr
   s.atol = atol;
   s.cvode_method = static_cast<pkm::CvodeMethod>(cvode_method);
   s.formulation = static_cast<pkm::Formulation>(formulation);
-  s.max_jacobian_condition = max_jacobian_condition;
-  s.min_leg_measure = min_leg_measure;
+  s.max_jacobian_condition = limits.max_jacobian_condition;
+  s.min_leg_measure = limits.min_leg_measure;
   auto plant_new = std::make_unique<pkm::Plant>(model);
   if (plant_new->set_solver(s, &why) != pkm::Status::Ok) {
     ctx.log.error("%s: parameter %s", function, why.c_str());
@@ -594,16 +592,7 @@ constexpr Variable kVariables[] = {
                     "Forward dynamics: 0 = augmented saddle-point system (Eq. 12), 1 = null-space projection with a QR "
                     "(Eq. 13), 2 = null space from the leg blocks (Eq. 13, leg-partitioned)",
                     PLANT_SCALAR(formulation), 0, 2),
-  real_parameter(146, "max_jacobian_condition", kDefaultSolver.max_jacobian_condition, "",
-                 "Parallel-singularity guard: a step whose end state has an actuator Jacobian condition number "
-                 "(phi column divided by 0.1 m) above this is discarded (Co-Simulation: Discard, state kept; Model "
-                 "Exchange: an event indicator, terminateSimulation); > 1",
-                 PLANT_SCALAR(max_jacobian_condition), 0, 1.0),
-  real_parameter(147, "min_leg_measure", kDefaultSolver.min_leg_measure, "",
-                 "Leg-singularity guard: a step whose end state has |cos(theta2) sin(theta2)| of a leg below this "
-                 "(rod nearly horizontal or vertical) is discarded (Co-Simulation: Discard, state kept; Model "
-                 "Exchange: an event indicator, terminateSimulation); in [0, 0.5)",
-                 PLANT_SCALAR(min_leg_measure), 0, 0.0, 0.5),
+  PKM_FMI_GUARD_PARAMETERS,
   real_parameter(148, "stop_stiffness", kDefaultParams.stop_stiffness, "N/m",
                  "Stiffness k of the compliant end stops: k delta + d delta_dot pushes a slider back past rho_min or rho_max by delta (never pulls)",
                  PKM_FMI_PARAM(stop_stiffness), 0, 0.0),
