@@ -289,7 +289,8 @@ TEST(HardeningParameters, UnreachableOrSingularInitialPosesFailInitialisationAnd
        {{"gamma[2]", g65}, {"gamma[4]", g65}},
        "singular configuration",
        "exceeds max_jacobian_condition"},
-      {"dx0 = 1e200 m/s (velocity terms overflow)", {{"dx0", 1e200}}, "non-finite", "initial velocity too large"},
+      {"dx0 = 1e200 m/s (beyond the physical bound on speeds)", {{"dx0", 1e200}}, "integrator failure",
+       "beyond the physical bound 1000 m/s"},
   };
   for (const BadStart& c : cases) {
     SCOPED_TRACE(c.what);

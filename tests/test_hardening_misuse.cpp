@@ -9,6 +9,7 @@
 // Every case prints a row of the hardening table ("| tried | answer | kept |").
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <string>
@@ -18,6 +19,7 @@
 
 #include "fmi3FunctionTypes.h"
 #include "fmu_loader.hpp"
+#include "fnv1a.hpp"
 #include "hardening_table.hpp"
 
 namespace {
@@ -659,6 +661,93 @@ TEST_F(HardeningMisuse, ForeignOrBrokenFmuStates) {
         inv.lib.fmi2FreeFMUstate(inv.c, &is);
         EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, &good), fmi2OK);
         for (unsigned char byte : junk) EXPECT_EQ(byte, 0);
+        return s;
+      });
+}
+
+/// A serialized state with the bytes at `at` replaced by `value` (a double,
+/// or the low 4 bytes of an integer when `u32`) and the checksum recomputed
+/// (fnv1a.hpp): a forgery that passes the header checks.
+std::vector<fmi2Byte> forge(std::vector<fmi2Byte> b, std::size_t at, double value, bool u32 = false) {
+  std::uint64_t bits = static_cast<std::uint64_t>(value);
+  if (!u32) std::memcpy(&bits, &value, 8);
+  for (int k = 0; k < (u32 ? 4 : 8); ++k) b[at + k] = static_cast<fmi2Byte>((bits >> (8 * k)) & 0xff);  // little-endian
+  const std::uint64_t h = pkm_fmi::fnv1a(reinterpret_cast<const unsigned char*>(b.data()), b.size() - 8);
+  for (int k = 0; k < 8; ++k) b[b.size() - 8 + k] = static_cast<fmi2Byte>((h >> (8 * k)) & 0xff);
+  return b;
+}
+
+// Issue 17.6: states with a valid checksum and absurd content. The layout
+// (fmu_state.cpp): a 32-byte header; mode (4), three flags (3), startTime,
+// stopTime, time, last successful time (8 each) from byte 39; the count (4)
+// and the stored variables (8 each) from byte 75; then the input
+// derivatives and the plant's part, which ends (before the 8-byte checksum)
+// with time (8), [pose; velocity] (64), the theta1 references (32), the
+// energy integrals (16) and the end-stop record (4).
+TEST_F(HardeningMisuse, ForgedFmuStatesWithAValidChecksumAreRefused) {
+  on_stepping_instance(
+      "fmi2DeSerializeFMUstate + fmi2SetFMUstate of states forged with a recomputed checksum: time = NaN, startTime "
+      "after the time, m_platform = -1, the plant's time = NaN, dx = 1e200 m/s, theta1 reference of leg 2 = 1e16 "
+      "rad or off by 1 rad, an end-stop record naming no stop",
+      fmi2Error,
+      "fmi2SetFMUstate: fmi2Error \"malformed FMU state (a time is not finite ...)\" / \"... outside its range\" / "
+      "\"beyond the physical bound 1000 m/s\" / \"theta1 reference ... is not the pose's theta1\"",
+      [&](PlantFmu& p, double) {
+        std::vector<fmi2Status> s;
+        fmi2FMUstate good = nullptr;
+        EXPECT_EQ(lib.fmi2GetFMUstate(p.c, &good), fmi2OK);
+        std::size_t size = 0;
+        EXPECT_EQ(lib.fmi2SerializedFMUstateSize(p.c, good, &size), fmi2OK);
+        std::vector<fmi2Byte> bytes(size);
+        EXPECT_EQ(lib.fmi2SerializeFMUstate(p.c, good, bytes.data(), size), fmi2OK);
+        EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, &good), fmi2OK);
+        const std::size_t end = size - 8;
+        std::size_t m_platform = 75;
+        for (std::size_t i = 0; i < p.def.n_variables; ++i) {
+          const pkm_fmi::Variable& v = p.def.variables[i];
+          if (std::string(v.name) == "m_platform") break;
+          if (v.stored_in_state()) m_platform += 8;
+        }
+        double theta1_2 = 0.0;
+        std::memcpy(&theta1_2, &bytes[end - 52 + 8], 8);
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        const struct {
+          std::size_t at;
+          double value;
+          const char* reason;
+          bool u32;
+        } forgeries[] = {
+            {55, nan, "a time is not finite"},
+            {39, 1.0, "the time lies before startTime"},
+            {m_platform, -1.0, "m_platform = -1, outside its range"},
+            {end - 124, nan, "not finite"},
+            {end - 84, 1e200, "beyond the physical bound"},
+            {end - 52 + 8, 1e16, "theta1 reference 10000000000000000 rad of leg 2"},
+            {end - 52 + 8, theta1_2 + 1.0, "of leg 2 is not the pose's theta1"},
+            {end - 4, 0xffff, "end-stop record", true},
+        };
+        // The control: the same bytes with the checksum recomputed restore.
+        {
+          double time = 0.0;
+          std::memcpy(&time, &bytes[55], 8);
+          fmi2FMUstate same = nullptr;
+          EXPECT_EQ(lib.fmi2DeSerializeFMUstate(p.c, forge(bytes, 55, time).data(), size, &same), fmi2OK);
+          EXPECT_EQ(lib.fmi2SetFMUstate(p.c, same), fmi2OK) << p.log.dump();
+          EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, &same), fmi2OK);
+        }
+        for (const auto& f : forgeries) {
+          SCOPED_TRACE(f.reason);
+          const std::vector<fmi2Byte> forged = forge(bytes, f.at, f.value, f.u32);
+          fmi2FMUstate st = nullptr;
+          EXPECT_EQ(lib.fmi2DeSerializeFMUstate(p.c, forged.data(), forged.size(), &st), fmi2OK);
+          const std::size_t logged = p.log.messages.size();
+          s.push_back(lib.fmi2SetFMUstate(p.c, st));
+          bool named = false;
+          for (std::size_t k = logged; k < p.log.messages.size(); ++k)
+            named = named || p.log.messages[k].text.find(f.reason) != std::string::npos;
+          EXPECT_TRUE(named) << p.log.dump();
+          EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, &st), fmi2OK);
+        }
         return s;
       });
 }

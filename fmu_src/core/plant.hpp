@@ -34,6 +34,13 @@ struct SolverSettings {
 /// work: about 25 s of computing at 2.5 us per step).
 constexpr double kMaxRk4StepsPerAdvance = 1e7;
 
+/// The fastest the platform can move: |dx|, |dy|, |dz| and 0.1 m * |dphi|
+/// at most 1e3 m/s, a fifth of the speed of sound in steel (a rigid-body
+/// model of a 0.1 m machine means nothing faster). Checked with the
+/// singularity guards: a step ending faster is undone (SolverFailure), an
+/// initial velocity or a restored state faster is refused.
+constexpr double kMaxSpeed = 1e3;
+
 /// Returns "" if the settings are usable, otherwise a message naming the
 /// offending setting.
 std::string validate(const SolverSettings& s);
@@ -114,8 +121,10 @@ class Plant {
   /// The integrated state [pose; velocity].
   const Vec8& state() const { return y_; }
   /// Restores a state saved earlier (time, y, theta1 continuity); refused
-  /// (nothing changes) if y lies beyond the singularity limits. The energy
-  /// integrals keep their values unless given.
+  /// (nothing changes, last_error() says why) if y lies beyond the
+  /// singularity limits or kMaxSpeed, or theta1_ref is not the pose's
+  /// closed-form theta1 (modulo 2 pi). The energy integrals keep their
+  /// values unless given.
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref);
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e);
 

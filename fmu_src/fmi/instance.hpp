@@ -151,6 +151,9 @@ class Instance {
   SavedState* new_state();
   void save(std::vector<unsigned char>& out) const;
   bool check_header(const unsigned char* bytes, std::size_t size, const char* function);
+  /// The times of a state being loaded: finite and in order (else logged).
+  bool times_consistent(double start, bool stop_defined, double stop, double time, double last_successful,
+                        const char* function);
   bool load(const std::vector<unsigned char>& bytes, const char* function);
 
   std::uint64_t tag_;  // identifies a live Instance of this version behind a handle

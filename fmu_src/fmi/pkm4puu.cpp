@@ -436,11 +436,16 @@ bool PlantData::load(StateReader& r, Context& ctx) {
   const pkm::EnergyIntegrals e{r.f64(), r.f64()};
   const unsigned beyond = r.u32();
   if (!r.ok()) return false;
+  if (beyond >> pkm::kStopIndicators) {
+    ctx.log.error("SetFMUState: malformed FMU state (end-stop record %#x names no stop)", beyond);
+    return false;
+  }
   std::unique_ptr<pkm::Plant> p;
   if (make_plant(ctx, "SetFMUState", p) != Status::OK) return false;
   const pkm::Status s = p->restore(t, y, ref, e);
   if (s != pkm::Status::Ok) {
-    ctx.log.error("SetFMUState: the saved state at t = %.17g cannot be restored: %s", t, pkm::status_name(s));
+    ctx.log.error("SetFMUState: the saved state at t = %.17g cannot be restored: %s%s%s", t, pkm::status_name(s),
+                  p->last_error().empty() ? "" : ": ", p->last_error().c_str());
     return false;
   }
   plant = std::move(p);
