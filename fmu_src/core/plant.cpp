@@ -68,12 +68,17 @@ std::string validate(const SolverSettings& s) {
     std::snprintf(buf, sizeof buf, "rk4_step = %.17g s must be positive and finite", s.rk4_step);
     return buf;
   }
+  if (!(s.rk4_step >= kMinRk4Step && s.rk4_step <= kMaxRk4Step)) {
+    std::snprintf(buf, sizeof buf, "rk4_step = %.17g s lies outside its range [%g, %g] s", s.rk4_step, kMinRk4Step,
+                  kMaxRk4Step);
+    return buf;
+  }
   if (!(s.rtol > 0.0) || !(s.rtol < 1.0)) {
     std::snprintf(buf, sizeof buf, "rtol = %.17g must lie in (0, 1)", s.rtol);
     return buf;
   }
-  if (!(s.atol > 0.0) || !std::isfinite(s.atol)) {
-    std::snprintf(buf, sizeof buf, "atol = %.17g must be positive and finite", s.atol);
+  if (!(s.atol > 0.0) || !(s.atol <= 1.0)) {
+    std::snprintf(buf, sizeof buf, "atol = %.17g must be positive and at most 1", s.atol);
     return buf;
   }
   if (s.cvode_method != CvodeMethod::Adams && s.cvode_method != CvodeMethod::BDF)
@@ -342,9 +347,11 @@ Status Plant::guard(const Vec8& y, double t) {
   return s;
 }
 
+double rk4_steps_for(double span, double rk4_step) { return std::ceil(span / rk4_step - 1e-9); }
+
 Status Plant::advance_rk4(double t_end) {
   const double span = t_end - t_;
-  const double steps = std::ceil(span / settings_.rk4_step - 1e-9);
+  const double steps = rk4_steps_for(span, settings_.rk4_step);
   if (!(steps <= kMaxRk4StepsPerAdvance)) {  // also NaN
     char buf[200];
     std::snprintf(buf, sizeof buf,

@@ -29,10 +29,18 @@ struct SolverSettings {
   GuardLimits limits() const { return {max_jacobian_condition, min_leg_measure}; }
 };
 
+/// The range of rk4_step (s): a thousandth of the paper's 1 ms resolves the
+/// stiffest default dynamics (the end stops ring at about 6 ms) many times
+/// over; above 1 s RK4 says nothing about this machine.
+constexpr double kMinRk4Step = 1e-6, kMaxRk4Step = 1.0;
+
 /// At most this many RK4 steps in one advance (a longer interval or a
 /// smaller rk4_step is refused with Status::InvalidArgument before any
 /// work: about 25 s of computing at 2.5 us per step).
 constexpr double kMaxRk4StepsPerAdvance = 1e7;
+/// How many RK4 steps an advance over `span` takes (whole steps no longer
+/// than rk4_step); compare with kMaxRk4StepsPerAdvance before any work.
+double rk4_steps_for(double span, double rk4_step);
 
 /// The fastest the platform can move: |dx|, |dy|, |dz| and 0.1 m * |dphi|
 /// at most 1e3 m/s, a fifth of the speed of sound in steel (a rigid-body

@@ -178,7 +178,9 @@ Status Instance::exit_initialization_mode() {
     log_.event("%s: initialised at t = %.17g, now in %s", fn, start_time_, mode_name(mode_));
     return s;
   }
-  mode_ = s == Status::Fatal ? kFatal : kError;
+  // Refused (the parameters cannot be used, reason logged): nothing changed,
+  // still in initialization mode, where the parameters can be corrected.
+  if (s == Status::Fatal) mode_ = kFatal;
   return s == Status::Fatal ? Status::Fatal : Status::Error;
 }
 

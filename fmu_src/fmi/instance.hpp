@@ -2,13 +2,18 @@
 // FMI function as a method over the model's table and hooks. The thin front
 // ends (fmi2_functions.cpp, fmi3_functions.cpp) translate the C calls.
 //
-// Error policy: a call with wrong arguments or in the wrong state returns
-// Error with a logged message and has no effect (the instance stays as it
-// was). A failure of the model itself (initialisation impossible, a step
-// failed beyond recovery) returns Error and puts the instance in the Error
-// state: then only get, reset, free and the FMU state functions are allowed
-// (SetFMUState may return to a saved good state). A step that cannot be
-// completed returns Discard with the state kept at the last good time.
+// Error policy (README "Error policy"): every check runs before anything
+// changes. A call with wrong arguments or in the wrong state, parameters
+// that cannot be used (ExitInitializationMode: the instance stays in
+// initialization mode, where they can be corrected), a step beyond the work
+// budget or an FMU state that cannot be used returns Error with a logged
+// message and has no effect: the instance stays as it was and usable. Only
+// a failure in the middle of a computation (a step failed beyond recovery,
+// an internal error) puts the instance in the Error state: then only get,
+// reset, free and the FMU state functions are allowed (SetFMUState may
+// return to a saved good state). A step that cannot be completed returns
+// Discard with the state kept at the last good time; a get whose inputs lie
+// outside the model's domain returns Discard with the last good outputs.
 //
 // Implementation, one concern per file: instance.cpp (creation, state
 // machine, initialisation, termination, reset, logging setup),

@@ -48,6 +48,9 @@ class ModelData {
   /// From t to t + h (t is the current time). On return t_reached is the last
   /// time the state is valid for: t + h for OK, the last good point for Discard.
   virtual Status do_step(Context& ctx, double t, double h, double& t_reached) = 0;
+  /// Before do_step, nothing changed yet: Error (reason logged) if a step of
+  /// h would exceed the model's work budget. The instance stays usable.
+  virtual Status check_step(Context& ctx, double h) const { (void)ctx, (void)h; return Status::OK; }
 
   // ---- Model Exchange (models without states keep the defaults)
   virtual void set_time(double t) { (void)t; }

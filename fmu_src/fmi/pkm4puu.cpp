@@ -84,6 +84,7 @@ struct PlantData final : MechanismData {
   void reset() override { plant.reset(); }
   Status exit_initialization(Context& ctx) override;
   Status do_step(Context& ctx, double t, double h, double& t_reached) override;
+  Status check_step(Context& ctx, double h) const override;
   Status update_outputs(Context& ctx) override;
   void save(StateWriter& w) const override;
   bool load(StateReader& r, Context& ctx) override;
@@ -267,6 +268,18 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
                     pkm::status_name(s), plant->last_error().empty() ? "" : ": ", plant->last_error().c_str());
       return Status::Error;
   }
+}
+
+Status PlantData::check_step(Context& ctx, double h) const {
+  if (!plant || plant->solver().solver != pkm::Solver::Rk4) return Status::OK;
+  const double step = plant->solver().rk4_step;
+  const double steps = pkm::rk4_steps_for(h, step);
+  if (steps <= pkm::kMaxRk4StepsPerAdvance) return Status::OK;
+  ctx.log.error("DoStep: a communication step of %.6g s needs %.3g RK4 steps of rk4_step = %.6g s, more than the "
+                "work budget of %.0e per step: use shorter communication steps or a larger rk4_step; the call has "
+                "no effect",
+                h, steps, step, pkm::kMaxRk4StepsPerAdvance);
+  return Status::Error;
 }
 
 Status PlantData::update_outputs(Context& ctx) {
@@ -576,21 +589,22 @@ constexpr Variable kVariables[] = {
   // Parameters: the mechanism (100..120), the initial state (130..137), the
   // solver (140..147), the end stops' compliance (148..149), the machine (150..160).
   PKM_FMI_MECHANISM_PARAMETERS,
-  real_parameter(130, "x0", 0.0, "m", "Initial x of P", PLANT(pose0), 0),
-  real_parameter(131, "y0", 0.0, "m", "Initial y of P", PLANT(pose0), 1),
-  real_parameter(132, "z0", 0.05, "m", "Initial z of P (home pose: 0.05 m)", PLANT(pose0), 2),
-  real_parameter(133, "phi0", 0.0, "rad", "Initial platform rotation about z", PLANT(pose0), 3),
-  real_parameter(134, "dx0", 0.0, "m/s", "Initial velocity of P, x component", PLANT(vel0), 0),
-  real_parameter(135, "dy0", 0.0, "m/s", "Initial velocity of P, y component", PLANT(vel0), 1),
-  real_parameter(136, "dz0", 0.0, "m/s", "Initial velocity of P, z component", PLANT(vel0), 2),
-  real_parameter(137, "dphi0", 0.0, "rad/s", "Initial platform angular velocity about z", PLANT(vel0), 3),
+  real_parameter(130, "x0", 0.0, "m", "Initial x of P", PLANT(pose0), 0, -pkm::kMaxLength, pkm::kMaxLength),
+  real_parameter(131, "y0", 0.0, "m", "Initial y of P", PLANT(pose0), 1, -pkm::kMaxLength, pkm::kMaxLength),
+  real_parameter(132, "z0", 0.05, "m", "Initial z of P (home pose: 0.05 m)", PLANT(pose0), 2, -pkm::kMaxLength, pkm::kMaxLength),
+  real_parameter(133, "phi0", 0.0, "rad", "Initial platform rotation about z", PLANT(pose0), 3, -pkm::kMaxAngle, pkm::kMaxAngle),
+  real_parameter(134, "dx0", 0.0, "m/s", "Initial velocity of P, x component", PLANT(vel0), 0, -pkm::kMaxSpeed, pkm::kMaxSpeed),
+  real_parameter(135, "dy0", 0.0, "m/s", "Initial velocity of P, y component", PLANT(vel0), 1, -pkm::kMaxSpeed, pkm::kMaxSpeed),
+  real_parameter(136, "dz0", 0.0, "m/s", "Initial velocity of P, z component", PLANT(vel0), 2, -pkm::kMaxSpeed, pkm::kMaxSpeed),
+  real_parameter(137, "dphi0", 0.0, "rad/s", "Initial platform angular velocity about z", PLANT(vel0), 3, -pkm::kMaxSpeed / pkm::kConditionLength, pkm::kMaxSpeed / pkm::kConditionLength),
   integer_parameter(140, "solver", static_cast<int>(kDefaultSolver.solver),
                     "Co-Simulation integrator: 0 = CVODE (variable step, rtol and atol), 1 = fixed-step RK4 (rk4_step), as in the paper",
                     PLANT_SCALAR(solver), 0, 1),
   real_parameter(141, "rk4_step", kDefaultSolver.rk4_step, "s",
-                 "RK4 step: a communication step is split into whole steps no longer than this", PLANT_SCALAR(rk4_step), 0),
+                 "RK4 step: a communication step is split into whole steps no longer than this", PLANT_SCALAR(rk4_step), 0,
+                 pkm::kMinRk4Step, pkm::kMaxRk4Step),
   real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance", PLANT_SCALAR(rtol), 0, 0.0, 1.0),
-  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)", PLANT_SCALAR(atol), 0, 0.0),
+  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)", PLANT_SCALAR(atol), 0, 0.0, 1.0),
   integer_parameter(144, "cvode_method", static_cast<int>(kDefaultSolver.cvode_method),
                     "CVODE method: 0 = Adams-Moulton (non-stiff), 1 = BDF", PLANT_SCALAR(cvode_method), 0, 1),
   integer_parameter(145, "formulation", static_cast<int>(kDefaultSolver.formulation),
@@ -600,9 +614,9 @@ constexpr Variable kVariables[] = {
   PKM_FMI_GUARD_PARAMETERS,
   real_parameter(148, "stop_stiffness", kDefaultParams.stop_stiffness, "N/m",
                  "Stiffness k of the compliant end stops: k delta + d delta_dot pushes a slider back past rho_min or rho_max by delta (never pulls)",
-                 PKM_FMI_PARAM(stop_stiffness), 0, 0.0),
+                 PKM_FMI_PARAM(stop_stiffness), 0, 0.0, pkm::kMaxStiffness),
   real_parameter(149, "stop_damping", kDefaultParams.stop_damping, "N.s/m", "Damping d of the end stops",
-                 PKM_FMI_PARAM(stop_damping), 0, 0.0),
+                 PKM_FMI_PARAM(stop_damping), 0, 0.0, pkm::kMaxDamping),
   PKM_FMI_MACHINE_PARAMETERS,
 };
 // clang-format on

@@ -104,6 +104,7 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
     return Status::Error;
   }
   Context ctx = context();
+  if (data_->check_step(ctx, h) != Status::OK) return Status::Error;
   double reached = time_;
   const Status s = data_->do_step(ctx, t, h, reached);
   outputs_valid_ = false;
