@@ -530,6 +530,35 @@ TEST_F(HardeningMisuse, AStepThatVanishesInTPlusHIsAnError) {
             "yes: every variable bit-identical; a later step of 1 s succeeds");
 }
 
+// Issue 17.7: at startTime 1e9 s, t + 1 ms rounds to a multiple of 0.12 us;
+// the model used to integrate (t + h) - t, 7e-5 s lost over 1 s. It
+// integrates the time since start: the motion is that of a start at 0.
+TEST_F(HardeningMisuse, TheMotionDoesNotDependOnTheStartTime) {
+  for (int solver : {0, 1}) {
+    SCOPED_TRACE(solver == 0 ? "CVODE" : "RK4");
+    PlantFmu late("late"), early("early");
+    for (PlantFmu* p : {&late, &early}) {
+      ASSERT_EQ(p->set_int("solver", solver), fmi2OK);
+      const double start = p == &late ? 1e9 : 0.0;
+      ASSERT_EQ(lib.fmi2SetupExperiment(p->c, fmi2False, 0.0, start, fmi2False, 0.0), fmi2OK);
+      ASSERT_EQ(p->enter(), fmi2OK);
+      ASSERT_EQ(p->exit(), fmi2OK);
+      double t = start;
+      for (int k = 0; k < 1000; ++k) {
+        drive(*p, k * 1e-3);  // the same forces at the same time since start
+        ASSERT_EQ(p->step(t, 1e-3), fmi2OK) << p->log.dump();
+        t += 1e-3;  // as a master counts: at 1e9 each addition rounds
+      }
+      EXPECT_EQ(p->get("time"), t) << "the FMU's time is the master's";
+    }
+    EXPECT_TRUE(bit_identical(late.outputs(), early.outputs()))
+        << "x after 1 s: " << late.get("x") << " (start 1e9) vs " << early.get("x") << " (start 0)";
+  }
+  table_row("startTime = 1e9 s, 1000 steps of 1 ms (the master's t += h rounds at every step), CVODE and RK4",
+            "fmi2OK; the model integrates the time since start (the sum of the step sizes)",
+            "yes: every output after 1 s bit-identical to a run started at 0");
+}
+
 TEST_F(HardeningMisuse, AStepTooLongForCvodeIsDiscarded) {
   PlantFmu p;
   p.initialize();
@@ -681,8 +710,8 @@ std::vector<fmi2Byte> forge(std::vector<fmi2Byte> b, std::size_t at, double valu
 
 // Issue 17.6: states with a valid checksum and absurd content. The layout
 // (fmu_state.cpp): a 32-byte header; mode (4), three flags (3), startTime,
-// stopTime, time, last successful time (8 each) from byte 39; the count (4)
-// and the stored variables (8 each) from byte 75; then the input
+// stopTime, time, last successful time, time since start (8 each) from byte
+// 39; the count (4) and the stored variables (8 each) from byte 83; then the input
 // derivatives and the plant's part, which ends (before the 8-byte checksum)
 // with time (8), [pose; velocity] (64), the theta1 references (32), the
 // energy integrals (16) and the end-stop record (4).
@@ -704,7 +733,7 @@ TEST_F(HardeningMisuse, ForgedFmuStatesWithAValidChecksumAreRefused) {
         EXPECT_EQ(lib.fmi2SerializeFMUstate(p.c, good, bytes.data(), size), fmi2OK);
         EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, &good), fmi2OK);
         const std::size_t end = size - 8;
-        std::size_t m_platform = 75;
+        std::size_t m_platform = 83;
         for (std::size_t i = 0; i < p.def.n_variables; ++i) {
           const pkm_fmi::Variable& v = p.def.variables[i];
           if (std::string(v.name) == "m_platform") break;
@@ -721,6 +750,7 @@ TEST_F(HardeningMisuse, ForgedFmuStatesWithAValidChecksumAreRefused) {
         } forgeries[] = {
             {55, nan, "a time is not finite"},
             {39, 1.0, "the time lies before startTime"},
+            {71, 5.0, "the time since startTime does not match the time"},
             {m_platform, -1.0, "m_platform = -1, outside its range"},
             {end - 124, nan, "not finite"},
             {end - 84, 1e200, "beyond the physical bound"},

@@ -14,7 +14,7 @@ namespace {
 
 constexpr std::uint64_t kStateTag = 0x53324d464d4b5002ull;  // marks a live SavedState
 constexpr unsigned char kMagic[8] = {'P', 'K', 'M', 'F', 'M', 'U', 'S', 'T'};
-constexpr std::uint32_t kFormatVersion = 3;  // 3: the plant's energy integrals and end-stop contacts
+constexpr std::uint32_t kFormatVersion = 4;  // 3: the plant's energy integrals and end-stop contacts; 4: elapsed
 constexpr std::size_t kHeaderSize = 32;
 constexpr std::size_t kTrailerSize = 8;
 
@@ -84,6 +84,7 @@ void Instance::save(std::vector<unsigned char>& out) const {
   w.f64(stop_time_);
   w.f64(time_);
   w.f64(last_successful_time_);
+  w.f64(elapsed_);
   w.u32(stored_count(def_));
   for (std::size_t i = 0; i < def_.n_variables; ++i) {
     const Variable& v = def_.variables[i];
@@ -132,9 +133,10 @@ bool Instance::check_header(const unsigned char* bytes, std::size_t size, const 
 }
 
 bool Instance::times_consistent(double start, bool stop_defined, double stop, double time, double last_successful,
-                                const char* function) {
+                                double elapsed, const char* function) {
   const char* why = nullptr;
-  if (!std::isfinite(start) || !std::isfinite(stop) || !std::isfinite(time) || !std::isfinite(last_successful))
+  if (!std::isfinite(start) || !std::isfinite(stop) || !std::isfinite(time) || !std::isfinite(last_successful) ||
+      !std::isfinite(elapsed))
     why = "a time is not finite";
   else if (stop_defined && !(stop >= start))
     why = "stopTime lies before startTime";
@@ -143,6 +145,9 @@ bool Instance::times_consistent(double start, bool stop_defined, double stop, do
   else if (interface_ == Interface::CoSimulation && stop_defined &&
            time > stop + 1e-9 * std::max(1.0, std::abs(stop)))
     why = "the time lies past stopTime";
+  else if (interface_ == Interface::CoSimulation &&
+           !(std::abs(start + elapsed - time) <= 1e-9 * std::max(1.0, std::abs(time))))
+    why = "the time since startTime does not match the time";
   if (!why) return true;
   log_.error("%s: malformed FMU state (%s: startTime = %.17g, stopTime = %.17g%s, time = %.17g, last successful "
              "time = %.17g); nothing changed",
@@ -161,6 +166,7 @@ bool Instance::load(const std::vector<unsigned char>& bytes, const char* functio
   const double stop_time = r.f64();
   const double time = r.f64();
   const double last_time = r.f64();
+  const double elapsed = r.f64();
   const std::uint32_t count = r.u32();
   const std::uint32_t expected = stored_count(def_);
   if (!r.ok() || count != expected || !(mode & kRestorableModes) || (mode & (mode - 1)) != 0) {
@@ -198,7 +204,7 @@ bool Instance::load(const std::vector<unsigned char>& bytes, const char* functio
   }
   // Every field as a setter or a step would have checked it: a state with a
   // valid checksum may still have been forged.
-  if (!times_consistent(start_time, stop_defined, stop_time, time, last_time, function)) return false;
+  if (!times_consistent(start_time, stop_defined, stop_time, time, last_time, elapsed, function)) return false;
   k = 0;
   for (std::size_t i = 0; i < def_.n_variables; ++i) {
     const Variable& v = def_.variables[i];
@@ -236,6 +242,7 @@ bool Instance::load(const std::vector<unsigned char>& bytes, const char* functio
   stop_time_ = stop_time;
   time_ = time;
   last_successful_time_ = last_time;
+  elapsed_ = elapsed;
   outputs_valid_ = false;
   data_->reset();
   Context ctx = context();

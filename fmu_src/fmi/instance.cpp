@@ -159,8 +159,9 @@ Status Instance::enter_initialization_mode() {
   if (!allowed(kMaskEnterInitialization, fn)) return Status::Error;
   mode_ = kInitializationMode;
   time_ = last_successful_time_ = start_time_;
+  elapsed_ = 0.0;
   outputs_valid_ = false;
-  data_->set_time(start_time_);
+  data_->set_time(0.0);
   log_.event("%s: initialization mode at t = %.17g", fn, start_time_);
   return Status::OK;
 }
@@ -174,6 +175,7 @@ Status Instance::exit_initialization_mode() {
   if (succeeded(s)) {
     mode_ = interface_ == Interface::CoSimulation ? kStepMode : kEventMode;
     time_ = last_successful_time_ = start_time_;
+    elapsed_ = 0.0;
     terminated_ = false;
     log_.event("%s: initialised at t = %.17g, now in %s", fn, start_time_, mode_name(mode_));
     return s;
@@ -199,7 +201,7 @@ Status Instance::reset() {
   data_->reset();
   input_derivatives_set_ = false;
   mode_ = kInstantiated;
-  start_time_ = stop_time_ = time_ = last_successful_time_ = 0.0;
+  start_time_ = stop_time_ = time_ = last_successful_time_ = elapsed_ = 0.0;
   stop_time_defined_ = false;
   terminated_ = false;
   outputs_valid_ = false;

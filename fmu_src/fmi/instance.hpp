@@ -158,7 +158,7 @@ class Instance {
   bool check_header(const unsigned char* bytes, std::size_t size, const char* function);
   /// The times of a state being loaded: finite and in order (else logged).
   bool times_consistent(double start, bool stop_defined, double stop, double time, double last_successful,
-                        const char* function);
+                        double elapsed, const char* function);
   bool load(const std::vector<unsigned char>& bytes, const char* function);
 
   std::uint64_t tag_;  // identifies a live Instance of this version behind a handle
@@ -173,6 +173,10 @@ class Instance {
   double stop_time_ = 0.0;
   bool stop_time_defined_ = false;
   double time_ = 0.0;                   // current time (CS: communication point)
+  // Time since startTime, the model's time: summed from the step sizes, so
+  // that the motion does not depend on startTime (at 1e9 s, t + 1 ms rounds
+  // to 0.12 us: 7e-5 s lost over 1 s when the model integrated t + h - t).
+  double elapsed_ = 0.0;
   double last_successful_time_ = 0.0;   // CS
   bool terminated_ = false;             // CS: set after a discarded step
   bool outputs_valid_ = false;          // computed variables up to date

@@ -18,7 +18,7 @@ struct Context {
   Logger& log;
   Interface interface;
   bool initialization_mode;  // between Enter- and ExitInitializationMode
-  double start_time;
+  double start_time;  // the model's time is the time since this
 };
 
 /// Per-instance data of a model. Start values are written through the
@@ -31,7 +31,9 @@ class ModelData {
   /// forget everything derived (solvers, caches).
   virtual void reset() = 0;
   /// ExitInitializationMode: build the model from the parameters and set the
-  /// initial state at ctx.start_time. Error with a logged message if impossible.
+  /// initial state at model time 0 (= ctx.start_time). Error with a logged
+  /// message if impossible. Every time the layer passes to a model is the
+  /// time since ctx.start_time.
   virtual Status exit_initialization(Context& ctx) = 0;
   /// Writes every computed variable for the current time, state, parameters
   /// and inputs. Called lazily, before a get that needs them. Discard (reason

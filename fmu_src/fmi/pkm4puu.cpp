@@ -98,6 +98,8 @@ struct PlantData final : MechanismData {
   Status get_event_indicators(Context& ctx, double z[]) override;
   Status event_update(Context& ctx, bool& terminate) override;
 
+  /// The absolute time of the plant (its own time is the time since startTime), for messages.
+  double absolute_time(const Context& ctx) const { return ctx.start_time + plant->time(); }
   /// A Plant for the current parameters (not yet initialised).
   Status make_plant(Context& ctx, const char* function, std::unique_ptr<pkm::Plant>& out) const;
   /// make_plant, then the consistent initial state from x0..phi0, dx0..dphi0.
@@ -156,7 +158,7 @@ Status PlantData::build(Context& ctx, const char* function) {
   if (st != Status::OK) return st;
   const pkm::Pose pose_0(pose0[0], pose0[1], pose0[2], pose0[3]);
   const pkm::Pose vel_0(vel0[0], vel0[1], vel0[2], vel0[3]);
-  const pkm::Status s = p->initialize(ctx.start_time, pose_0, vel_0);
+  const pkm::Status s = p->initialize(0.0, pose_0, vel_0);  // model time: since ctx.start_time
   if (s != pkm::Status::Ok) {
     const char* what = s == pkm::Status::Unreachable ? "cannot be assembled elbow-down"
                        : s == pkm::Status::Singular  ? "lies beyond the singularity limits"
@@ -187,7 +189,7 @@ void PlantData::log_stop_changes(Context& ctx, unsigned now, const char* where) 
   for (int k = 0; k < pkm::kStopIndicators; ++k) {
     if (!(changed & (1u << k))) continue;
     const bool lower = k < 4;
-    ctx.log.event("%s at t = %.17g: slider %d %s its %s end stop (%s = %.9g m)", where, plant->time(), k % 4 + 1,
+    ctx.log.event("%s at t = %.17g: slider %d %s its %s end stop (%s = %.9g m)", where, absolute_time(ctx), k % 4 + 1,
                   (now & (1u << k)) ? "passes" : "leaves", lower ? "lower" : "upper", lower ? "rho_min" : "rho_max",
                   lower ? plant->model().p.rho_min : plant->model().p.rho_max);
   }
@@ -258,13 +260,14 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
       // step start), within the singularity limits. The layer sets
       // terminated: a master stops at the last successful time instead of
       // retrying the same step.
-      ctx.log.discard("DoStep: integration from t = %.17g to %.17g failed (%s%s%s); the state is kept at "
-                      "t = %.17g (the last successful time), terminated = true",
-                      t_start, t_end, pkm::status_name(s), plant->last_error().empty() ? "" : ": ",
-                      plant->last_error().c_str(), t_reached);
+      ctx.log.discard("DoStep: integration from t = %.17g to %.17g failed (%s%s%s, times since startTime); the "
+                      "state is kept at t = %.17g (the last successful time), terminated = true",
+                      ctx.start_time + t_start, ctx.start_time + t_end, pkm::status_name(s),
+                      plant->last_error().empty() ? "" : ": ", plant->last_error().c_str(), ctx.start_time + t_reached);
       return Status::Discard;
     default:
-      ctx.log.error("DoStep: integration from t = %.17g to %.17g failed: %s%s%s", t_start, t_end,
+      ctx.log.error("DoStep: integration from t = %.17g to %.17g failed: %s%s%s", ctx.start_time + t_start,
+                    ctx.start_time + t_end,
                     pkm::status_name(s), plant->last_error().empty() ? "" : ": ", plant->last_error().c_str());
       return Status::Error;
   }
@@ -288,7 +291,7 @@ Status PlantData::update_outputs(Context& ctx) {
   pkm::MechanismState ms;
   const pkm::Status s = plant->mechanism(inputs(plant->time()).signal(), ms);
   if (s != pkm::Status::Ok) {
-    ctx.log.error("get: the mechanism cannot be evaluated at t = %.17g: %s", plant->time(), pkm::status_name(s));
+    ctx.log.error("get: the mechanism cannot be evaluated at t = %.17g: %s", absolute_time(ctx), pkm::status_name(s));
     return Status::Error;
   }
   const pkm::Vec8& y = plant->state();
@@ -307,7 +310,7 @@ Status PlantData::update_outputs(Context& ctx) {
   pkm::MachineOutputs mo;
   const pkm::Status sm = plant->machine_outputs(inputs(plant->time()).signal(), mo);
   if (sm != pkm::Status::Ok) {
-    ctx.log.error("get: the machine's outputs cannot be evaluated at t = %.17g: %s", plant->time(),
+    ctx.log.error("get: the machine's outputs cannot be evaluated at t = %.17g: %s", absolute_time(ctx),
                   pkm::status_name(sm));
     return Status::Error;
   }
@@ -333,7 +336,7 @@ Status PlantData::update_outputs(Context& ctx) {
   if (pkm::guard_indicators(plant->model(), y.head<4>(), plant->solver().limits(), z) != pkm::Status::Ok)
     finite = false;
   if (!finite) {
-    ctx.log.error("get: non-finite outputs at t = %.17g (singular configuration?)", plant->time());
+    ctx.log.error("get: non-finite outputs at t = %.17g (singular configuration?)", absolute_time(ctx));
     return Status::Error;
   }
   return Status::OK;
@@ -365,7 +368,7 @@ Status PlantData::set_states(Context& ctx, const double x[]) {
     ctx.log.discard("SetContinuousStates: the pose x = %.9g m, y = %.9g m, z = %.9g m, phi = %.9g rad at t = %.17g "
                     "cannot be assembled (%s: %s); the states are unchanged (a smaller step may stay within the "
                     "workspace)",
-                    x[0], x[1], x[2], x[3], plant->time(), pkm::status_name(s), plant->last_error().c_str());
+                    x[0], x[1], x[2], x[3], absolute_time(ctx), pkm::status_name(s), plant->last_error().c_str());
     return Status::Discard;
   }
   return Status::OK;
@@ -377,7 +380,7 @@ Status PlantData::get_derivatives(Context& ctx, double dx[]) {
   pkm::Vec10 xdot;
   const pkm::Status s = plant->derivative_now(inputs(plant->time()).signal(), xdot);
   if (s != pkm::Status::Ok || !xdot.allFinite()) {
-    ctx.log.error("GetDerivatives: the state derivative at t = %.17g cannot be evaluated: %s", plant->time(),
+    ctx.log.error("GetDerivatives: the state derivative at t = %.17g cannot be evaluated: %s", absolute_time(ctx),
                   s != pkm::Status::Ok ? pkm::status_name(s) : "not finite (singular configuration?)");
     return Status::Error;
   }
@@ -392,7 +395,7 @@ Status PlantData::get_event_indicators(Context& ctx, double z[]) {
   pkm::Status s = pkm::guard_indicators(plant->model(), pose_now, plant->solver().limits(), z);
   if (s == pkm::Status::Ok) s = pkm::stop_indicators(plant->model(), pose_now, z + pkm::kGuardIndicators);
   if (s != pkm::Status::Ok) {
-    ctx.log.error("GetEventIndicators: not defined at t = %.17g: %s", plant->time(), pkm::status_name(s));
+    ctx.log.error("GetEventIndicators: not defined at t = %.17g: %s", absolute_time(ctx), pkm::status_name(s));
     return Status::Error;
   }
   return Status::OK;
@@ -413,11 +416,11 @@ Status PlantData::event_update(Context& ctx, bool& terminate) {
     if (k == 0) {
       ctx.log.warning("event at t = %.17g: the actuator Jacobian's condition number reached max_jacobian_condition "
                       "= %g (parallel-singularity guard); terminateSimulation = true",
-                      plant->time(), plant->solver().max_jacobian_condition);
+                      absolute_time(ctx), plant->solver().max_jacobian_condition);
     } else {
       ctx.log.warning("event at t = %.17g: leg %d reached min_leg_measure = %g (leg-singularity guard: rod nearly "
                       "horizontal or vertical); terminateSimulation = true",
-                      plant->time(), k, plant->solver().min_leg_measure);
+                      absolute_time(ctx), k, plant->solver().min_leg_measure);
     }
     return Status::Warning;
   }
