@@ -696,6 +696,18 @@ TEST_F(HardeningMisuse, ForeignOrBrokenFmuStates) {
       });
 }
 
+/// The instance's current state, serialized.
+std::vector<fmi2Byte> serialized_state(FmuInstance& p) {
+  fmi2FMUstate st = nullptr;
+  std::size_t size = 0;
+  EXPECT_EQ(p.lib.fmi2GetFMUstate(p.c, &st), fmi2OK);
+  EXPECT_EQ(p.lib.fmi2SerializedFMUstateSize(p.c, st, &size), fmi2OK);
+  std::vector<fmi2Byte> bytes(size);
+  EXPECT_EQ(p.lib.fmi2SerializeFMUstate(p.c, st, bytes.data(), size), fmi2OK);
+  EXPECT_EQ(p.lib.fmi2FreeFMUstate(p.c, &st), fmi2OK);
+  return bytes;
+}
+
 /// A serialized state with the bytes at `at` replaced by `value` (a double,
 /// or the low 4 bytes of an integer when `u32`) and the checksum recomputed
 /// (fnv1a.hpp): a forgery that passes the header checks.
@@ -725,14 +737,8 @@ TEST_F(HardeningMisuse, ForgedFmuStatesWithAValidChecksumAreRefused) {
       "\"beyond the physical bound 1000 m/s\" / \"theta1 reference ... is not the pose's theta1\"",
       [&](PlantFmu& p, double) {
         std::vector<fmi2Status> s;
-        fmi2FMUstate good = nullptr;
-        EXPECT_EQ(lib.fmi2GetFMUstate(p.c, &good), fmi2OK);
-        std::size_t size = 0;
-        EXPECT_EQ(lib.fmi2SerializedFMUstateSize(p.c, good, &size), fmi2OK);
-        std::vector<fmi2Byte> bytes(size);
-        EXPECT_EQ(lib.fmi2SerializeFMUstate(p.c, good, bytes.data(), size), fmi2OK);
-        EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, &good), fmi2OK);
-        const std::size_t end = size - 8;
+        const std::vector<fmi2Byte> bytes = serialized_state(p);
+        const std::size_t size = bytes.size(), end = size - 8;
         std::size_t m_platform = 83;
         for (std::size_t i = 0; i < p.def.n_variables; ++i) {
           const pkm_fmi::Variable& v = p.def.variables[i];
@@ -814,18 +820,11 @@ TEST_F(HardeningMisuse, TheErrorPolicyAsATable) {
        "unchanged, StepComplete: the next step", steps_on},
       {"fmi2SetFMUstate(state with time = NaN, checksum recomputed)", fmi2Error,
        [&](PlantFmu& p, double) {
-         fmi2FMUstate st = nullptr;
-         std::size_t size = 0;
-         EXPECT_EQ(lib.fmi2GetFMUstate(p.c, &st), fmi2OK);
-         EXPECT_EQ(lib.fmi2SerializedFMUstateSize(p.c, st, &size), fmi2OK);
-         std::vector<fmi2Byte> bytes(size);
-         EXPECT_EQ(lib.fmi2SerializeFMUstate(p.c, st, bytes.data(), size), fmi2OK);
-         const std::vector<fmi2Byte> forged = forge(bytes, 55, std::nan(""));
+         const std::vector<fmi2Byte> forged = forge(serialized_state(p), 55, std::nan(""));
          fmi2FMUstate bad = nullptr;
-         EXPECT_EQ(lib.fmi2DeSerializeFMUstate(p.c, forged.data(), size, &bad), fmi2OK);
+         EXPECT_EQ(lib.fmi2DeSerializeFMUstate(p.c, forged.data(), forged.size(), &bad), fmi2OK);
          const fmi2Status s = lib.fmi2SetFMUstate(p.c, bad);
          lib.fmi2FreeFMUstate(p.c, &bad);
-         lib.fmi2FreeFMUstate(p.c, &st);
          return s;
        },
        "unchanged, StepComplete: the next step", steps_on},
