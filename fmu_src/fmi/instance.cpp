@@ -75,6 +75,13 @@ Status Instance::internal_error(const char* function, const char* what) {
   return Status::Error;
 }
 
+Status Instance::concurrent_call(const char* function) {
+  log_.error("%s: called while another call on this instance is running (from another thread?): an instance must "
+             "be used by one thread at a time; the call has no effect",
+             function);
+  return Status::Error;
+}
+
 Status Instance::not_supported(const char* function, const char* why) {
   if (!allowed(kAlive, function)) return Status::Error;
   log_.error("%s: not supported by %s: %s; the call has no effect", function, def_.identifier, why);

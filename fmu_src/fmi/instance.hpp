@@ -21,6 +21,7 @@
 // serialisation), stepping.cpp (Co-Simulation), model_exchange.cpp.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -128,6 +129,25 @@ class Instance {
   /// Turns an exception escaping a method into Error (never across the C ABI).
   Status internal_error(const char* function, const char* what);
 
+  /// One call at a time: FMI does not allow an instance to be used from two
+  /// threads at once. A call that finds another one running answers
+  /// concurrent_call() (Error, no effect) instead of racing it.
+  class Busy {
+   public:
+    explicit Busy(Instance& i) : i_(i), entered_(!i.busy_.exchange(true, std::memory_order_acquire)) {}
+    ~Busy() {
+      if (entered_) i_.busy_.store(false, std::memory_order_release);
+    }
+    Busy(const Busy&) = delete;
+    Busy& operator=(const Busy&) = delete;
+    explicit operator bool() const { return entered_; }
+
+   private:
+    Instance& i_;
+    bool entered_;
+  };
+  Status concurrent_call(const char* function);
+
   const ModelDefinition& definition() const { return def_; }
   std::uint32_t mode() const { return mode_; }
   Interface interface() const { return interface_; }
@@ -182,6 +202,7 @@ class Instance {
   bool outputs_valid_ = false;          // computed variables up to date
   bool input_derivatives_set_ = false;  // SetRealInputDerivatives was used (or a state restored)
   std::unordered_set<SavedState*> states_;  // FMU states this instance created and nobody freed yet
+  std::atomic<bool> busy_{false};           // a call is running (Busy)
 
  public:
   /// Forgets a state freed through any instance (FreeFMUState).
