@@ -9,6 +9,7 @@
 // Every case prints a row of the hardening table ("| tried | answer | kept |").
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <string>
@@ -18,6 +19,7 @@
 
 #include "fmi3FunctionTypes.h"
 #include "fmu_loader.hpp"
+#include "fnv1a.hpp"
 #include "hardening_table.hpp"
 
 namespace {
@@ -528,6 +530,35 @@ TEST_F(HardeningMisuse, AStepThatVanishesInTPlusHIsAnError) {
             "yes: every variable bit-identical; a later step of 1 s succeeds");
 }
 
+// Issue 17.7: at startTime 1e9 s, t + 1 ms rounds to a multiple of 0.12 us;
+// the model used to integrate (t + h) - t, 7e-5 s lost over 1 s. It
+// integrates the time since start: the motion is that of a start at 0.
+TEST_F(HardeningMisuse, TheMotionDoesNotDependOnTheStartTime) {
+  for (int solver : {0, 1}) {
+    SCOPED_TRACE(solver == 0 ? "CVODE" : "RK4");
+    PlantFmu late("late"), early("early");
+    for (PlantFmu* p : {&late, &early}) {
+      ASSERT_EQ(p->set_int("solver", solver), fmi2OK);
+      const double start = p == &late ? 1e9 : 0.0;
+      ASSERT_EQ(lib.fmi2SetupExperiment(p->c, fmi2False, 0.0, start, fmi2False, 0.0), fmi2OK);
+      ASSERT_EQ(p->enter(), fmi2OK);
+      ASSERT_EQ(p->exit(), fmi2OK);
+      double t = start;
+      for (int k = 0; k < 1000; ++k) {
+        drive(*p, k * 1e-3);  // the same forces at the same time since start
+        ASSERT_EQ(p->step(t, 1e-3), fmi2OK) << p->log.dump();
+        t += 1e-3;  // as a master counts: at 1e9 each addition rounds
+      }
+      EXPECT_EQ(p->get("time"), t) << "the FMU's time is the master's";
+    }
+    EXPECT_TRUE(bit_identical(late.outputs(), early.outputs()))
+        << "x after 1 s: " << late.get("x") << " (start 1e9) vs " << early.get("x") << " (start 0)";
+  }
+  table_row("startTime = 1e9 s, 1000 steps of 1 ms (the master's t += h rounds at every step), CVODE and RK4",
+            "fmi2OK; the model integrates the time since start (the sum of the step sizes)",
+            "yes: every output after 1 s bit-identical to a run started at 0");
+}
+
 TEST_F(HardeningMisuse, AStepTooLongForCvodeIsDiscarded) {
   PlantFmu p;
   p.initialize();
@@ -564,25 +595,27 @@ TEST_F(HardeningMisuse, AStepPastTheStopTimeIsAnError) {
 }
 
 TEST_F(HardeningMisuse, TooManyRk4StepsAreRefusedBeforeAnyWork) {
-  PlantFmu p;
-  ASSERT_EQ(p.set_int("solver", 1), fmi2OK);
-  ASSERT_EQ(p.set("rk4_step", 1e-9), fmi2OK);
-  p.initialize();
-  for (int i = 1; i <= 4; ++i) ASSERT_EQ(p.set(force_name(i), kStaticForce), fmi2OK);
-  ASSERT_EQ(p.step(0.0, 1e-6), fmi2OK);
-  const std::vector<double> before = p.outputs();
-  fmi2FMUstate s = nullptr;
-  ASSERT_EQ(lib.fmi2GetFMUstate(p.c, &s), fmi2OK);
-  EXPECT_EQ(p.step(1e-6, 1.0), fmi2Error);  // 1e9 RK4 steps: about 40 minutes of computing
-  EXPECT_TRUE(p.log.contains("more than 1e+07")) << p.log.dump();
-  EXPECT_TRUE(bit_identical(p.outputs(), before)) << "readable in the Error state, unchanged";
-  ASSERT_EQ(lib.fmi2SetFMUstate(p.c, s), fmi2OK);
-  EXPECT_EQ(p.step(1e-6, 1e-6), fmi2OK);
-  lib.fmi2FreeFMUstate(p.c, &s);
-  table_row("RK4 with rk4_step = 1e-9 s, then fmi2DoStep(h = 1 s): 1e9 RK4 steps",
-            "fmi2Error at once, \"an interval of 1 s needs 1e+09 RK4 steps of rk4_step = 1e-09 s, more than 1e+07\" "
-            "(Error state)",
-            "yes: outputs bit-identical; fmi2SetFMUstate to a saved state and stepping go on");
+  // The smallest rk4_step its range allows (1e-6 s): a 20 s step needs 2e7
+  // RK4 steps, twice the work budget (1e7, about 25 s of computing).
+  PlantFmu p("refused"), twin("twin");
+  for (PlantFmu* q : {&p, &twin}) {
+    ASSERT_EQ(q->set_int("solver", 1), fmi2OK);
+    ASSERT_EQ(q->set("rk4_step", 1e-6), fmi2OK);
+    q->initialize();
+    drive(*q, 0.0);
+  }
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(0.0, 20.0), fmi2Error);
+  EXPECT_TRUE(p.log.contains("more than the work budget of 1e+07")) << p.log.dump();
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  // Usable as it was (no Reset, no SetFMUstate): the next step is the twin's.
+  ASSERT_EQ(p.step(0.0, 1e-3), fmi2OK) << p.log.dump();
+  ASSERT_EQ(twin.step(0.0, 1e-3), fmi2OK);
+  EXPECT_TRUE(bit_identical(p.outputs(), twin.outputs()));
+  table_row("RK4 with rk4_step = 1e-6 s (the smallest its range allows), then fmi2DoStep(h = 20 s): 2e7 RK4 steps",
+            "fmi2Error at once, \"a communication step of 20 s needs 2e+07 RK4 steps of rk4_step = 1e-06 s, more "
+            "than the work budget of 1e+07 per step ...; the call has no effect\"",
+            "yes: every variable bit-identical; the next step bit-identical to an untouched twin's");
 }
 
 TEST_F(HardeningMisuse, HugeFiniteInputsEndTheStepWithADiscard) {
@@ -661,6 +694,203 @@ TEST_F(HardeningMisuse, ForeignOrBrokenFmuStates) {
         for (unsigned char byte : junk) EXPECT_EQ(byte, 0);
         return s;
       });
+}
+
+/// The instance's current state, serialized.
+std::vector<fmi2Byte> serialized_state(FmuInstance& p) {
+  fmi2FMUstate st = nullptr;
+  std::size_t size = 0;
+  EXPECT_EQ(p.lib.fmi2GetFMUstate(p.c, &st), fmi2OK);
+  EXPECT_EQ(p.lib.fmi2SerializedFMUstateSize(p.c, st, &size), fmi2OK);
+  std::vector<fmi2Byte> bytes(size);
+  EXPECT_EQ(p.lib.fmi2SerializeFMUstate(p.c, st, bytes.data(), size), fmi2OK);
+  EXPECT_EQ(p.lib.fmi2FreeFMUstate(p.c, &st), fmi2OK);
+  return bytes;
+}
+
+/// A serialized state with the bytes at `at` replaced by `value` (a double,
+/// or the low 4 bytes of an integer when `u32`) and the checksum recomputed
+/// (fnv1a.hpp): a forgery that passes the header checks.
+std::vector<fmi2Byte> forge(std::vector<fmi2Byte> b, std::size_t at, double value, bool u32 = false) {
+  std::uint64_t bits = static_cast<std::uint64_t>(value);
+  if (!u32) std::memcpy(&bits, &value, 8);
+  for (int k = 0; k < (u32 ? 4 : 8); ++k) b[at + k] = static_cast<fmi2Byte>((bits >> (8 * k)) & 0xff);  // little-endian
+  const std::uint64_t h = pkm_fmi::fnv1a(reinterpret_cast<const unsigned char*>(b.data()), b.size() - 8);
+  for (int k = 0; k < 8; ++k) b[b.size() - 8 + k] = static_cast<fmi2Byte>((h >> (8 * k)) & 0xff);
+  return b;
+}
+
+// Issue 17.6: states with a valid checksum and absurd content. The layout
+// (fmu_state.cpp): a 32-byte header; mode (4), three flags (3), startTime,
+// stopTime, time, last successful time, time since start (8 each) from byte
+// 39; the count (4) and the stored variables (8 each) from byte 83; then the input
+// derivatives and the plant's part, which ends (before the 8-byte checksum)
+// with time (8), [pose; velocity] (64), the theta1 references (32), the
+// energy integrals (16) and the end-stop record (4).
+TEST_F(HardeningMisuse, ForgedFmuStatesWithAValidChecksumAreRefused) {
+  on_stepping_instance(
+      "fmi2DeSerializeFMUstate + fmi2SetFMUstate of states forged with a recomputed checksum: time = NaN, startTime "
+      "after the time, m_platform = -1, the plant's time = NaN, dx = 1e200 m/s, theta1 reference of leg 2 = 1e16 "
+      "rad or off by 1 rad, an end-stop record naming no stop",
+      fmi2Error,
+      "fmi2SetFMUstate: fmi2Error \"malformed FMU state (a time is not finite ...)\" / \"... outside its range\" / "
+      "\"beyond the physical bound 1000 m/s\" / \"theta1 reference ... is not the pose's theta1\"",
+      [&](PlantFmu& p, double) {
+        std::vector<fmi2Status> s;
+        const std::vector<fmi2Byte> bytes = serialized_state(p);
+        const std::size_t size = bytes.size(), end = size - 8;
+        std::size_t m_platform = 83;
+        for (std::size_t i = 0; i < p.def.n_variables; ++i) {
+          const pkm_fmi::Variable& v = p.def.variables[i];
+          if (std::string(v.name) == "m_platform") break;
+          if (v.stored_in_state()) m_platform += 8;
+        }
+        double theta1_2 = 0.0;
+        std::memcpy(&theta1_2, &bytes[end - 52 + 8], 8);
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        const struct {
+          std::size_t at;
+          double value;
+          const char* reason;
+          bool u32 = false;
+        } forgeries[] = {
+            {55, nan, "a time is not finite"},
+            {39, 1.0, "the time lies before startTime"},
+            {71, 5.0, "the time since startTime does not match the time"},
+            {m_platform, -1.0, "m_platform = -1, outside its range"},
+            {end - 124, nan, "not finite"},
+            {end - 84, 1e200, "beyond the physical bound"},
+            {end - 52 + 8, 1e16, "theta1 reference 10000000000000000 rad of leg 2"},
+            {end - 52 + 8, theta1_2 + 1.0, "of leg 2 is not the pose's theta1"},
+            {end - 4, 0xffff, "end-stop record", true},
+        };
+        // The control: the same bytes with the checksum recomputed restore.
+        {
+          double time = 0.0;
+          std::memcpy(&time, &bytes[55], 8);
+          fmi2FMUstate same = nullptr;
+          EXPECT_EQ(lib.fmi2DeSerializeFMUstate(p.c, forge(bytes, 55, time).data(), size, &same), fmi2OK);
+          EXPECT_EQ(lib.fmi2SetFMUstate(p.c, same), fmi2OK) << p.log.dump();
+          EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, &same), fmi2OK);
+        }
+        for (const auto& f : forgeries) {
+          SCOPED_TRACE(f.reason);
+          const std::vector<fmi2Byte> forged = forge(bytes, f.at, f.value, f.u32);
+          fmi2FMUstate st = nullptr;
+          EXPECT_EQ(lib.fmi2DeSerializeFMUstate(p.c, forged.data(), forged.size(), &st), fmi2OK);
+          const std::size_t logged = p.log.messages.size();
+          s.push_back(lib.fmi2SetFMUstate(p.c, st));
+          bool named = false;
+          for (std::size_t k = logged; k < p.log.messages.size(); ++k)
+            named = named || p.log.messages[k].text.find(f.reason) != std::string::npos;
+          EXPECT_TRUE(named) << p.log.dump();
+          EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, &st), fmi2OK);
+        }
+        return s;
+      });
+}
+
+// ---------------------------------------------------------------- the error policy
+
+// The error policy (README "Error policy", instance.hpp) as a table: each
+// refusal, its status, and what the instance can still do without Reset.
+// Errors found before anything changed leave the instance as it was,
+// wherever they come from (FMI 2.0.4 allows an importer to give up after
+// any fmi2Error; this FMU guarantees more). Discard leaves a valid
+// instance: StepFailed (Co-Simulation) until a saved state is restored or
+// the importer terminates, the inputs' domain for a get.
+TEST_F(HardeningMisuse, TheErrorPolicyAsATable) {
+  struct Row {
+    const char* refusal;
+    fmi2Status expected;
+    std::function<fmi2Status(PlantFmu&, double)> refuse;
+    const char* after;
+    std::function<void(PlantFmu&, double)> usable;
+  };
+  auto steps_on = [](PlantFmu& p, double t) {
+    drive(p, t);
+    ASSERT_EQ(p.step(t, 1e-3), fmi2OK) << p.log.dump();
+  };
+  const Row rows[] = {
+      {"fmi2SetReal(F[1] = NaN)", fmi2Error, [](PlantFmu& p, double) { return p.set("F[1]", std::nan("")); },
+       "unchanged, StepComplete: the next step", steps_on},
+      {"fmi2DoStep(h = -1 ms)", fmi2Error, [](PlantFmu& p, double t) { return p.step(t, -1e-3); },
+       "unchanged, StepComplete: the next step", steps_on},
+      {"fmi2DoStep past stopTime (10 s)", fmi2Error, [](PlantFmu& p, double t) { return p.step(t, 20.0); },
+       "unchanged, StepComplete: the next step", steps_on},
+      {"fmi2SetFMUstate(state with time = NaN, checksum recomputed)", fmi2Error,
+       [&](PlantFmu& p, double) {
+         const std::vector<fmi2Byte> forged = forge(serialized_state(p), 55, std::nan(""));
+         fmi2FMUstate bad = nullptr;
+         EXPECT_EQ(lib.fmi2DeSerializeFMUstate(p.c, forged.data(), forged.size(), &bad), fmi2OK);
+         const fmi2Status s = lib.fmi2SetFMUstate(p.c, bad);
+         lib.fmi2FreeFMUstate(p.c, &bad);
+         return s;
+       },
+       "unchanged, StepComplete: the next step", steps_on},
+      {"fmi2DoStep with F[3] = 1e300 N (the step cannot be completed)", fmi2Discard,
+       [](PlantFmu& p, double t) {
+         EXPECT_EQ(p.set("F[3]", 1e300), fmi2OK);
+         return p.step(t, 1e-3);
+       },
+       "StepFailed, state at fmi2LastSuccessfulTime: gets and status; fmi2DoStep and fmi2SetReal are Errors; a "
+       "saved state restored, the steps go on",
+       [&](PlantFmu& p, double t) {
+         EXPECT_TRUE(p.terminated());
+         EXPECT_EQ(p.last_successful_time(), t);
+         EXPECT_TRUE(all_finite(p.outputs()));
+         EXPECT_EQ(p.step(t, 1e-3), fmi2Error);
+         EXPECT_EQ(p.set("F[3]", kStaticForce), fmi2Error);
+         PlantFmu fresh("fresh");
+         fresh.initialize();
+         fmi2FMUstate home = nullptr;
+         ASSERT_EQ(lib.fmi2GetFMUstate(fresh.c, &home), fmi2OK);
+         ASSERT_EQ(lib.fmi2SetFMUstate(p.c, home), fmi2OK) << p.log.dump();
+         lib.fmi2FreeFMUstate(fresh.c, &home);
+         drive(p, 0.0);
+         EXPECT_EQ(p.step(0.0, 1e-3), fmi2OK) << p.log.dump();
+       }},
+  };
+  for (const Row& r : rows) {
+    SCOPED_TRACE(r.refusal);
+    PlantFmu p("policy");
+    ASSERT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 0.0, fmi2True, 10.0), fmi2OK);  // stopTime 10 s
+    ASSERT_EQ(p.enter(), fmi2OK);
+    ASSERT_EQ(p.exit(), fmi2OK);
+    double t = 0.0;
+    for (int k = 0; k < 3; ++k, t += 1e-3) steps_on(p, t);
+    const std::size_t logged = p.log.messages.size();
+    EXPECT_EQ(r.refuse(p, t), r.expected) << p.log.dump();
+    EXPECT_GT(p.log.messages.size(), logged) << "every refusal comes with its reason";
+    r.usable(p, t);
+    table_row(std::string("error policy: ") + r.refusal,
+              r.expected == fmi2Error ? "fmi2Error, reason logged" : "fmi2Discard, reason logged", r.after);
+  }
+  // Initialisation refused: still in initialization mode, the parameter can be corrected.
+  PlantFmu p("policy");
+  ASSERT_EQ(p.set("l", 0.0), fmi2OK);
+  ASSERT_EQ(p.setup(), fmi2OK);
+  ASSERT_EQ(p.enter(), fmi2OK);
+  EXPECT_EQ(p.exit(), fmi2Error);
+  EXPECT_TRUE(p.log.contains("l = 0 must be positive")) << p.log.dump();
+  ASSERT_EQ(p.set("l", 0.08), fmi2OK) << p.log.dump();
+  ASSERT_EQ(p.exit(), fmi2OK) << p.log.dump();
+  steps_on(p, 0.0);
+  table_row("error policy: fmi2ExitInitializationMode with l = 0", "fmi2Error, reason logged",
+            "InitializationMode: the parameter corrected, fmi2ExitInitializationMode succeeds (no fmi2Reset)");
+  // The inverse FMU: a get beyond a singularity guard.
+  InverseFmu inv;
+  inv.initialize();
+  const std::vector<double> good = inv.outputs();
+  ASSERT_EQ(inv.set("x", 0.0231306807897694 * (1.0 - 1e-9)), fmi2OK);  // leg 2's rod within 3e-5 rad of horizontal
+  const fmi2ValueReference F1 = inv.vr("F[1]");
+  double f = 0.0;
+  EXPECT_EQ(inv.lib.fmi2GetReal(inv.c, &F1, 1, &f), fmi2Discard) << inv.log.dump();
+  EXPECT_EQ(f, good[0]);
+  ASSERT_EQ(inv.set("x", 0.0), fmi2OK);
+  EXPECT_TRUE(bit_identical(inv.outputs(), good));
+  table_row("error policy: inverse fmi2GetReal at a pose beyond a singularity guard", "fmi2Discard, reason logged",
+            "the last good outputs handed out; inputs within the guards: fmi2OK again");
 }
 
 TEST_F(HardeningMisuse, StatesLeftBehindAreFreedWithTheInstance) {

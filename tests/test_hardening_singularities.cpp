@@ -7,11 +7,14 @@
 // fmi2GetBooleanStatus(fmi2Terminated) = fmi2True, finite outputs within
 // the limits, a message naming the leg or the condition number, and the
 // instance recoverable through a saved FMU state. fmpy, as a master, then
-// stops at the last successful time.
+// stops at the last successful time. The inverse FMU, asked for a pose
+// beyond the same guards, answers fmi2Discard with its last good outputs.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -19,6 +22,7 @@
 
 #include "fmu_loader.hpp"
 #include "hardening_table.hpp"
+#include "reference_model.hpp"
 
 namespace {
 
@@ -235,6 +239,118 @@ TEST(HardeningSingularities, AStepThatLeavesTheWorkspaceEntirelyIsDiscardedToo) 
                   (solver == 0 ? std::string("CVODE ... corrector convergence test failed") :
                                  std::string("the RK4 step ... could not be evaluated: pose unreachable")) + "\")",
               "yes: outputs bit-identical to the step start, finite");
+  }
+}
+
+// ---------------------------------------------------------------- the inverse FMU
+
+/// The guards' quantities of a pose from MODEL_SPEC's closed-form leg
+/// inverse kinematics alone: with d = p + Rz(phi) r_Qi - B_i and
+/// A^2 = d_x^2 + d_y^2 - h'^2 (invariant to Rz(beta_i)), cos theta2 = A / l
+/// and rho = z - h + sqrt(l^2 - A^2) (elbow-down), so
+/// d rho / du = -(d A^2 / du) / (2 sqrt(l^2 - A^2)).
+struct SpecGuards {
+  double leg_measure_min = 1.0;  // min |cos theta2 sin theta2|
+  int leg = -1;                  // where (1-based)
+  double condition = 0.0;        // of d rho / d(x, y, z, phi / 0.1 m)
+};
+
+SpecGuards spec_guards(double x, double y, double phi) {
+  const ref::RefParams p;
+  SpecGuards g;
+  Eigen::Matrix4d J;
+  for (int i = 0; i < 4; ++i) {
+    const double ax = p.r_Q * std::cos(p.beta[i] + p.gamma[i] + phi), ay = p.r_Q * std::sin(p.beta[i] + p.gamma[i] + phi);
+    const double dx = x + ax - p.r_b * std::cos(p.beta[i]), dy = y + ay - p.r_b * std::sin(p.beta[i]);
+    const double A2 = dx * dx + dy * dy - p.h_prime * p.h_prime;
+    const double c2 = std::sqrt(A2) / p.l, s2 = std::sqrt(1.0 - c2 * c2);
+    if (c2 * s2 < g.leg_measure_min) {
+      g.leg_measure_min = c2 * s2;
+      g.leg = i + 1;
+    }
+    const double r = std::sqrt(p.l * p.l - A2);
+    J.row(i) << -dx / r, -dy / r, 1.0, -(dy * ax - dx * ay) / r / 0.1;
+  }
+  const Eigen::Vector4d sv = Eigen::JacobiSVD<Eigen::Matrix4d>(J).singularValues();
+  g.condition = sv[0] / sv[3];
+  return g;
+}
+
+// Issue 17.1: leg 2's rod turns horizontal at x = 0.0231306807897694 m
+// (y = 0, z = 0.05 m, phi = 0); with dx = 0.01 m/s the inverse FMU used to
+// answer fmi2OK with forces of -1.1e19 N. Approaching that pose along x,
+// every answer must follow the guards as computed from the spec: OK with
+// leg_measure_min and jacobian_condition equal to the spec's within the
+// limits, fmi2Discard with the reason and the last good outputs beyond.
+TEST(HardeningSingularities, InverseFmuDiscardsPosesBeyondTheGuardsWithTheLastGoodOutputs) {
+  const double x_singular = 0.0231306807897694;
+  struct Case {
+    double max_condition, min_measure;
+  };
+  // The defaults, and the parallel-singularity guard lowered so that it acts first.
+  for (const Case& c : {Case{1e3, 1e-2}, Case{40.0, 1e-2}}) {
+    SCOPED_TRACE("max_jacobian_condition = " + std::to_string(c.max_condition));
+    InverseFmu inv;
+    ASSERT_EQ(inv.set("max_jacobian_condition", c.max_condition), fmi2OK);
+    ASSERT_EQ(inv.set("min_leg_measure", c.min_measure), fmi2OK);
+    ASSERT_EQ(inv.set("rho_min", -1.0), fmi2OK);  // slider 2 passes its lower stop near x = 0.022 m
+    inv.initialize();
+    ASSERT_EQ(inv.set("dx", 0.01), fmi2OK);
+    const std::vector<fmi2ValueReference> vrs = inv.reals(pkm_fmi::Causality::Output);
+    const std::size_t i_measure = std::find(vrs.begin(), vrs.end(), inv.vr("leg_measure_min")) - vrs.begin();
+    const std::size_t i_condition = std::find(vrs.begin(), vrs.end(), inv.vr("jacobian_condition")) - vrs.begin();
+    std::vector<double> good;
+    int ok = 0, discarded = 0;
+    std::set<std::string> reasons;
+    double worst_force = 0.0;
+    for (int k = 0; k <= 28; ++k) {
+      // x = x_singular (1 - 10^(-k/4)): from home to 1e-7 of the singular pose.
+      const double x = k == 0 ? 0.0 : x_singular * (1.0 - std::pow(10.0, -k / 4.0));
+      const SpecGuards g = spec_guards(x, 0.0, 0.0);
+      const bool beyond = g.leg_measure_min < c.min_measure || g.condition > c.max_condition;
+      if (std::fabs(g.leg_measure_min / c.min_measure - 1.0) < 1e-6 ||
+          std::fabs(g.condition / c.max_condition - 1.0) < 1e-6)
+        continue;  // on a limit: either answer is right
+      ASSERT_EQ(inv.set("x", x), fmi2OK);
+      std::vector<double> out(vrs.size(), 12345.0);
+      const std::size_t logged = inv.log.messages.size();
+      const fmi2Status st = inv.lib.fmi2GetReal(inv.c, vrs.data(), vrs.size(), out.data());
+      if (!beyond) {
+        ASSERT_EQ(st, fmi2OK) << "x = " << x << "\n" << inv.log.dump();
+        EXPECT_NEAR(out[i_measure], g.leg_measure_min, 1e-12) << "x = " << x;
+        EXPECT_NEAR(out[i_condition], g.condition, 1e-9 * g.condition) << "x = " << x;
+        for (int i = 1; i <= 4; ++i) worst_force = std::max(worst_force, std::fabs(inv.get(force_name(i))));
+        good = out;
+        ++ok;
+      } else {
+        ASSERT_EQ(st, fmi2Discard) << "x = " << x << ": leg measure " << g.leg_measure_min << ", condition "
+                                   << g.condition << "\n" << inv.log.dump();
+        ASSERT_GT(inv.log.messages.size(), logged);
+        EXPECT_EQ(inv.log.messages.back().category, "logStatusDiscard");
+        // The leg guard is checked first.
+        const std::string reason = g.leg_measure_min < c.min_measure
+                                       ? "leg " + std::to_string(g.leg) + " is at a leg singularity"
+                                       : "parallel singularity: the condition number";
+        EXPECT_NE(inv.log.last().find(reason), std::string::npos) << inv.log.last();
+        reasons.insert(reason);
+        EXPECT_TRUE(bit_identical(out, good)) << "x = " << x << ": not the last good outputs";
+        ++discarded;
+      }
+    }
+    EXPECT_GT(ok, 3);
+    EXPECT_GT(discarded, 3);
+    // Usable again: at rest at home, the static forces.
+    ASSERT_EQ(inv.set("x", 0.0), fmi2OK);
+    ASSERT_EQ(inv.set("dx", 0.0), fmi2OK);
+    for (int i = 1; i <= 4; ++i) EXPECT_NEAR(inv.get(force_name(i)), kStaticForce, 1e-9);
+    ASSERT_EQ(inv.step(0.0, 1e-3), fmi2OK) << inv.log.dump();
+    std::string said;
+    for (const std::string& r : reasons) said += (said.empty() ? "\"" : "\" / \"") + r + " ...";
+    table_row(std::string("inverse FMU, dx = 0.01 m/s, x -> 0.0231306807897694 m (leg 2's rod horizontal); "
+                          "max_jacobian_condition = ") + std::to_string(c.max_condition),
+              std::to_string(ok) + " poses within the guards fmi2OK (|F| <= " + std::to_string(worst_force) +
+                  " N), " + std::to_string(discarded) + " beyond fmi2Discard " + said + "\"",
+              "yes: the last good outputs handed out again; back home the static forces");
   }
 }
 

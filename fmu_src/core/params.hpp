@@ -54,6 +54,20 @@ struct Params {
   double payload_Izz = 0.0;                  // kg*m^2, >= 0
 };
 
+/// Physical ranges of the parameters: validate() and the FMUs' variable
+/// table (the modelDescription's min/max) use these same numbers. A machine
+/// of this kind spans decimetres; these bounds leave room for any real one
+/// and refuse what only overflows (g = 1e300 made the first step's size NaN).
+constexpr double kMaxLength = 10.0;     // m: lengths, |rho_min|, |rho_max|, |payload_com|, screw_lead
+constexpr double kMaxMass = 1e4;        // kg
+constexpr double kMaxInertia = 1e4;     // kg*m^2
+constexpr double kMaxGravity = 1e3;     // m/s^2, |g| (100 times the earth's)
+constexpr double kMaxAngle = 10.0 * kPi; // rad, |beta_i|, |gamma_i|
+constexpr double kMaxForce = 1e6;       // N: friction_coulomb
+constexpr double kMaxDamping = 1e6;     // N*s/m: friction_viscous, stop_damping
+constexpr double kMaxStiffness = 1e9;   // N/m: stop_stiffness
+constexpr double kMaxSlipSpeed = 10.0;  // m/s: friction_velocity
+
 /// Checks every parameter. Returns an empty string when they are valid,
 /// otherwise a message that names the offending parameter and its value.
 std::string validate(const Params& p);

@@ -48,6 +48,10 @@ double event_time_tolerance(double t) { return 1e-12 + 8.0 * std::numeric_limits
 // CVODE: at most this many roots in one advance.
 constexpr int kMaxEventsPerAdvance = 100000;
 
+// |theta1| of a leg never comes near this: the closed form gives
+// |theta1| < 2 pi, and the legs keep the platform from turning a whole turn.
+constexpr double kMaxTheta1 = 8.0 * kPi;
+
 double unwrap_near(double angle, double ref) {
   constexpr double two_pi = 2.0 * kPi;
   return angle + two_pi * std::round((ref - angle) / two_pi);
@@ -66,12 +70,17 @@ std::string validate(const SolverSettings& s) {
     std::snprintf(buf, sizeof buf, "rk4_step = %.17g s must be positive and finite", s.rk4_step);
     return buf;
   }
+  if (!(s.rk4_step >= kMinRk4Step && s.rk4_step <= kMaxRk4Step)) {
+    std::snprintf(buf, sizeof buf, "rk4_step = %.17g s lies outside its range [%g, %g] s", s.rk4_step, kMinRk4Step,
+                  kMaxRk4Step);
+    return buf;
+  }
   if (!(s.rtol > 0.0) || !(s.rtol < 1.0)) {
     std::snprintf(buf, sizeof buf, "rtol = %.17g must lie in (0, 1)", s.rtol);
     return buf;
   }
-  if (!(s.atol > 0.0) || !std::isfinite(s.atol)) {
-    std::snprintf(buf, sizeof buf, "atol = %.17g must be positive and finite", s.atol);
+  if (!(s.atol > 0.0) || !(s.atol <= 1.0)) {
+    std::snprintf(buf, sizeof buf, "atol = %.17g must be positive and at most 1", s.atol);
     return buf;
   }
   if (s.cvode_method != CvodeMethod::Adams && s.cvode_method != CvodeMethod::BDF)
@@ -135,12 +144,30 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
 }
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
-  if (!std::isfinite(t) || !y.allFinite() || !theta1_ref.allFinite()) return Status::NonFinite;
+  if (!std::isfinite(t) || !y.allFinite() || !theta1_ref.allFinite()) {
+    error_ = "the time, state or theta1 references are not finite";
+    return Status::NonFinite;
+  }
   Status s = guard(y, t);
   if (s != Status::Ok) return s;
   Vec16 q, qd;
   s = expand_state(model_, y, q, qd);
   if (s != Status::Ok) return s;
+  // theta1 is continuous, never wrapped, but cannot wind: the references
+  // are the pose's closed-form angles up to whole turns, within a few turns.
+  for (int i = 0; i < kLegs; ++i) {
+    const double th1 = q[leg_offset(i) + 1];
+    const bool near = std::fabs(unwrap_near(th1, theta1_ref[i]) - theta1_ref[i]) <= 1e-9;
+    if (!(std::fabs(theta1_ref[i]) <= kMaxTheta1) || !near) {
+      char buf[240];
+      std::snprintf(buf, sizeof buf,
+                    "the theta1 reference %.17g rad of leg %d is not the pose's theta1 = %.17g rad modulo 2 pi "
+                    "(within %g rad)",
+                    theta1_ref[i], i + 1, th1, kMaxTheta1);
+      error_ = buf;
+      return Status::InvalidArgument;
+    }
+  }
   t_ = t;
   y_ = y;
   theta1_ref_ = theta1_ref;
@@ -303,18 +330,30 @@ int Plant::cvode_rhs(double t, const Vec10& y, Vec10& ydot, void* self) {
 }
 
 Status Plant::guard(const Vec8& y, double t) {
+  char at[64];
+  std::snprintf(at, sizeof at, "at t = %.17g s: ", t);
+  const double speed = std::max(y.segment<3>(4).cwiseAbs().maxCoeff(), kConditionLength * std::fabs(y[7]));
+  if (!(speed <= kMaxSpeed)) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "the platform moves at %.6g m/s (|dx|, |dy|, |dz| or 0.1 m |dphi|), beyond the physical bound "
+                  "%g m/s",
+                  speed, kMaxSpeed);
+    error_ = at + std::string(buf);
+    return Status::SolverFailure;
+  }
   GuardReport report;
   const Status s = check_configuration(model_, y.head<4>(), settings_.limits(), &report);
   if (s == Status::Ok) return s;
-  char at[64];
-  std::snprintf(at, sizeof at, "at t = %.17g s: ", t);
   error_ = at + describe_configuration_failure(model_, y.head<4>(), settings_.limits(), report);
   return s;
 }
 
+double rk4_steps_for(double span, double rk4_step) { return std::ceil(span / rk4_step - 1e-9); }
+
 Status Plant::advance_rk4(double t_end) {
   const double span = t_end - t_;
-  const double steps = std::ceil(span / settings_.rk4_step - 1e-9);
+  const double steps = rk4_steps_for(span, settings_.rk4_step);
   if (!(steps <= kMaxRk4StepsPerAdvance)) {  // also NaN
     char buf[200];
     std::snprintf(buf, sizeof buf,

@@ -29,10 +29,25 @@ struct SolverSettings {
   GuardLimits limits() const { return {max_jacobian_condition, min_leg_measure}; }
 };
 
+/// The range of rk4_step (s): a thousandth of the paper's 1 ms resolves the
+/// stiffest default dynamics (the end stops ring at about 6 ms) many times
+/// over; above 1 s RK4 says nothing about this machine.
+constexpr double kMinRk4Step = 1e-6, kMaxRk4Step = 1.0;
+
 /// At most this many RK4 steps in one advance (a longer interval or a
 /// smaller rk4_step is refused with Status::InvalidArgument before any
 /// work: about 25 s of computing at 2.5 us per step).
 constexpr double kMaxRk4StepsPerAdvance = 1e7;
+/// How many RK4 steps an advance over `span` takes (whole steps no longer
+/// than rk4_step); compare with kMaxRk4StepsPerAdvance before any work.
+double rk4_steps_for(double span, double rk4_step);
+
+/// The fastest the platform can move: |dx|, |dy|, |dz| and 0.1 m * |dphi|
+/// at most 1e3 m/s, a fifth of the speed of sound in steel (a rigid-body
+/// model of a 0.1 m machine means nothing faster). Checked with the
+/// singularity guards: a step ending faster is undone (SolverFailure), an
+/// initial velocity or a restored state faster is refused.
+constexpr double kMaxSpeed = 1e3;
 
 /// Returns "" if the settings are usable, otherwise a message naming the
 /// offending setting.
@@ -114,8 +129,10 @@ class Plant {
   /// The integrated state [pose; velocity].
   const Vec8& state() const { return y_; }
   /// Restores a state saved earlier (time, y, theta1 continuity); refused
-  /// (nothing changes) if y lies beyond the singularity limits. The energy
-  /// integrals keep their values unless given.
+  /// (nothing changes, last_error() says why) if y lies beyond the
+  /// singularity limits or kMaxSpeed, or theta1_ref is not the pose's
+  /// closed-form theta1 (modulo 2 pi). The energy integrals keep their
+  /// values unless given.
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref);
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e);
 

@@ -60,6 +60,8 @@ template <class Body>
 fmi2Status call(fmi2Component c, const char* function, Body&& body) {
   Instance* inst = Instance::from(c, definition(), 2);
   if (!inst) return fmi2Error;  // no instance of this FMU: nobody to log to
+  const Instance::Busy busy(*inst);
+  if (!busy) return to_fmi2(inst->concurrent_call(function));
   try {
     return to_fmi2(body(*inst));
   } catch (const std::exception& e) {

@@ -36,6 +36,8 @@ template <class Body>
 fmi3Status call(fmi3Instance c, const char* function, Body&& body) {
   Instance* inst = Instance::from(c, definition(), 3);
   if (!inst) return fmi3Error;  // no instance of this FMU: nobody to log to
+  const Instance::Busy busy(*inst);
+  if (!busy) return to_fmi3(inst->concurrent_call(function));
   try {
     return to_fmi3(body(*inst));
   } catch (const std::exception& e) {

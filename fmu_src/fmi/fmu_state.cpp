@@ -1,5 +1,6 @@
 #include "fmu_state.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -13,7 +14,7 @@ namespace {
 
 constexpr std::uint64_t kStateTag = 0x53324d464d4b5002ull;  // marks a live SavedState
 constexpr unsigned char kMagic[8] = {'P', 'K', 'M', 'F', 'M', 'U', 'S', 'T'};
-constexpr std::uint32_t kFormatVersion = 3;  // 3: the plant's energy integrals and end-stop contacts
+constexpr std::uint32_t kFormatVersion = 4;  // 3: the plant's energy integrals and end-stop contacts; 4: elapsed
 constexpr std::size_t kHeaderSize = 32;
 constexpr std::size_t kTrailerSize = 8;
 
@@ -83,6 +84,7 @@ void Instance::save(std::vector<unsigned char>& out) const {
   w.f64(stop_time_);
   w.f64(time_);
   w.f64(last_successful_time_);
+  w.f64(elapsed_);
   w.u32(stored_count(def_));
   for (std::size_t i = 0; i < def_.n_variables; ++i) {
     const Variable& v = def_.variables[i];
@@ -130,6 +132,29 @@ bool Instance::check_header(const unsigned char* bytes, std::size_t size, const 
   return true;
 }
 
+bool Instance::times_consistent(double start, bool stop_defined, double stop, double time, double last_successful,
+                                double elapsed, const char* function) {
+  const char* why = nullptr;
+  if (!std::isfinite(start) || !std::isfinite(stop) || !std::isfinite(time) || !std::isfinite(last_successful) ||
+      !std::isfinite(elapsed))
+    why = "a time is not finite";
+  else if (stop_defined && !(stop >= start))
+    why = "stopTime lies before startTime";
+  else if (interface_ == Interface::CoSimulation && !(time >= start && last_successful >= start))
+    why = "the time lies before startTime";
+  else if (interface_ == Interface::CoSimulation && stop_defined &&
+           time > stop + 1e-9 * std::max(1.0, std::abs(stop)))
+    why = "the time lies past stopTime";
+  else if (interface_ == Interface::CoSimulation &&
+           !(std::abs(start + elapsed - time) <= 1e-9 * std::max(1.0, std::abs(time))))
+    why = "the time since startTime does not match the time";
+  if (!why) return true;
+  log_.error("%s: malformed FMU state (%s: startTime = %.17g, stopTime = %.17g%s, time = %.17g, last successful "
+             "time = %.17g); nothing changed",
+             function, why, start, stop, stop_defined ? "" : " (undefined)", time, last_successful);
+  return false;
+}
+
 bool Instance::load(const std::vector<unsigned char>& bytes, const char* function) {
   if (!check_header(bytes.data(), bytes.size(), function)) return false;
   StateReader r(bytes.data() + kHeaderSize, bytes.size() - kHeaderSize - kTrailerSize);
@@ -141,6 +166,7 @@ bool Instance::load(const std::vector<unsigned char>& bytes, const char* functio
   const double stop_time = r.f64();
   const double time = r.f64();
   const double last_time = r.f64();
+  const double elapsed = r.f64();
   const std::uint32_t count = r.u32();
   const std::uint32_t expected = stored_count(def_);
   if (!r.ok() || count != expected || !(mode & kRestorableModes) || (mode & (mode - 1)) != 0) {
@@ -153,6 +179,7 @@ bool Instance::load(const std::vector<unsigned char>& bytes, const char* functio
     return false;
   }
   // Read every value before changing anything.
+  std::size_t k = 0;
   std::vector<double> values;
   values.reserve(count);
   for (std::size_t i = 0; i < def_.n_variables; ++i) {
@@ -175,16 +202,30 @@ bool Instance::load(const std::vector<unsigned char>& bytes, const char* functio
     log_.error("%s: malformed FMU state (truncated)", function);
     return false;
   }
-  for (double x : values) {
-    if (!std::isfinite(x)) {
-      log_.error("%s: malformed FMU state (a non-finite value)", function);
+  // Every field as a setter or a step would have checked it: a state with a
+  // valid checksum may still have been forged.
+  if (!times_consistent(start_time, stop_defined, stop_time, time, last_time, elapsed, function)) return false;
+  k = 0;
+  for (std::size_t i = 0; i < def_.n_variables; ++i) {
+    const Variable& v = def_.variables[i];
+    if (!v.stored_in_state()) continue;
+    const double x = values[k++];
+    if (!std::isfinite(x) || !(x >= v.min && x <= v.max)) {
+      log_.error("%s: malformed FMU state (%s = %.17g, outside its range [%.17g, %.17g]); nothing changed",
+                 function, v.name, x, v.min, v.max);
+      return false;
+    }
+  }
+  for (; k < values.size(); ++k) {
+    if (!std::isfinite(values[k])) {
+      log_.error("%s: malformed FMU state (a non-finite input derivative); nothing changed", function);
       return false;
     }
   }
   // Commit, keeping a copy of the current state to fall back to.
   std::vector<unsigned char> backup;
   save(backup);
-  std::size_t k = 0;
+  k = 0;
   for (std::size_t i = 0; i < def_.n_variables; ++i) {
     const Variable& v = def_.variables[i];
     if (v.stored_in_state()) write_from_double(*data_, v, values[k++]);
@@ -201,6 +242,7 @@ bool Instance::load(const std::vector<unsigned char>& bytes, const char* functio
   stop_time_ = stop_time;
   time_ = time;
   last_successful_time_ = last_time;
+  elapsed_ = elapsed;
   valid_groups_ = 0;
   data_->reset();
   Context ctx = context();

@@ -75,6 +75,13 @@ Status Instance::internal_error(const char* function, const char* what) {
   return Status::Error;
 }
 
+Status Instance::concurrent_call(const char* function) {
+  log_.error("%s: called while another call on this instance is running (from another thread?): an instance must "
+             "be used by one thread at a time; the call has no effect",
+             function);
+  return Status::Error;
+}
+
 Status Instance::not_supported(const char* function, const char* why) {
   if (!allowed(kAlive, function)) return Status::Error;
   log_.error("%s: not supported by %s: %s; the call has no effect", function, def_.identifier, why);
@@ -115,15 +122,18 @@ Status Instance::set_debug_logging(bool on, std::size_t n, const char* const cat
     return Status::Error;
   }
   // Check every name before changing anything.
+  bool named[kLogCategoryCount] = {};
   for (std::size_t k = 0; k < n; ++k) {
-    if (log_category(categories[k]) < 0) {
+    const int c = log_category(categories[k]);
+    if (c < 0) {
       log_.error("%s: unknown log category \"%s\" (known: logEvents, logStatusWarning, logStatusDiscard, "
                  "logStatusError, logStatusFatal, logCalls); nothing changed",
                  fn, categories[k] ? categories[k] : "(NULL)");
       return Status::Error;
     }
+    named[c] = true;
   }
-  for (std::size_t k = 0; k < n; ++k) log_.enable(static_cast<LogCategory>(log_category(categories[k])), on);
+  log_.select(named, on);
   return Status::OK;
 }
 
@@ -156,8 +166,9 @@ Status Instance::enter_initialization_mode() {
   if (!allowed(kMaskEnterInitialization, fn)) return Status::Error;
   mode_ = kInitializationMode;
   time_ = last_successful_time_ = start_time_;
+  elapsed_ = 0.0;
   valid_groups_ = 0;
-  data_->set_time(start_time_);
+  data_->set_time(0.0);
   log_.event("%s: initialization mode at t = %.17g", fn, start_time_);
   return Status::OK;
 }
@@ -171,11 +182,14 @@ Status Instance::exit_initialization_mode() {
   if (succeeded(s)) {
     mode_ = interface_ == Interface::CoSimulation ? kStepMode : kEventMode;
     time_ = last_successful_time_ = start_time_;
+    elapsed_ = 0.0;
     terminated_ = false;
     log_.event("%s: initialised at t = %.17g, now in %s", fn, start_time_, mode_name(mode_));
     return s;
   }
-  mode_ = s == Status::Fatal ? kFatal : kError;
+  // Refused (the parameters cannot be used, reason logged): nothing changed,
+  // still in initialization mode, where the parameters can be corrected.
+  if (s == Status::Fatal) mode_ = kFatal;
   return s == Status::Fatal ? Status::Fatal : Status::Error;
 }
 
@@ -194,7 +208,7 @@ Status Instance::reset() {
   data_->reset();
   input_derivatives_set_ = false;
   mode_ = kInstantiated;
-  start_time_ = stop_time_ = time_ = last_successful_time_ = 0.0;
+  start_time_ = stop_time_ = time_ = last_successful_time_ = elapsed_ = 0.0;
   stop_time_defined_ = false;
   terminated_ = false;
   valid_groups_ = 0;

@@ -2,13 +2,18 @@
 // FMI function as a method over the model's table and hooks. The thin front
 // ends (fmi2_functions.cpp, fmi3_functions.cpp) translate the C calls.
 //
-// Error policy: a call with wrong arguments or in the wrong state returns
-// Error with a logged message and has no effect (the instance stays as it
-// was). A failure of the model itself (initialisation impossible, a step
-// failed beyond recovery) returns Error and puts the instance in the Error
-// state: then only get, reset, free and the FMU state functions are allowed
-// (SetFMUState may return to a saved good state). A step that cannot be
-// completed returns Discard with the state kept at the last good time.
+// Error policy (README "Error policy"): every check runs before anything
+// changes. A call with wrong arguments or in the wrong state, parameters
+// that cannot be used (ExitInitializationMode: the instance stays in
+// initialization mode, where they can be corrected), a step beyond the work
+// budget or an FMU state that cannot be used returns Error with a logged
+// message and has no effect: the instance stays as it was and usable. Only
+// a failure in the middle of a computation (a step failed beyond recovery,
+// an internal error) puts the instance in the Error state: then only get,
+// reset, free and the FMU state functions are allowed (SetFMUState may
+// return to a saved good state). A step that cannot be completed returns
+// Discard with the state kept at the last good time; a get whose inputs lie
+// outside the model's domain returns Discard with the last good outputs.
 //
 // Implementation, one concern per file: instance.cpp (creation, state
 // machine, initialisation, termination, reset, logging setup),
@@ -16,6 +21,7 @@
 // serialisation), stepping.cpp (Co-Simulation), model_exchange.cpp.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -123,6 +129,25 @@ class Instance {
   /// Turns an exception escaping a method into Error (never across the C ABI).
   Status internal_error(const char* function, const char* what);
 
+  /// One call at a time: FMI does not allow an instance to be used from two
+  /// threads at once. A call that finds another one running answers
+  /// concurrent_call() (Error, no effect) instead of racing it.
+  class Busy {
+   public:
+    explicit Busy(Instance& i) : i_(i), entered_(!i.busy_.exchange(true, std::memory_order_acquire)) {}
+    ~Busy() {
+      if (entered_) i_.busy_.store(false, std::memory_order_release);
+    }
+    Busy(const Busy&) = delete;
+    Busy& operator=(const Busy&) = delete;
+    explicit operator bool() const { return entered_; }
+
+   private:
+    Instance& i_;
+    bool entered_;
+  };
+  Status concurrent_call(const char* function);
+
   const ModelDefinition& definition() const { return def_; }
   std::uint32_t mode() const { return mode_; }
   Interface interface() const { return interface_; }
@@ -152,6 +177,9 @@ class Instance {
   SavedState* new_state();
   void save(std::vector<unsigned char>& out) const;
   bool check_header(const unsigned char* bytes, std::size_t size, const char* function);
+  /// The times of a state being loaded: finite and in order (else logged).
+  bool times_consistent(double start, bool stop_defined, double stop, double time, double last_successful,
+                        double elapsed, const char* function);
   bool load(const std::vector<unsigned char>& bytes, const char* function);
 
   std::uint64_t tag_;  // identifies a live Instance of this version behind a handle
@@ -166,11 +194,16 @@ class Instance {
   double stop_time_ = 0.0;
   bool stop_time_defined_ = false;
   double time_ = 0.0;                   // current time (CS: communication point)
+  // Time since startTime, the model's time: summed from the step sizes, so
+  // that the motion does not depend on startTime (at 1e9 s, t + 1 ms rounds
+  // to 0.12 us: 7e-5 s lost over 1 s when the model integrated t + h - t).
+  double elapsed_ = 0.0;
   double last_successful_time_ = 0.0;   // CS
   bool terminated_ = false;             // CS: set after a discarded step
   unsigned valid_groups_ = 0;           // output groups (Variable::group) up to date
   bool input_derivatives_set_ = false;  // SetRealInputDerivatives was used (or a state restored)
   std::unordered_set<SavedState*> states_;  // FMU states this instance created and nobody freed yet
+  std::atomic<bool> busy_{false};           // a call is running (Busy)
 
  public:
   /// Forgets a state freed through any instance (FreeFMUState).

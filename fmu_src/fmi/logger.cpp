@@ -20,11 +20,15 @@ Logger::Logger(LogEmitter emit, void* callback, void* env, std::string instance_
 
 void Logger::set_default(bool logging_on) {
   for (bool& b : on_) b = false;
-  enable(LogCategory::StatusWarning, true);
-  enable(LogCategory::StatusDiscard, true);
-  enable(LogCategory::StatusError, true);
-  enable(LogCategory::StatusFatal, true);
-  enable(LogCategory::Events, logging_on);
+  for (LogCategory c : {LogCategory::StatusWarning, LogCategory::StatusDiscard, LogCategory::StatusError,
+                        LogCategory::StatusFatal})
+    on_[static_cast<unsigned>(c)] = true;
+  on_[static_cast<unsigned>(LogCategory::Events)] = logging_on;
+}
+
+void Logger::select(const bool (&named)[kLogCategoryCount], bool on) {
+  for (int c = 0; c < kLogCategoryCount; ++c)
+    if (on || named[c]) on_[c] = on && named[c];
 }
 
 void Logger::vlog(Status status, LogCategory c, const char* fmt, va_list args) {

@@ -8,14 +8,20 @@
 //   logStatusFatal    the reason of every Fatal
 //   logCalls          every FMI call with its arguments (verbose; only when named)
 //
-// One rule for instantiation and fmiXSetDebugLogging:
+// One rule for instantiation and fmiXSetDebugLogging (FMI 2.0.4 section
+// 2.1.5, FMI 3.0 fmi3SetDebugLogging):
 //   - logging off (loggingOn = false, or SetDebugLogging(false) with no
 //     category named): the four logStatus* categories only, so that a status
 //     other than OK always comes with its reason;
 //   - logging on with no category named (loggingOn = true, or
 //     SetDebugLogging(true) with no category named): those and logEvents;
-//   - categories named: exactly those are switched on or off, the others
-//     keep their setting. logCalls is on only when named.
+//   - SetDebugLogging(true, categories): exactly the named categories, the
+//     others off ("only debug messages according to the categories");
+//   - SetDebugLogging(false, categories): the named categories off, the
+//     others keep their setting.
+// logCalls is on only when named. Whatever the setting, the reason of an
+// Error or a Fatal reaches the importer: switching debug logging off does not
+// hide why an instance became unusable.
 #pragma once
 
 #include <cstdarg>
@@ -57,10 +63,14 @@ class Logger {
   Logger() = default;
   Logger(LogEmitter emit, void* callback, void* env, std::string instance_name, bool logging_on);
 
-  bool enabled(LogCategory c) const { return callback_ && on_[static_cast<unsigned>(c)]; }
+  bool enabled(LogCategory c) const {
+    return callback_ && (on_[static_cast<unsigned>(c)] || c == LogCategory::StatusError || c == LogCategory::StatusFatal);
+  }
   /// The default set of categories for logging on or off (see above).
   void set_default(bool logging_on);
-  void enable(LogCategory c, bool on) { on_[static_cast<unsigned>(c)] = on; }
+  /// Categories named in SetDebugLogging (see above): on = true selects
+  /// exactly `named`, on = false switches `named` off.
+  void select(const bool (&named)[kLogCategoryCount], bool on);
 
   void error(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);
   void warning(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);

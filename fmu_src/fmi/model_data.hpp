@@ -18,7 +18,7 @@ struct Context {
   Logger& log;
   Interface interface;
   bool initialization_mode;  // between Enter- and ExitInitializationMode
-  double start_time;
+  double start_time;  // the model's time is the time since this
 };
 
 /// Per-instance data of a model. Start values are written through the
@@ -31,12 +31,16 @@ class ModelData {
   /// forget everything derived (solvers, caches).
   virtual void reset() = 0;
   /// ExitInitializationMode: build the model from the parameters and set the
-  /// initial state at ctx.start_time. Error with a logged message if impossible.
+  /// initial state at model time 0 (= ctx.start_time). Error with a logged
+  /// message if impossible. Every time the layer passes to a model is the
+  /// time since ctx.start_time.
   virtual Status exit_initialization(Context& ctx) = 0;
   /// Writes the computed variables of the output groups `groups` (bits of
   /// Variable::group) for the current time, state, parameters and inputs.
   /// Called lazily, before a get that reads them, once per group until
-  /// anything changes. A model may write more than it is asked for.
+  /// anything changes; a model may write more than it is asked for. Discard
+  /// (reason logged): the inputs lie outside the model's domain, the
+  /// computed variables are left as they were and the get hands those out.
   virtual Status update_outputs(Context& ctx, unsigned groups) = 0;
   /// The model's state beyond the table's values.
   virtual void save(StateWriter& w) const = 0;
@@ -48,6 +52,9 @@ class ModelData {
   /// From t to t + h (t is the current time). On return t_reached is the last
   /// time the state is valid for: t + h for OK, the last good point for Discard.
   virtual Status do_step(Context& ctx, double t, double h, double& t_reached) = 0;
+  /// Before do_step, nothing changed yet: Error (reason logged) if a step of
+  /// h would exceed the model's work budget. The instance stays usable.
+  virtual Status check_step(Context& ctx, double h) const { (void)ctx, (void)h; return Status::OK; }
 
   // ---- Model Exchange (models without states keep the defaults)
   virtual void set_time(double t) { (void)t; }

@@ -57,7 +57,7 @@ Status Instance::set_time(double t) {
     return Status::Error;
   }
   time_ = t;
-  data_->set_time(t);
+  data_->set_time(t - start_time_);
   valid_groups_ = 0;
   return Status::OK;
 }

@@ -75,8 +75,6 @@ struct PlantData final : MechanismData {
   double atol = kDefaultSolver.atol;
   std::int32_t cvode_method = static_cast<std::int32_t>(kDefaultSolver.cvode_method);
   std::int32_t formulation = static_cast<std::int32_t>(kDefaultSolver.formulation);
-  double max_jacobian_condition = kDefaultSolver.max_jacobian_condition;
-  double min_leg_measure = kDefaultSolver.min_leg_measure;
   // Inputs u = [F1..F4, Fe1..Fe3, Me_z, tau1..tau4] at the current time, and du/dt.
   double u[kInputs] = {kHoldingForce, kHoldingForce, kHoldingForce, kHoldingForce};
   double du[kInputs] = {};
@@ -101,6 +99,7 @@ struct PlantData final : MechanismData {
   void reset() override { plant.reset(); }
   Status exit_initialization(Context& ctx) override;
   Status do_step(Context& ctx, double t, double h, double& t_reached) override;
+  Status check_step(Context& ctx, double h) const override;
   Status update_outputs(Context& ctx, unsigned groups) override;
   void save(StateWriter& w) const override;
   bool load(StateReader& r, Context& ctx) override;
@@ -114,6 +113,8 @@ struct PlantData final : MechanismData {
   Status get_event_indicators(Context& ctx, double z[]) override;
   Status event_update(Context& ctx, bool& terminate) override;
 
+  /// The absolute time of the plant (its own time is the time since startTime), for messages.
+  double absolute_time(const Context& ctx) const { return ctx.start_time + plant->time(); }
   /// A Plant for the current parameters (not yet initialised).
   Status make_plant(Context& ctx, const char* function, std::unique_ptr<pkm::Plant>& out) const;
   /// make_plant, then the consistent initial state from x0..phi0, dx0..dphi0.
@@ -155,8 +156,8 @@ Status PlantData::make_plant(Context& ctx, const char* function, std::unique_ptr
   s.atol = atol;
   s.cvode_method = static_cast<pkm::CvodeMethod>(cvode_method);
   s.formulation = static_cast<pkm::Formulation>(formulation);
-  s.max_jacobian_condition = max_jacobian_condition;
-  s.min_leg_measure = min_leg_measure;
+  s.max_jacobian_condition = limits.max_jacobian_condition;
+  s.min_leg_measure = limits.min_leg_measure;
   auto plant_new = std::make_unique<pkm::Plant>(model);
   if (plant_new->set_solver(s, &why) != pkm::Status::Ok) {
     ctx.log.error("%s: parameter %s", function, why.c_str());
@@ -172,7 +173,7 @@ Status PlantData::build(Context& ctx, const char* function) {
   if (st != Status::OK) return st;
   const pkm::Pose pose_0(pose0[0], pose0[1], pose0[2], pose0[3]);
   const pkm::Pose vel_0(vel0[0], vel0[1], vel0[2], vel0[3]);
-  const pkm::Status s = p->initialize(ctx.start_time, pose_0, vel_0);
+  const pkm::Status s = p->initialize(0.0, pose_0, vel_0);  // model time: since ctx.start_time
   if (s != pkm::Status::Ok) {
     const char* what = s == pkm::Status::Unreachable ? "cannot be assembled elbow-down"
                        : s == pkm::Status::Singular  ? "lies beyond the singularity limits"
@@ -203,7 +204,7 @@ void PlantData::log_stop_changes(Context& ctx, unsigned now, const char* where) 
   for (int k = 0; k < pkm::kStopIndicators; ++k) {
     if (!(changed & (1u << k))) continue;
     const bool lower = k < 4;
-    ctx.log.event("%s at t = %.17g: slider %d %s its %s end stop (%s = %.9g m)", where, plant->time(), k % 4 + 1,
+    ctx.log.event("%s at t = %.17g: slider %d %s its %s end stop (%s = %.9g m)", where, absolute_time(ctx), k % 4 + 1,
                   (now & (1u << k)) ? "passes" : "leaves", lower ? "lower" : "upper", lower ? "rho_min" : "rho_max",
                   lower ? plant->model().p.rho_min : plant->model().p.rho_max);
   }
@@ -274,22 +275,35 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
       // step start), within the singularity limits. The layer sets
       // terminated: a master stops at the last successful time instead of
       // retrying the same step.
-      ctx.log.discard("DoStep: integration from t = %.17g to %.17g failed (%s%s%s); the state is kept at "
-                      "t = %.17g (the last successful time), terminated = true",
-                      t_start, t_end, pkm::status_name(s), plant->last_error().empty() ? "" : ": ",
-                      plant->last_error().c_str(), t_reached);
+      ctx.log.discard("DoStep: integration from t = %.17g to %.17g failed (%s%s%s, times since startTime); the "
+                      "state is kept at t = %.17g (the last successful time), terminated = true",
+                      ctx.start_time + t_start, ctx.start_time + t_end, pkm::status_name(s),
+                      plant->last_error().empty() ? "" : ": ", plant->last_error().c_str(), ctx.start_time + t_reached);
       return Status::Discard;
     default:
-      ctx.log.error("DoStep: integration from t = %.17g to %.17g failed: %s%s%s", t_start, t_end,
+      ctx.log.error("DoStep: integration from t = %.17g to %.17g failed: %s%s%s", ctx.start_time + t_start,
+                    ctx.start_time + t_end,
                     pkm::status_name(s), plant->last_error().empty() ? "" : ": ", plant->last_error().c_str());
       return Status::Error;
   }
 }
 
+Status PlantData::check_step(Context& ctx, double h) const {
+  if (!plant || plant->solver().solver != pkm::Solver::Rk4) return Status::OK;
+  const double step = plant->solver().rk4_step;
+  const double steps = pkm::rk4_steps_for(h, step);
+  if (steps <= pkm::kMaxRk4StepsPerAdvance) return Status::OK;
+  ctx.log.error("DoStep: a communication step of %.6g s needs %.3g RK4 steps of rk4_step = %.6g s, more than the "
+                "work budget of %.0e per step: use shorter communication steps or a larger rk4_step; the call has "
+                "no effect",
+                h, steps, step, pkm::kMaxRk4StepsPerAdvance);
+  return Status::Error;
+}
+
 Status PlantData::update_outputs(Context& ctx, unsigned groups) {
   const Status st = ready(ctx, "get");
   if (st != Status::OK) return st;
-  const double t = plant->time();
+  const double t = absolute_time(ctx);  // for the messages; the model's own time is plant->time()
   bool finite = true;
   auto all_finite = [&finite](const double* v, int n) {
     for (int i = 0; i < n; ++i) finite = finite && std::isfinite(v[i]);
@@ -332,7 +346,7 @@ Status PlantData::update_outputs(Context& ctx, unsigned groups) {
   }
   if (groups & kGroupDynamics) {  // Eqs. 12-13 and the multipliers
     pkm::MechanismState ms;
-    const pkm::Status s = plant->mechanism(inputs(t).signal(), ms);
+    const pkm::Status s = plant->mechanism(inputs(plant->time()).signal(), ms);
     if (s != pkm::Status::Ok) {
       ctx.log.error("get: the mechanism cannot be evaluated at t = %.17g: %s", t, pkm::status_name(s));
       return Status::Error;
@@ -344,7 +358,7 @@ Status PlantData::update_outputs(Context& ctx, unsigned groups) {
   }
   if (groups & kGroupMachine) {
     pkm::MachineOutputs mo;
-    const pkm::Status s = plant->machine_outputs(inputs(t).signal(), mo);
+    const pkm::Status s = plant->machine_outputs(inputs(plant->time()).signal(), mo);
     if (s != pkm::Status::Ok) {
       ctx.log.error("get: the machine's outputs cannot be evaluated at t = %.17g: %s", t, pkm::status_name(s));
       return Status::Error;
@@ -405,7 +419,7 @@ Status PlantData::set_states(Context& ctx, const double x[]) {
     ctx.log.discard("SetContinuousStates: the pose x = %.9g m, y = %.9g m, z = %.9g m, phi = %.9g rad at t = %.17g "
                     "cannot be assembled (%s: %s); the states are unchanged (a smaller step may stay within the "
                     "workspace)",
-                    x[0], x[1], x[2], x[3], plant->time(), pkm::status_name(s), plant->last_error().c_str());
+                    x[0], x[1], x[2], x[3], absolute_time(ctx), pkm::status_name(s), plant->last_error().c_str());
     return Status::Discard;
   }
   return Status::OK;
@@ -417,7 +431,7 @@ Status PlantData::get_derivatives(Context& ctx, double dx[]) {
   pkm::Vec10 xdot;
   const pkm::Status s = plant->derivative_now(inputs(plant->time()).signal(), xdot);
   if (s != pkm::Status::Ok || !xdot.allFinite()) {
-    ctx.log.error("GetDerivatives: the state derivative at t = %.17g cannot be evaluated: %s", plant->time(),
+    ctx.log.error("GetDerivatives: the state derivative at t = %.17g cannot be evaluated: %s", absolute_time(ctx),
                   s != pkm::Status::Ok ? pkm::status_name(s) : "not finite (singular configuration?)");
     return Status::Error;
   }
@@ -432,7 +446,7 @@ Status PlantData::get_event_indicators(Context& ctx, double z[]) {
   pkm::Status s = pkm::guard_indicators(plant->model(), pose_now, plant->solver().limits(), z);
   if (s == pkm::Status::Ok) s = pkm::stop_indicators(plant->model(), pose_now, z + pkm::kGuardIndicators);
   if (s != pkm::Status::Ok) {
-    ctx.log.error("GetEventIndicators: not defined at t = %.17g: %s", plant->time(), pkm::status_name(s));
+    ctx.log.error("GetEventIndicators: not defined at t = %.17g: %s", absolute_time(ctx), pkm::status_name(s));
     return Status::Error;
   }
   return Status::OK;
@@ -453,11 +467,11 @@ Status PlantData::event_update(Context& ctx, bool& terminate) {
     if (k == 0) {
       ctx.log.warning("event at t = %.17g: the actuator Jacobian's condition number reached max_jacobian_condition "
                       "= %g (parallel-singularity guard); terminateSimulation = true",
-                      plant->time(), plant->solver().max_jacobian_condition);
+                      absolute_time(ctx), plant->solver().max_jacobian_condition);
     } else {
       ctx.log.warning("event at t = %.17g: leg %d reached min_leg_measure = %g (leg-singularity guard: rod nearly "
                       "horizontal or vertical); terminateSimulation = true",
-                      plant->time(), k, plant->solver().min_leg_measure);
+                      absolute_time(ctx), k, plant->solver().min_leg_measure);
     }
     return Status::Warning;
   }
@@ -489,11 +503,16 @@ bool PlantData::load(StateReader& r, Context& ctx) {
   const pkm::EnergyIntegrals e{r.f64(), r.f64()};
   const unsigned beyond = r.u32();
   if (!r.ok()) return false;
+  if (beyond >> pkm::kStopIndicators) {
+    ctx.log.error("SetFMUState: malformed FMU state (end-stop record %#x names no stop)", beyond);
+    return false;
+  }
   std::unique_ptr<pkm::Plant> p;
   if (make_plant(ctx, "SetFMUState", p) != Status::OK) return false;
   const pkm::Status s = p->restore(t, y, ref, e);
   if (s != pkm::Status::Ok) {
-    ctx.log.error("SetFMUState: the saved state at t = %.17g cannot be restored: %s", t, pkm::status_name(s));
+    ctx.log.error("SetFMUState: the saved state at t = %.17g cannot be restored: %s%s%s", t, pkm::status_name(s),
+                  p->last_error().empty() ? "" : ": ", p->last_error().c_str());
     return false;
   }
   plant = std::move(p);
@@ -628,42 +647,34 @@ constexpr Variable kVariables[] = {
   // Parameters: the mechanism (100..120), the initial state (130..137), the
   // solver (140..147), the end stops' compliance (148..149), the machine (150..160).
   PKM_FMI_MECHANISM_PARAMETERS,
-  real_parameter(130, "x0", 0.0, "m", "Initial x of P", PLANT(pose0), 0),
-  real_parameter(131, "y0", 0.0, "m", "Initial y of P", PLANT(pose0), 1),
-  real_parameter(132, "z0", 0.05, "m", "Initial z of P (home pose: 0.05 m)", PLANT(pose0), 2),
-  real_parameter(133, "phi0", 0.0, "rad", "Initial platform rotation about z", PLANT(pose0), 3),
-  real_parameter(134, "dx0", 0.0, "m/s", "Initial velocity of P, x component", PLANT(vel0), 0),
-  real_parameter(135, "dy0", 0.0, "m/s", "Initial velocity of P, y component", PLANT(vel0), 1),
-  real_parameter(136, "dz0", 0.0, "m/s", "Initial velocity of P, z component", PLANT(vel0), 2),
-  real_parameter(137, "dphi0", 0.0, "rad/s", "Initial platform angular velocity about z", PLANT(vel0), 3),
+  real_parameter(130, "x0", 0.0, "m", "Initial x of P", PLANT(pose0), 0, -pkm::kMaxLength, pkm::kMaxLength),
+  real_parameter(131, "y0", 0.0, "m", "Initial y of P", PLANT(pose0), 1, -pkm::kMaxLength, pkm::kMaxLength),
+  real_parameter(132, "z0", 0.05, "m", "Initial z of P (home pose: 0.05 m)", PLANT(pose0), 2, -pkm::kMaxLength, pkm::kMaxLength),
+  real_parameter(133, "phi0", 0.0, "rad", "Initial platform rotation about z", PLANT(pose0), 3, -pkm::kMaxAngle, pkm::kMaxAngle),
+  real_parameter(134, "dx0", 0.0, "m/s", "Initial velocity of P, x component", PLANT(vel0), 0, -pkm::kMaxSpeed, pkm::kMaxSpeed),
+  real_parameter(135, "dy0", 0.0, "m/s", "Initial velocity of P, y component", PLANT(vel0), 1, -pkm::kMaxSpeed, pkm::kMaxSpeed),
+  real_parameter(136, "dz0", 0.0, "m/s", "Initial velocity of P, z component", PLANT(vel0), 2, -pkm::kMaxSpeed, pkm::kMaxSpeed),
+  real_parameter(137, "dphi0", 0.0, "rad/s", "Initial platform angular velocity about z", PLANT(vel0), 3, -pkm::kMaxSpeed / pkm::kConditionLength, pkm::kMaxSpeed / pkm::kConditionLength),
   integer_parameter(140, "solver", static_cast<int>(kDefaultSolver.solver),
                     "Co-Simulation integrator: 0 = CVODE (variable step, rtol and atol), 1 = fixed-step RK4 (rk4_step), as in the paper",
                     PLANT_SCALAR(solver), 0, 1),
   real_parameter(141, "rk4_step", kDefaultSolver.rk4_step, "s",
-                 "RK4 step: a communication step is split into whole steps no longer than this", PLANT_SCALAR(rk4_step), 0),
+                 "RK4 step: a communication step is split into whole steps no longer than this", PLANT_SCALAR(rk4_step), 0,
+                 pkm::kMinRk4Step, pkm::kMaxRk4Step),
   real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance", PLANT_SCALAR(rtol), 0, 0.0, 1.0),
-  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)", PLANT_SCALAR(atol), 0, 0.0),
+  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)", PLANT_SCALAR(atol), 0, 0.0, 1.0),
   integer_parameter(144, "cvode_method", static_cast<int>(kDefaultSolver.cvode_method),
                     "CVODE method: 0 = Adams-Moulton (non-stiff), 1 = BDF", PLANT_SCALAR(cvode_method), 0, 1),
   integer_parameter(145, "formulation", static_cast<int>(kDefaultSolver.formulation),
                     "Forward dynamics: 0 = augmented saddle-point system (Eq. 12), 1 = null-space projection with a QR "
                     "(Eq. 13), 2 = null space from the leg blocks (Eq. 13, leg-partitioned)",
                     PLANT_SCALAR(formulation), 0, 2),
-  real_parameter(146, "max_jacobian_condition", kDefaultSolver.max_jacobian_condition, "",
-                 "Parallel-singularity guard: a step whose end state has an actuator Jacobian condition number "
-                 "(phi column divided by 0.1 m) above this is discarded (Co-Simulation: Discard, state kept; Model "
-                 "Exchange: an event indicator, terminateSimulation); > 1",
-                 PLANT_SCALAR(max_jacobian_condition), 0, 1.0),
-  real_parameter(147, "min_leg_measure", kDefaultSolver.min_leg_measure, "",
-                 "Leg-singularity guard: a step whose end state has |cos(theta2) sin(theta2)| of a leg below this "
-                 "(rod nearly horizontal or vertical) is discarded (Co-Simulation: Discard, state kept; Model "
-                 "Exchange: an event indicator, terminateSimulation); in [0, 0.5)",
-                 PLANT_SCALAR(min_leg_measure), 0, 0.0, 0.5),
+  PKM_FMI_GUARD_PARAMETERS,
   real_parameter(148, "stop_stiffness", kDefaultParams.stop_stiffness, "N/m",
                  "Stiffness k of the compliant end stops: k delta + d delta_dot pushes a slider back past rho_min or rho_max by delta (never pulls)",
-                 PKM_FMI_PARAM(stop_stiffness), 0, 0.0),
+                 PKM_FMI_PARAM(stop_stiffness), 0, 0.0, pkm::kMaxStiffness),
   real_parameter(149, "stop_damping", kDefaultParams.stop_damping, "N.s/m", "Damping d of the end stops",
-                 PKM_FMI_PARAM(stop_damping), 0, 0.0),
+                 PKM_FMI_PARAM(stop_damping), 0, 0.0, pkm::kMaxDamping),
   PKM_FMI_MACHINE_PARAMETERS,
 };
 // clang-format on

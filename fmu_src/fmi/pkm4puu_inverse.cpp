@@ -15,13 +15,24 @@
 // after a jump of the inputs, and makes the outputs a pure function of the
 // current inputs and parameters (bit for bit, whatever was computed
 // before; nothing to carry in FMU states).
+//
+// The plant's singularity guards (workspace_guard.hpp, the same parameters
+// max_jacobian_condition and min_leg_measure): near a leg or parallel
+// singularity the forces grow without bound (1e19 N with a rod horizontal),
+// numbers no drive should be handed. A pose beyond a guard makes the get
+// answer Discard with the reason logged and the outputs of the last pose
+// within the guards; the outputs jacobian_condition and leg_measure_min tell
+// the master how close it is.
+#include <algorithm>
 #include <cmath>
 #include <iterator>
 #include <memory>
 
+#include "constraints.hpp"
 #include "inverse_dynamics.hpp"
 #include "mechanism_parameters.hpp"
 #include "models.hpp"
+#include "workspace_guard.hpp"
 
 namespace pkm_fmi {
 namespace {
@@ -33,6 +44,7 @@ struct InverseData final : MechanismData {
   double wrench[4] = {};  // Fe1..Fe3, Me_z
   // Outputs.
   double F[4] = {}, tau[4] = {}, rho[4] = {}, drho[4] = {}, lambda[12] = {};
+  double condition = 0.0, leg_measure_min = 0.0;
   // Joints beyond their end stops at the last evaluation (bit i: below
   // rho_min, 4 + i: above rho_max): a warning is given on entering, once.
   unsigned beyond_stops = 0;
@@ -56,6 +68,11 @@ Status InverseData::make(Context& ctx, const char* function, pkm::Model& out) co
   std::string why;
   if (pkm::make_model(params, out, &why) != pkm::Status::Ok) {
     ctx.log.error("%s: %s", function, why.c_str());
+    return Status::Error;
+  }
+  why = pkm::validate(limits);
+  if (!why.empty()) {
+    ctx.log.error("%s: parameter %s", function, why.c_str());
     return Status::Error;
   }
   return Status::OK;
@@ -85,6 +102,14 @@ Status InverseData::update_outputs(Context& ctx, unsigned) {  // one group: ever
   const pkm::Pose pd(vel[0], vel[1], vel[2], vel[3]);
   const pkm::Pose pdd(acc[0], acc[1], acc[2], acc[3]);
   const pkm::Wrench we(wrench[0], wrench[1], wrench[2], wrench[3]);
+  pkm::GuardReport guard;
+  if (pkm::check_configuration(*m, p, limits, &guard) == pkm::Status::Singular) {
+    ctx.log.discard("get: the requested pose x = %.17g m, y = %.17g m, z = %.17g m, phi = %.17g rad is beyond a "
+                    "singularity guard: %s; the outputs keep their values of the last pose within the guards",
+                    pose[0], pose[1], pose[2], pose[3],
+                    pkm::describe_configuration_failure(*m, p, limits, guard).c_str());
+    return Status::Discard;
+  }
   pkm::InverseDynamicsResult r;
   const pkm::Status s = pkm::inverse_dynamics(*m, p, pd, pdd, we, r, /*warm_start=*/false);
   if (s != pkm::Status::Ok) {
@@ -101,6 +126,12 @@ Status InverseData::update_outputs(Context& ctx, unsigned) {  // one group: ever
     drho[i] = r.qd[o];
   }
   for (int k = 0; k < 12; ++k) lambda[k] = r.lambda[k];
+  condition = pkm::actuator_jacobian_condition(*m, r.q);
+  leg_measure_min = 0.5;
+  for (int i = 0; i < 4; ++i) {
+    const double t2 = r.q[pkm::leg_offset(i) + 2];
+    leg_measure_min = std::min(leg_measure_min, std::fabs(std::cos(t2) * std::sin(t2)));
+  }
   const unsigned entered = r.beyond_stops & ~beyond_stops;
   beyond_stops = r.beyond_stops;
   if (entered == 0) return Status::OK;
@@ -135,6 +166,7 @@ bool InverseData::load(StateReader& r, Context& ctx) {
 
 #define INV(member) \
   [](ModelData& d, int i) -> void* { return &static_cast<InverseData&>(d).member[i]; }
+#define INV_SCALAR(member) [](ModelData& d, int) -> void* { return &static_cast<InverseData&>(d).member; }
 
 // The multipliers: invariant to a vertical translation. The forces follow z
 // too, through the end stops (beyond them), and dz through the joints'
@@ -192,13 +224,17 @@ constexpr Variable kVariables[] = {
   real_output(49, "lambda[10]", "N", "Lagrange multiplier of leg 4's loop closure, x row (Eq. 10)", INV(lambda), 9, kMultipliers),
   real_output(50, "lambda[11]", "N", "Lagrange multiplier of leg 4's loop closure, y row (Eq. 10)", INV(lambda), 10, kMultipliers),
   real_output(51, "lambda[12]", "N", "Lagrange multiplier of leg 4's loop closure, z row (Eq. 10)", INV(lambda), 11, kMultipliers),
-  // Parameters: the mechanism (100..120), the machine (150..160).
+  real_output(52, "leg_measure_min", "", "Smallest |cos(theta2) sin(theta2)| of the four legs (0 at a leg singularity; the guard min_leg_measure)", INV_SCALAR(leg_measure_min), 0, kOnPositions),
+  real_output(53, "jacobian_condition", "", "Condition number of the 4x4 actuator Jacobian d(rho)/d(x, y, z, phi), its phi column divided by 0.1 m (the guard max_jacobian_condition)", INV_SCALAR(condition), 0, kOnPositions),
+  // Parameters: the mechanism (100..120), the guards (146..147), the machine (150..160).
   PKM_FMI_MECHANISM_PARAMETERS,
+  PKM_FMI_GUARD_PARAMETERS,
   PKM_FMI_MACHINE_PARAMETERS,
 };
 // clang-format on
 
 #undef INV
+#undef INV_SCALAR
 
 static_assert(sorted_by_vr(kVariables, std::size(kVariables)), "the table must be sorted by value reference");
 
@@ -214,8 +250,9 @@ const ModelDefinition kDefinition{
     "Lagrange multipliers and the four actuator forces. The outputs are algebraic functions of the inputs at "
     "the current time (direct feedthrough): in Co-Simulation a step only advances time; in Model Exchange it has "
     "no states and no event indicators.</p>"
-    "<p>An unreachable or singular pose makes the get of an output return Error with a message; no output is "
-    "written then. At rest at the home pose (0, 0, 0.05 m, 0) with g = 9.81 m/s2 each actuator carries "
+    "<p>An unreachable pose makes the get of an output return Error with a message; no output is written "
+    "then. A pose beyond a singularity guard (min_leg_measure, max_jacobian_condition, as in the plant) makes "
+    "it return Discard with the reason logged and the outputs of the last pose within the guards. At rest at the home pose (0, 0, 0.05 m, 0) with g = 9.81 m/s2 each actuator carries "
     "2.655616050 N.</p>",
     kVariables,
     std::size(kVariables),

@@ -104,16 +104,21 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
     return Status::Error;
   }
   Context ctx = context();
-  double reached = time_;
-  const Status s = data_->do_step(ctx, t, h, reached);
+  if (data_->check_step(ctx, h) != Status::OK) return Status::Error;
+  // The model integrates from elapsed_ by h; the reported time follows the
+  // master's t + h.
+  double reached = elapsed_;
+  const Status s = data_->do_step(ctx, elapsed_, h, reached);
   valid_groups_ = 0;
   switch (s) {
     case Status::OK:
     case Status::Warning:
+      elapsed_ += h;
       time_ = last_successful_time_ = t + h;
       break;
     case Status::Discard:
-      time_ = last_successful_time_ = reached;
+      time_ = last_successful_time_ = t + (reached - elapsed_);  // t itself when nothing was reached
+      elapsed_ = reached;
       terminated_ = true;
       mode_ = kStepFailed;
       break;
@@ -121,7 +126,7 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
       mode_ = kFatal;
       break;
     case Status::Error:
-      last_successful_time_ = reached;
+      last_successful_time_ = t + (reached - elapsed_);
       mode_ = kError;
       break;
   }

@@ -47,8 +47,10 @@ Status Instance::get_values(const char* function, VarType type, const std::uint3
   }
   Status s = Status::OK;
   if (needed) {
+    // Discard: the inputs lie outside the model's domain (reason logged);
+    // the computed variables keep the values of the last good evaluation.
     s = ensure_outputs(function, needed);
-    if (!succeeded(s)) return s;
+    if (s == Status::Error || s == Status::Fatal) return s;
   }
   for (std::size_t k = 0; k < n; ++k) {
     const Variable* v = def_.find(vr[k]);

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The C++ FMI tests (dlopen'd FMU binaries: life cycle, misuse, bad input,
+# singularities, threads, Model Exchange) against FMU binaries and tests
+# built with AddressSanitizer and UndefinedBehaviorSanitizer
+# (-DPKM_SANITIZE=ON, in its own build directory). Any finding fails.
+#   scripts/check_sanitizers.sh [--build-dir DIR]     (default build-sanitize)
+# Excluded: FmuBinaries.NeedOnlyTheSystemRuntime (instrumented binaries need
+# libasan by design) and the fmpy-driven cases (an uninstrumented Python
+# would have to preload libasan).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=build-sanitize
+if [[ "${1:-}" == "--build-dir" ]]; then build="$2"; fi
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPKM_SANITIZE=ON -DPKM_LTO=OFF \
+      -DPKM_BUILD_BENCHMARKS=OFF ${FMI2_HEADERS_DIR:+-DFMI2_HEADERS_DIR=$FMI2_HEADERS_DIR} >/dev/null
+targets=(test_fmi_lifecycle test_fmi_model_exchange test_fmi_machine test_hardening_inputs
+         test_hardening_singularities test_hardening_misuse test_hardening_threads)
+cmake --build "$build" -j2 --target "${targets[@]}"
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+for t in "${targets[@]}"; do
+  "$build/tests/$t" --gtest_brief=1 --gtest_filter='-FmuBinaries.NeedOnlyTheSystemRuntime:*Fmpy*'
+done
+echo "check_sanitizers: no finding in ${#targets[@]} test programs"
