@@ -89,6 +89,24 @@ inline double passive_joint_force(const Params& p, int leg, unsigned stops, doub
   return friction_force(p, rhod) + stop_contact(p, leg, stops, rho, rhod).force;
 }
 
+/// d/d(rho, rhod) of passive_joint_force (the friction's tanh is smooth;
+/// a stop contributes (-k, -d) while it pushes and nothing otherwise: its
+/// kinks at contact and release take the side the force is evaluated on).
+struct PassiveSlopes { double drho = 0, drhod = 0; };
+inline PassiveSlopes passive_joint_force_slopes(const Params& p, int leg, unsigned stops, double rho, double rhod) {
+  PassiveSlopes s;
+  s.drhod = -p.friction_viscous;
+  if (p.friction_coulomb != 0.0) {
+    const double th = std::tanh(rhod / p.friction_velocity);
+    s.drhod -= p.friction_coulomb / p.friction_velocity * (1.0 - th * th);
+  }
+  if (stop_contact(p, leg, stops, rho, rhod).force != 0.0) {
+    s.drho = -p.stop_stiffness;
+    s.drhod -= p.stop_damping;
+  }
+  return s;
+}
+
 /// Energy stored in the stop's spring, 1/2 k delta^2 (J).
 inline double stop_potential(const Params& p, double rho) {
   const double d = rho < p.rho_min ? p.rho_min - rho : (rho > p.rho_max ? rho - p.rho_max : 0.0);

@@ -1,0 +1,197 @@
+// Analytic derivatives of the forward and inverse dynamics
+// (reduced_dynamics_derivatives.hpp, inverse_dynamics_derivatives.hpp)
+// against central differences of the same model's plain functions
+// (state_derivative, inverse_dynamics) with Richardson extrapolation:
+// at several poses (home, the auto-test's end pose, off-centre and rotated),
+// with nonzero rates and every machine term on, and with an end stop pushing.
+#include <cstdio>
+
+#include "inverse_dynamics.hpp"
+#include "inverse_dynamics_derivatives.hpp"
+#include "lagrangian.hpp"
+#include "machine.hpp"
+#include "minimal_state.hpp"
+#include "reduced_dynamics_derivatives.hpp"
+#include "test_support.hpp"
+
+using namespace pkm_test;
+
+namespace {
+
+/// d/ds f(s) at s = 0: central differences at h, h/2, h/4, h/8 and
+/// Richardson's table (error O(h^8)); *err is the size of the last
+/// correction, an estimate of the result's own error.
+template <class F>
+auto richardson(F f, double h, double* err) -> decltype(f(0.0)) {
+  using V = decltype(f(0.0));
+  constexpr int kLevels = 4;
+  V T[kLevels];
+  for (int k = 0; k < kLevels; ++k) {
+    const double hk = h / (1 << k);
+    T[k] = (f(hk) - f(-hk)) / (2 * hk);
+    double factor = 4.0;
+    for (int j = k - 1; j >= 0; --j, factor *= 4.0) T[j] = (factor * T[j + 1] - T[j]) / (factor - 1.0);
+    if (k == kLevels - 1) *err = (T[0] - T[1]).cwiseAbs().maxCoeff();
+  }
+  return T[0];
+}
+
+/// Every machine term on: rotors, payload off the centre, viscous and
+/// Coulomb friction with a velocity scale that keeps tanh's slope visible.
+Params machine_params() {
+  Params p;
+  p.rotor_inertia = 2e-7;
+  p.friction_viscous = 1.5;
+  p.friction_coulomb = 0.2;
+  p.friction_velocity = 0.05;
+  p.payload_mass = 0.3;
+  p.payload_com = {0.02, -0.012};
+  p.payload_Izz = 1.2e-4;
+  return p;
+}
+
+struct Case {
+  const char* name;
+  Pose pose, vel;
+};
+
+// Home, the auto-test's end pose (MODEL_SPEC), off-centre and rotated the
+// other way; each with rates in every coordinate.
+const Case kCases[] = {
+    {"home", Pose(0.0, 0.0, 0.05, 0.0), Pose(0.12, -0.08, 0.10, 0.9)},
+    {"autotest end", Pose(0.005, -0.005, 0.07, deg(4)), Pose(-0.05, 0.11, -0.07, -0.6)},
+    {"off-centre rotated", Pose(-0.007, 0.006, 0.058, -0.07), Pose(0.09, 0.04, 0.13, 1.3)},
+};
+
+const Vec4 kF(2.7, 2.5, 2.9, 2.6);             // N
+const Vec4 kTau(1e-3, -2e-3, 1.5e-3, 0.0);     // N*m
+const Wrench kWe(0.3, -0.2, 0.5, 0.01);        // N, N*m
+
+/// pdd at y for the inputs u = (F, Fe, Me_z, tau) by the plain state function.
+Pose plain_pdd(const Model& m, const Vec8& y, const Eigen::Matrix<double, 12, 1>& u) {
+  const Vec16 f = generalized_forces(m, u.head<4>(), u.tail<4>(), u.segment<4>(4));
+  Vec8 ydot;
+  EXPECT_EQ(state_derivative(m, Formulation::LegPartitioned, y, f, ydot), Status::Ok);
+  return ydot.tail<4>();
+}
+
+/// Column by column: |analytic - difference|_max over the column's largest
+/// analytic entry, and the same for the difference quotient's own error
+/// estimate (the quotient must be reliable for the comparison to mean anything).
+void expect_columns_match(const char* what, const Eigen::MatrixXd& an, const Eigen::MatrixXd& fd,
+                          const Eigen::VectorXd& fd_err, double tol) {
+  double worst = 0.0;
+  for (int k = 0; k < an.cols(); ++k) {
+    const double scale = std::max(an.col(k).cwiseAbs().maxCoeff(), 1e-12);
+    const double rel = (an.col(k) - fd.col(k)).cwiseAbs().maxCoeff() / scale;
+    EXPECT_LT(fd_err[k] / scale, 0.1 * tol) << what << " column " << k << ": the difference quotient is unreliable";
+    EXPECT_LT(rel, tol) << what << " column " << k << ": relative difference " << rel << " (bound " << tol << ")";
+    worst = std::max(worst, rel);
+  }
+  std::printf("%s: largest relative difference %.2e (bound %.0e)\n", what, worst, tol);
+}
+
+/// The state Jacobians against Richardson differences of state_derivative;
+/// `h` scales every step (an end stop's kink must stay out of reach).
+void check_forward(const Model& m, const Case& c, double h) {
+  SCOPED_TRACE(c.name);
+  Vec8 y;
+  y << c.pose, c.vel;
+  Eigen::Matrix<double, 12, 1> u;
+  u << kF, kWe, kTau;
+  Vec8 ydot;
+  Mat8 A;
+  Mat8x12 B;
+  ASSERT_EQ(state_derivative_jacobians(m, y, kF, kTau, kWe, kStopsFromState, ydot, A, B), Status::Ok);
+  EXPECT_EQ(ydot.tail<4>(), plain_pdd(m, y, u)) << "the value is the plain state function's";
+  EXPECT_EQ(ydot.head<4>(), c.vel);
+  // dpd/dy: identity on the rates, nothing else; dpd/du = 0.
+  Mat8 top = Mat8::Zero();
+  top.topRightCorner<4, 4>().setIdentity();
+  EXPECT_EQ(A.topRows<4>(), top.topRows<4>());
+  EXPECT_EQ(B.topRows<4>(), (Eigen::Matrix<double, 4, 12>::Zero()));
+
+  // Steps: pose 0.3 mm and 3 mrad, rates 5 mm/s and 50 mrad/s, forces 1 N,
+  // moments 0.01 N*m, torques 5 mN*m (the dynamics are linear in u).
+  const double hy[8] = {3e-4, 3e-4, 3e-4, 3e-3, 5e-3, 5e-3, 5e-3, 5e-2};
+  Eigen::MatrixXd fd(4, 8 + 12);
+  Eigen::VectorXd err(8 + 12);
+  for (int k = 0; k < 8; ++k) {
+    fd.col(k) = richardson([&](double s) {
+      Vec8 ys = y;
+      ys[k] += s;
+      return plain_pdd(m, ys, u);
+    }, h * hy[k], &err[k]);
+  }
+  for (int k = 0; k < 12; ++k) {
+    const double hu = k < 7 ? 1.0 : (k == 7 ? 1e-2 : 5e-3);
+    fd.col(8 + k) = richardson([&](double s) {
+      Eigen::Matrix<double, 12, 1> us = u;
+      us[k] += s;
+      return plain_pdd(m, y, us);
+    }, hu, &err[8 + k]);
+  }
+  Eigen::MatrixXd an(4, 20);
+  an << A.bottomRows<4>(), B.bottomRows<4>();
+  expect_columns_match("d pdd / d(p, pd)", an.leftCols(8), fd.leftCols(8), err.head(8), 1e-7);
+  expect_columns_match("d pdd / du", an.rightCols(12), fd.rightCols(12), err.tail(12), 1e-7);
+}
+
+}  // namespace
+
+TEST(ForwardDerivatives, IdealMechanismMatchesRichardsonDifferences) {
+  const Model m = default_model();
+  for (const Case& c : kCases) check_forward(m, c, 1.0);
+}
+
+TEST(ForwardDerivatives, EveryMachineTermOnMatchesRichardsonDifferences) {
+  const Model m = model_of(machine_params());
+  for (const Case& c : kCases) check_forward(m, c, 1.0);
+}
+
+TEST(ForwardDerivatives, PushingEndStopMatchesRichardsonDifferences) {
+  // Leg 1's upper stop 1 mm below its joint at the case's pose: the stop
+  // pushes (k delta = 100 N dominates d delta_dot), smooth within 1 mm.
+  Params p = machine_params();
+  const Case& c = kCases[2];
+  Vec4 rho;
+  ASSERT_EQ(actuator_positions(default_model(), c.pose, rho), Status::Ok);
+  p.rho_max = rho[0] - 1e-3;
+  const Model m = model_of(p);
+  ASSERT_GT(std::fabs(stop_force(m.p, rho[0], 0.0)), 0.0);
+  check_forward(m, c, 0.05);  // steps of at most 50 um in the pose
+}
+
+TEST(InverseDerivatives, MatchRichardsonDifferencesOfTheInverseDynamics) {
+  const Model m = model_of(machine_params());
+  const Pose acc(0.8, -0.5, 1.1, 6.0);
+  for (const Case& c : kCases) {
+    SCOPED_TRACE(c.name);
+    InverseDynamicsPartials d;
+    ASSERT_EQ(inverse_dynamics_derivatives(m, c.pose, c.vel, acc, kWe, d), Status::Ok);
+    // The force itself: the full Eqs. 10-11 of inverse_dynamics, an
+    // independent route (Newton, servo Jacobian, 12x12 multipliers).
+    auto forces = [&](const Pose& p, const Pose& v, const Pose& a, const Wrench& we) {
+      InverseDynamicsResult r;
+      EXPECT_EQ(inverse_dynamics(m, p, v, a, we, r), Status::Ok);
+      return Vec4(r.F);
+    };
+    const Vec4 F = forces(c.pose, c.vel, acc, kWe);
+    EXPECT_LT(rel_diff(d.F, F), 1e-12) << d.F.transpose() << " vs " << F.transpose();
+
+    const double h[4] = {3e-4, 1e-2, 0.1, 1.0};  // steps for p (phi: 10x), pd, pdd, we
+    Eigen::MatrixXd an(4, 16), fd(4, 16);
+    Eigen::VectorXd err(16);
+    an << d.dp, d.dpd, d.dpdd, d.dwe;
+    for (int block = 0; block < 4; ++block)
+      for (int k = 0; k < 4; ++k) {
+        const double hk = h[block] * (block < 2 && k == 3 ? 10.0 : 1.0);
+        fd.col(4 * block + k) = richardson([&](double s) {
+          Pose x[4] = {c.pose, c.vel, acc, kWe};
+          x[block][k] += s;
+          return forces(x[0], x[1], x[2], x[3]);
+        }, hk, &err[4 * block + k]);
+      }
+    expect_columns_match("dF / d(p, pd, pdd, we)", an, fd, err, 1e-7);
+  }
+}
