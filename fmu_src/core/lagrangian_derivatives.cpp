@@ -11,8 +11,7 @@ LegTermsPartials leg_terms_partials(const Params& p, const LegConfig& c, const V
   const double ddM22 = 2.0 * k * (c.c2 * c.c2 - c.s2 * c.s2);
   const double a = qd[1], b = qd[2];
   LegTermsPartials out;
-  out.dq.setZero();
-  out.dq.col(2) << d.dM13 * qdd[2] + ddM13 * b * b,
+  out.dtheta2 << d.dM13 * qdd[2] + ddM13 * b * b,
                    d.dM22 * qdd[1] + ddM22 * a * b,
                    d.dM13 * qdd[0] - 0.5 * ddM22 * a * a - 0.5 * p.m_rod * p.g * p.l * c.s2;
   out.dqd << 0.0, 0.0, 2.0 * d.dM13 * b,

@@ -16,8 +16,8 @@
 namespace pkm {
 
 struct LegTermsPartials {
-  Mat3 dq;   // dw/d(rho, theta1, theta2): only column 2 is nonzero
-  Mat3 dqd;  // dw/d(rhod, th1d, th2d)
+  Vec3 dtheta2;  // dw/dtheta2 (dw/drho = dw/dtheta1 = 0)
+  Mat3 dqd;      // dw/d(rhod, th1d, th2d)
 };
 
 LegTermsPartials leg_terms_partials(const Params& p, const LegConfig& c, const Vec3& qd, const Vec3& qdd);

@@ -25,7 +25,7 @@ Status ReducedDynamics::prepare_leg_kinematics(const Model& m, int leg, const Le
   const double a = -p.l * c.s1 * c.c2 + p.h_prime * c.c1, b = p.l * c.c1 * c.c2 + p.h_prime * c.s1;
   const double e = -p.l * c.c1 * c.s2, f = -p.l * c.s1 * c.s2, g = p.l * c.c2;
   const double inv_D = 1.0 / (a * f - b * e);
-  Mat3 Jinv;
+  Mat3& Jinv = L.Jinv;
   Jinv << b * g * inv_D, -a * g * inv_D, 1.0,
           f * inv_D,     -e * inv_D,     0.0,
           -b * inv_D,    a * inv_D,      0.0;

@@ -49,6 +49,7 @@ class ReducedDynamics {
     LegConfig c;
     Vec3 attach;  // Rz(phi) r_Qi
     Mat3 Linv;    // L_i^{-1}
+    Mat3 Jinv;    // J_i^{-1} = L_i^{-1} Rz(beta_i)
     Mat34 A;      // L_i^{-1} P_i
     Mat3 M;       // leg mass matrix
     Vec3 b;       // -L_i^{-1} gamma_i

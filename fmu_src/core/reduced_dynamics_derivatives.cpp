@@ -9,11 +9,17 @@
 namespace pkm {
 namespace {
 
-Mat3 rz_beta(const Model& m, int leg) {
-  const double c = m.cos_beta[leg], s = m.sin_beta[leg];
-  Mat3 R;
-  R << c, -s, 0, s, c, 0, 0, 0, 1;
-  return R;
+/// out += A^T X A + (A^T x) e_phi^T for A = L^{-1} P, P = [I3, c]:
+/// with Y = L^{-T} X L^{-1} and y = L^{-T} x, P^T Y P = [Y, Y c; c^T Y, c^T Y c]
+/// and P^T y = (y, c . y).
+void add_projected(const Mat3& Linv, const Vec3& c, const Mat3& X, const Vec3& x, Mat4& out) {
+  const Mat3 Y = Linv.transpose() * X * Linv;
+  const Vec3 y = Linv.transpose() * x;
+  const Vec3 Yc = Y * c;
+  out.topLeftCorner<3, 3>() += Y;
+  out.col(3).head<3>() += Yc + y;
+  out.row(3).head<3>() += c.transpose() * Y;
+  out(3, 3) += c.dot(Yc) + c.dot(y);
 }
 
 }  // namespace
@@ -27,36 +33,42 @@ void residual_partials(const Model& m, const ReducedDynamics& rd, const Pose& pd
   for (int i = 0; i < kLegs; ++i) {
     const ReducedDynamics::Leg& L = rd.leg(i);
     const Vec3 qd = L.A * pd;
-    const Vec3 qdd = L.A * pdd + L.b;
-    Vec3 w = L.M * (L.A * pdd) - L.r;  // M qdd + V + G - f (the r of add_leg)
+    const Vec3 Apdd = L.A * pdd;
+    const Vec3 qdd = Apdd + L.b;
+    Vec3 w = L.M * Apdd - L.r;  // M qdd + V + G - f (the r of add_leg)
     w[0] -= F_extra[i];
-    const Mat3 Rz = rz_beta(m, i);
     const Vec3& r = L.attach;
+    const Vec3 c(-r.y(), r.x(), 0.0);  // e_z x r: P_i's phi column
+    const Vec3 Linv_r = L.Linv * r;
     const LegPointCurvature k = leg_point_curvature(p, L.c);
     const Mat3 Eqd = leg_point_hessian_times(k, qd);
-    // N = d qd_i/dp (header comment).
-    Mat34 X = Rz * (Eqd * L.A);
-    X.col(3) += r * phid;
-    const Mat34 N = -(L.Linv * X);
-    // Q = d qdd_i/dp.
-    X.noalias() = Rz * ((leg_point_hessian_times(k, qdd) + leg_point_third_times(k, qd)) * L.A + 2.0 * Eqd * N);
-    X.col(3) += pdd[3] * r + phid * phid * Vec3(-r.y(), r.x(), 0.0);
-    const Mat34 Q = -(L.Linv * X);
-    // S = d(A_i^T)/dp w_i, through mu = L^{-T} w in the leg frame.
-    const Vec3 mu = L.Linv.transpose() * w;
-    const Vec3 mu_leg = Rz.transpose() * mu;
-    const double h11 = mu_leg.dot(k.p11), h12 = mu_leg.dot(k.p12), h22 = mu_leg.dot(k.p22);
-    const Vec4 a1 = L.A.row(1).transpose(), a2 = L.A.row(2).transpose();
-    const Vec4 g1 = h11 * a1 + h12 * a2, g2 = h12 * a1 + h22 * a2;
-    out.dp.noalias() -= g1 * a1.transpose() + g2 * a2.transpose();
-    out.dp(3, 3) -= mu.dot(r);
-    // The leg's own terms and its joint's passive force.
+    // d qd_i/dp = Na A + n e_phi^T, d qdd_i/dp = Qa A + qa e_phi^T (header comment).
+    // (E and T have a zero rho column, and so have Na and Qa.)
+    Mat3 Na;
+    Na.col(0).setZero();
+    Na.rightCols<2>().noalias() = -(L.Jinv * Eqd.rightCols<2>());
+    const Vec3 n = -phid * Linv_r;
+    Mat3 Y = leg_point_hessian_times(k, qdd) + leg_point_third_times(k, qd);
+    Y.rightCols<2>().noalias() += 2.0 * (Eqd.rightCols<2>() * Na.bottomRightCorner<2, 2>());
+    Mat3 Qa;
+    Qa.col(0).setZero();
+    Qa.rightCols<2>().noalias() = -(L.Jinv * Y.rightCols<2>());
+    const Vec3 qa = 2.0 * (Na * n) - L.Linv * (pdd[3] * r + phid * phid * c);
+    // The leg's own terms, its joint's passive force and d(A_i^T)/dp w_i.
     LegTermsPartials W = leg_terms_partials(p, L.c, qd, qdd);
     const PassiveSlopes ps = passive_joint_force_slopes(p, i, stops, L.c.rho, qd[0]);
-    W.dq(0, 0) -= ps.drho;
     W.dqd(0, 0) -= ps.drhod;
-    out.dp.noalias() += L.A.transpose() * (W.dq * L.A + W.dqd * N + L.M * Q);
-    out.dpd.noalias() += L.A.transpose() * (W.dqd * L.A + 2.0 * L.M * N);
+    const Vec3 mu_leg = L.Jinv.transpose() * w;  // Rz^T L^{-T} w
+    Mat3 K = W.dqd * Na + L.M * Qa;
+    K.col(2) += W.dtheta2;
+    K(0, 0) -= ps.drho;
+    K(1, 1) -= mu_leg.dot(k.p11);
+    K(1, 2) -= mu_leg.dot(k.p12);
+    K(2, 1) -= mu_leg.dot(k.p12);
+    K(2, 2) -= mu_leg.dot(k.p22);
+    add_projected(L.Linv, c, K, W.dqd * n + L.M * qa, out.dp);
+    out.dp(3, 3) -= w.dot(Linv_r);
+    add_projected(L.Linv, c, W.dqd + 2.0 * (L.M * Na), 2.0 * (L.M * n), out.dpd);
     out.J_rho.row(i) = L.A.row(0);
   }
   // The platform with its payload.
@@ -83,17 +95,20 @@ Status state_derivative_jacobians(const Model& m, const Vec8& y, const Vec4& F, 
   ResidualPartials P;
   residual_partials(m, rd, pd, pdd, Vec4::Zero(), stops, P);
   // dpdd/dx = -Mr^{-1} dR/dx; dR/dF = -J_rho^T, dR/dtau = -(2 pi/p) J_rho^T, dR/dwe = -I.
-  Eigen::Matrix<double, 4, 8 + kPlantInputs> rhs;
-  rhs << -P.dp, -P.dpd, P.J_rho.transpose(), Mat4::Identity(), m.drive_ratio * P.J_rho.transpose();
-  const Eigen::LDLT<Mat4> ldlt(P.Mr);
-  const Eigen::Matrix<double, 4, 8 + kPlantInputs> sol = ldlt.solve(rhs);
-  if (!sol.allFinite()) return Status::Singular;
+  // Mr is symmetric positive definite (solve_platform's LDL^T succeeded) and
+  // 4x4: its explicit inverse (cofactors) is far cheaper than a
+  // factorisation with 20 right-hand sides.
+  const Mat4 Mr_inv = P.Mr.inverse();
   ydot << pd, pdd;
-  A.setZero();
+  A.topRows<4>().setZero();
   A.topRightCorner<4, 4>().setIdentity();
-  A.bottomRows<4>() = sol.leftCols<8>();
-  B.setZero();
-  B.bottomRows<4>() = sol.rightCols<kPlantInputs>();
+  A.bottomLeftCorner<4, 4>().noalias() = -(Mr_inv * P.dp);
+  A.bottomRightCorner<4, 4>().noalias() = -(Mr_inv * P.dpd);
+  B.topRows<4>().setZero();
+  B.block<4, 4>(4, 0).noalias() = Mr_inv * P.J_rho.transpose();
+  B.block<4, 4>(4, 4) = Mr_inv;
+  B.block<4, 4>(4, 8) = m.drive_ratio * B.block<4, 4>(4, 0);
+  if (!A.allFinite() || !B.allFinite()) return Status::Singular;
   return Status::Ok;
 }
 

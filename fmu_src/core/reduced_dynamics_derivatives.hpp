@@ -12,20 +12,20 @@
 //
 // Leg i's closure in the direction u of p (du q_i = A_i u), with the
 // symmetric Gamma_i(u, v) = Rz(beta_i) H(A_i u, A_i v) + r_i u_phi v_phi
-// (H: leg_kinematics_derivatives.hpp, r_i = Rz(phi) r_Qi):
-//   du (A_i v)  = -L_i^{-1} Gamma_i(u, v)
-//   du qd_i     = N_i u,   N_i = -L_i^{-1} [Rz E(qd_i) A_i + r_i phid e_phi^T]
-//   dpd qdd_i   = 2 N_i
-//   du qdd_i    = Q_i u,   Q_i = -L_i^{-1} [Rz (E(qdd_i) + T(qd_i)) A_i + 2 Rz E(qd_i) N_i
-//                                        + (pdd_phi r_i + phid^2 e_z x r_i) e_phi^T]
-//   du (A_i^T) w_i = S_i u, S_i = -A_i^T H_mu A_i - (mu_i . r_i) e_phi e_phi^T,
-//                           mu_i = L_i^{-T} w_i (= -lambda_i), H_mu = sum_c (Rz^T mu_i)_c d^2 p_Qc/dq^2
-// so that
-//   dR/dp  = sum_i S_i + A_i^T (W_q A_i + W_qd N_i + M_i Q_i) + dw_p/dp
-//   dR/dpd = sum_i A_i^T (W_qd A_i + 2 M_i N_i) + dw_p/dpd
-// with W_q, W_qd the partials of w_i (lagrangian_derivatives.hpp, minus
-// the passive joint forces' slopes, machine.hpp). The platform's
-// (lagrangian.hpp, mwx' = -mwy, mwy' = mwx):
+// (H, E, T: leg_kinematics_derivatives.hpp; r_i = Rz(phi) r_Qi; L_i^{-1} Rz(beta_i) = J_i^{-1}):
+//   du (A_i v) = -L_i^{-1} Gamma_i(u, v)
+//   d qd_i/dp  = Na A_i + n e_phi^T,   Na = -J_i^{-1} E(qd_i),  n = -phid L_i^{-1} r_i
+//   d qdd_i/dpd = 2 d qd_i/dp
+//   d qdd_i/dp = Qa A_i + qa e_phi^T,  Qa = -J_i^{-1} (E(qdd_i) + T(qd_i) + 2 E(qd_i) Na),
+//                qa = 2 Na n - L_i^{-1} (pdd_phi r_i + phid^2 e_z x r_i)
+//   d(A_i^T)/dp w_i = -A_i^T H_mu A_i - (w_i . L_i^{-1} r_i) e_phi e_phi^T,
+//                H_mu = sum_c (J_i^{-T} w_i)_c d^2 p_Qc/dq^2  (w_i . L_i^{-1} r_i = -lambda_i . r_i)
+// so that, with W_q, W_qd the partials of w_i (lagrangian_derivatives.hpp,
+// minus the passive joint force's slopes, machine.hpp),
+//   dR/dp  = sum_i A_i^T (W_q - H_mu + W_qd Na + M_i Qa) A_i + A_i^T (W_qd n + M_i qa) e_phi^T
+//            - (w_i . L_i^{-1} r_i) e_phi e_phi^T + dw_p/dp
+//   dR/dpd = sum_i A_i^T (W_qd + 2 M_i Na) A_i + 2 A_i^T M_i n e_phi^T + dw_p/dpd.
+// The platform's (lagrangian.hpp, mwx' = -mwy, mwy' = mwx):
 //   dw_p/dphi  = (-mwx phidd + mwy phid^2, -mwy phidd - mwx phid^2, 0, -mwx xdd - mwy ydd)
 //   dw_p/dphid = (-2 mwx phid, -2 mwy phid, 0, 0)
 #pragma once
