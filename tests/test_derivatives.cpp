@@ -102,7 +102,8 @@ void check_forward(const Model& m, const Case& c, double h) {
   Vec8 ydot;
   Mat8 A;
   Mat8x12 B;
-  ASSERT_EQ(state_derivative_jacobians(m, y, kF, kTau, kWe, kStopsFromState, ydot, A, B), Status::Ok);
+  JointJacobians joints;
+  ASSERT_EQ(state_derivative_jacobians(m, y, kF, kTau, kWe, kStopsFromState, ydot, A, B, &joints), Status::Ok);
   EXPECT_EQ(ydot.tail<4>(), plain_pdd(m, y, u)) << "the value is the plain state function's";
   EXPECT_EQ(ydot.head<4>(), c.vel);
   // dpd/dy: identity on the rates, nothing else; dpd/du = 0.
@@ -135,6 +136,24 @@ void check_forward(const Model& m, const Case& c, double h) {
   an << A.bottomRows<4>(), B.bottomRows<4>();
   expect_columns_match("d pdd / d(p, pd)", an.leftCols(8), fd.leftCols(8), err.head(8), 1e-7);
   expect_columns_match("d pdd / du", an.rightCols(12), fd.rightCols(12), err.tail(12), 1e-7);
+
+  // The sliders' rows: d rho/dp, d rhod/dp and d rhod/dpd = d rho/dp, from
+  // the joints the plain state function reports.
+  Eigen::MatrixXd fd_joints(8, 8), an_joints(8, 8);
+  Eigen::VectorXd err_joints(8);
+  for (int k = 0; k < 8; ++k) {
+    fd_joints.col(k) = richardson([&](double s) {
+      Vec8 ys = y, yd;
+      ys[k] += s;
+      JointMotion jm;
+      EXPECT_EQ(state_derivative(m, Formulation::LegPartitioned, ys, Vec16::Zero(), yd, nullptr, &jm), Status::Ok);
+      Vec8 out;
+      out << jm.rho, jm.rhod;
+      return out;
+    }, h * hy[k], &err_joints[k]);
+  }
+  an_joints << joints.J_rho, Mat4::Zero(), joints.drhod_dp, joints.J_rho;
+  expect_columns_match("d (rho, rhod) / d(p, pd)", an_joints, fd_joints, err_joints, 1e-7);
 }
 
 }  // namespace

@@ -70,6 +70,8 @@ void residual_partials(const Model& m, const ReducedDynamics& rd, const Pose& pd
     out.dp(3, 3) -= w.dot(Linv_r);
     add_projected(L.Linv, c, W.dqd + 2.0 * (L.M * Na), 2.0 * (L.M * n), out.dpd);
     out.J_rho.row(i) = L.A.row(0);
+    out.drhod_dp.row(i).noalias() = Na.row(0) * L.A;
+    out.drhod_dp(i, 3) += n[0];
   }
   // The platform with its payload.
   const PlatformInertia pi = platform_inertia(m, rd.cos_phi(), rd.sin_phi());
@@ -83,7 +85,7 @@ void residual_partials(const Model& m, const ReducedDynamics& rd, const Pose& pd
 }
 
 Status state_derivative_jacobians(const Model& m, const Vec8& y, const Vec4& F, const Vec4& tau, const Wrench& we,
-                                  unsigned stops, Vec8& ydot, Mat8& A, Mat8x12& B) {
+                                  unsigned stops, Vec8& ydot, Mat8& A, Mat8x12& B, JointJacobians* joints) {
   if (!y.allFinite() || !F.allFinite() || !tau.allFinite() || !we.allFinite()) return Status::NonFinite;
   ReducedDynamics rd;
   Status s = reduced_terms(m, y, generalized_forces(m, F, tau, we), stops, rd);
@@ -109,6 +111,10 @@ Status state_derivative_jacobians(const Model& m, const Vec8& y, const Vec4& F, 
   B.block<4, 4>(4, 4) = Mr_inv;
   B.block<4, 4>(4, 8) = m.drive_ratio * B.block<4, 4>(4, 0);
   if (!A.allFinite() || !B.allFinite()) return Status::Singular;
+  if (joints) {
+    joints->J_rho = P.J_rho;
+    joints->drhod_dp = P.drhod_dp;
+  }
   return Status::Ok;
 }
 

@@ -39,6 +39,7 @@ struct ResidualPartials {
   Mat4 dpd = Mat4::Zero();   // dR/dpd
   Mat4 Mr = Mat4::Zero();    // dR/dpdd, the reduced mass matrix
   Mat4 J_rho = Mat4::Zero(); // d rho/dp (row i = A_i's rho row): dR/dF = -J_rho^T
+  Mat4 drhod_dp = Mat4::Zero();  // d rhod/dp (row i = the rho row of d qd_i/dp); d rhod/dpd = J_rho
 };
 
 /// The partials at the reduced terms `rd` (reduced_terms, minimal_state.hpp:
@@ -59,7 +60,12 @@ using Mat8x12 = Eigen::Matrix<double, 8, kPlantInputs>;
 /// formulation and its Jacobians A = dydot/dy (8x8) and B = dydot/du
 /// (8x12): the machine included (rotor, friction, payload; the end stops
 /// where smooth: `stops` as in state_derivative).
+/// If `joints` is given it receives the slider rows: J_rho = d rho/dp and
+/// drhod_dp = d rhod/dp (d rhod/dpd = J_rho).
+struct JointJacobians {
+  Mat4 J_rho, drhod_dp;
+};
 Status state_derivative_jacobians(const Model& m, const Vec8& y, const Vec4& F, const Vec4& tau, const Wrench& we,
-                                  unsigned stops, Vec8& ydot, Mat8& A, Mat8x12& B);
+                                  unsigned stops, Vec8& ydot, Mat8& A, Mat8x12& B, JointJacobians* joints = nullptr);
 
 }  // namespace pkm
