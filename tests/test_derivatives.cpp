@@ -18,24 +18,6 @@ using namespace pkm_test;
 
 namespace {
 
-/// d/ds f(s) at s = 0: central differences at h, h/2, h/4, h/8 and
-/// Richardson's table (error O(h^8)); *err is the size of the last
-/// correction, an estimate of the result's own error.
-template <class F>
-auto richardson(F f, double h, double* err) -> decltype(f(0.0)) {
-  using V = decltype(f(0.0));
-  constexpr int kLevels = 4;
-  V T[kLevels];
-  for (int k = 0; k < kLevels; ++k) {
-    const double hk = h / (1 << k);
-    T[k] = (f(hk) - f(-hk)) / (2 * hk);
-    double factor = 4.0;
-    for (int j = k - 1; j >= 0; --j, factor *= 4.0) T[j] = (factor * T[j + 1] - T[j]) / (factor - 1.0);
-    if (k == kLevels - 1) *err = (T[0] - T[1]).cwiseAbs().maxCoeff();
-  }
-  return T[0];
-}
-
 /// Every machine term on: rotors, payload off the centre, viscous and
 /// Coulomb friction with a velocity scale that keeps tanh's slope visible.
 Params machine_params() {
@@ -73,22 +55,6 @@ Pose plain_pdd(const Model& m, const Vec8& y, const Eigen::Matrix<double, 12, 1>
   Vec8 ydot;
   EXPECT_EQ(state_derivative(m, Formulation::LegPartitioned, y, f, ydot), Status::Ok);
   return ydot.tail<4>();
-}
-
-/// Column by column: |analytic - difference|_max over the column's largest
-/// analytic entry, and the same for the difference quotient's own error
-/// estimate (the quotient must be reliable for the comparison to mean anything).
-void expect_columns_match(const char* what, const Eigen::MatrixXd& an, const Eigen::MatrixXd& fd,
-                          const Eigen::VectorXd& fd_err, double tol) {
-  double worst = 0.0;
-  for (int k = 0; k < an.cols(); ++k) {
-    const double scale = std::max(an.col(k).cwiseAbs().maxCoeff(), 1e-12);
-    const double rel = (an.col(k) - fd.col(k)).cwiseAbs().maxCoeff() / scale;
-    EXPECT_LT(fd_err[k] / scale, 0.1 * tol) << what << " column " << k << ": the difference quotient is unreliable";
-    EXPECT_LT(rel, tol) << what << " column " << k << ": relative difference " << rel << " (bound " << tol << ")";
-    worst = std::max(worst, rel);
-  }
-  std::printf("%s: largest relative difference %.2e (bound %.0e)\n", what, worst, tol);
 }
 
 /// The state Jacobians against Richardson differences of state_derivative;
