@@ -28,6 +28,8 @@ Status inverse_dynamics_derivatives(const Model& m, const Pose& pose, const Pose
   out.dpd = lu.solve(P.dpd);
   out.dpdd = lu.solve(P.Mr);
   out.dwe = -lu.solve(Mat4::Identity());
+  out.J_rho = J_rho;
+  out.drhod_dp = P.drhod_dp;
   const bool finite = out.F.allFinite() && out.dp.allFinite() && out.dpd.allFinite() && out.dpdd.allFinite();
   return finite ? Status::Ok : Status::Singular;
 }

@@ -19,6 +19,8 @@ struct InverseDynamicsPartials {
   Mat4 dpd = Mat4::Zero();     // dF/d(dx, dy, dz, dphi)
   Mat4 dpdd = Mat4::Zero();    // dF/d(ddx, ddy, ddz, ddphi)
   Mat4 dwe = Mat4::Zero();     // dF/d(Fe[1..3], Me_z)
+  Mat4 J_rho = Mat4::Zero();   // d rho/dp (= d rhod/dpd)
+  Mat4 drhod_dp = Mat4::Zero();  // d rhod/dp
 };
 
 /// Status::Unreachable off the workspace, ::Singular at a leg or parallel
