@@ -180,3 +180,34 @@ TEST(InverseDerivatives, MatchRichardsonDifferencesOfTheInverseDynamics) {
     expect_columns_match("dF / d(p, pd, pdd, we)", an, fd, err, 1e-7);
   }
 }
+
+TEST(MachineDerivatives, PassiveForceAndDissipationSlopesMatchRichardsonDifferences) {
+  // Friction alone (within the travel), a pushing stop, a released stop
+  // (k delta + d delta_dot < 0: the force is held at 0, the spring's energy
+  // flows back), each stop from the state and held on (machine.hpp).
+  const Params p = machine_params();
+  struct Joint { const char* what; double rho, rhod; unsigned stops; };
+  const Joint joints[] = {
+      {"within the travel", 0.06, 0.03, kStopsFromState},
+      {"pushing lower stop", p.rho_min - 1e-3, 0.02, kStopsFromState},
+      {"pushing upper stop, held", p.rho_max + 1e-3, -0.02, 1u << 4},
+      {"released lower stop", p.rho_min - 1e-4, 0.2, kStopsFromState},
+      {"released upper stop, held", p.rho_max + 1e-4, -0.2, 1u << 4},
+  };
+  for (const Joint& j : joints) {
+    SCOPED_TRACE(j.what);
+    const PassiveSlopes f = passive_joint_force_slopes(p, 0, j.stops, j.rho, j.rhod);
+    const PassiveSlopes d = dissipated_power_slopes(p, 0, j.stops, j.rho, j.rhod);
+    Eigen::MatrixXd an(2, 2), fd(2, 2);
+    Eigen::VectorXd err(2);
+    an << f.drho, f.drhod, d.drho, d.drhod;
+    auto both = [&](double rho, double rhod) {
+      Eigen::VectorXd v(2);
+      v << passive_joint_force(p, 0, j.stops, rho, rhod), dissipated_power(p, 0, j.stops, rho, rhod);
+      return v;
+    };
+    fd.col(0) = richardson([&](double s) { return both(j.rho + s, j.rhod); }, 2e-5, &err[0]);
+    fd.col(1) = richardson([&](double s) { return both(j.rho, j.rhod + s); }, 2e-3, &err[1]);
+    expect_columns_match("d(F_passive, P_dissipated)/d(rho, rhod)", an, fd, err, 1e-7);
+  }
+}

@@ -58,7 +58,7 @@ struct MeFmu {
 // The unknowns this FMU differentiates and the knowns of Model Exchange.
 const std::initializer_list<const char*> kUnknowns = {
     "der(x)", "der(y)", "der(z)", "der(phi)", "der(dx)", "der(dy)", "der(dz)", "der(dphi)", "der(actuator_work)",
-    "x", "dphi", "rho[1]", "rho[2]", "rho[3]", "rho[4]", "drho[1]", "drho[2]", "drho[3]", "drho[4]"};
+    "der(dissipated_energy)", "x", "dphi", "rho[1]", "rho[2]", "rho[3]", "rho[4]", "drho[1]", "drho[2]", "drho[3]", "drho[4]"};
 const std::initializer_list<const char*> kKnowns = {
     "x", "y", "z", "phi", "dx", "dy", "dz", "dphi", "F[1]", "F[2]", "F[3]", "F[4]",
     "Fe[1]", "Fe[2]", "Fe[3]", "Me_z", "tau[1]", "tau[2]", "tau[3]", "tau[4]"};
@@ -92,12 +92,12 @@ TEST(FmuDerivatives, ModelExchangeJacobianMatchesRichardsonDifferencesOfTheFmu) 
   auto unknowns = [&]() {
     double dx[kStates];
     EXPECT_EQ(f.lib.fmi2GetDerivatives(f.c, dx, kStates), fmi2OK) << f.log.dump();
-    const std::vector<fmi2ValueReference> outs(u.begin() + 9, u.end());
+    const std::vector<fmi2ValueReference> outs(u.begin() + kStates, u.end());
     std::vector<double> o(outs.size());
     EXPECT_EQ(f.lib.fmi2GetReal(f.c, outs.data(), outs.size(), o.data()), fmi2OK) << f.log.dump();
     Eigen::VectorXd v(u.size());
-    for (int i = 0; i < 9; ++i) v[i] = dx[i];
-    for (std::size_t i = 0; i < o.size(); ++i) v[9 + i] = o[i];
+    for (int i = 0; i < kStates; ++i) v[i] = dx[i];
+    for (std::size_t i = 0; i < o.size(); ++i) v[kStates + i] = o[i];
     return v;
   };
   // Steps: pose 0.3 mm, 3 mrad; rates 5 mm/s, 50 mrad/s; forces 1 N; Me_z 0.01 N*m; tau 5 mN*m.

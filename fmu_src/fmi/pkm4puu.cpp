@@ -421,8 +421,9 @@ Status PlantData::get_derivatives(Context& ctx, double dx[]) {
 
 // Analytic (reduced_dynamics_derivatives.hpp) at the current state and
 // inputs, the end stops acting when their joint is past them: der(x) ..
-// der(dphi) and der(actuator_work) (= Fa . drho + we . pd), the states as
-// outputs, rho[i] and drho[i]. The other computed variables are refused
+// der(dphi), der(actuator_work) (= Fa . drho + we . pd) and
+// der(dissipated_energy) (machine.hpp, dissipated_power_slopes), the states
+// as outputs, rho[i] and drho[i]. The other computed variables are refused
 // with Error (not differentiated yet).
 Status PlantData::partial_derivatives(Context& ctx, const Variable* const unknowns[], std::size_t nu,
                                       const Variable* const knowns[], std::size_t nk, double J[]) {
@@ -441,6 +442,12 @@ Status PlantData::partial_derivatives(Context& ctx, const Variable* const unknow
     ctx.log.error("%s: the derivatives at t = %.17g cannot be evaluated: %s", fn, plant->time(), pkm::status_name(s));
     return Status::Error;
   }
+  const pkm::Vec4 rhod = joints.J_rho * y.tail<4>();
+  pkm::Vec4 rho;
+  if (pkm::actuator_positions(plant->model(), y.head<4>(), rho) != pkm::Status::Ok) {
+    ctx.log.error("%s: the actuator positions at t = %.17g cannot be evaluated", fn, plant->time());
+    return Status::Error;
+  }
   // One row over [the 10 states, the 12 inputs u] per unknown.
   Eigen::Matrix<double, 1, kStates + kInputs> row;
   for (std::size_t i = 0; i < nu; ++i) {
@@ -451,12 +458,17 @@ Status PlantData::partial_derivatives(Context& ctx, const Variable* const unknow
       row.tail<kInputs>() = B.row(v.state_of);
     } else if (v.state_of == 8) {  // der(actuator_work)
       const pkm::Vec4 Fa = F + plant->model().drive_ratio * tau;
-      const pkm::Vec4 rhod = joints.J_rho * y.tail<4>();
       row.head<4>() = Fa.transpose() * joints.drhod_dp;
       row.segment<4>(4) = Fa.transpose() * joints.J_rho + we.transpose();
       row.segment<4>(kStates) = rhod.transpose();
       row.segment<4>(kStates + 4) = y.tail<4>().transpose();
       row.segment<4>(kStates + 8) = plant->model().drive_ratio * rhod.transpose();
+    } else if (v.state_of == 9) {  // der(dissipated_energy): sum over the joints
+      for (int l = 0; l < 4; ++l) {
+        const pkm::PassiveSlopes d = pkm::dissipated_power_slopes(plant->model().p, l, pkm::kStopsFromState, rho[l], rhod[l]);
+        row.head<4>() += d.drho * joints.J_rho.row(l) + d.drhod * joints.drhod_dp.row(l);
+        row.segment<4>(4) += d.drhod * joints.J_rho.row(l);
+      }
     } else if (v.state >= 0) {
       row[v.state] = 1.0;
     } else if (std::strncmp(v.name, "rho[", 4) == 0) {
@@ -465,8 +477,8 @@ Status PlantData::partial_derivatives(Context& ctx, const Variable* const unknow
       row.head<4>() = joints.drhod_dp.row(v.index);
       row.segment<4>(4) = joints.J_rho.row(v.index);
     } else {
-      ctx.log.error("%s: the partial derivatives of %s are not provided (analytic so far: der(x) .. der(dphi), "
-                    "der(actuator_work), the states, rho[1..4] and drho[1..4])",
+      ctx.log.error("%s: the partial derivatives of %s are not provided (analytic so far: the states' "
+                    "derivatives, the states, rho[1..4] and drho[1..4])",
                     fn, v.name);
       return Status::Error;
     }
