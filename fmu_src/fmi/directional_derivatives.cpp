@@ -46,28 +46,30 @@ Status Instance::partial_derivative(const char* fn, bool adjoint, const std::uin
     return Status::Error;
   }
   const bool me = interface_ == Interface::ModelExchange;
-  d_unknowns_.clear();
-  d_knowns_.clear();
-  for (std::size_t i = 0; i < nu; ++i) {
-    const Variable* v = def_.find(unknowns[i]);
-    if (!v || v->type != VarType::Real || !(v->causality == Causality::Output || (me && v->state_of >= 0))) {
-      log_.error("%s: value reference %u is not an unknown of this FMU (%s); the call has no effect", fn,
-                 static_cast<unsigned>(unknowns[i]),
-                 me ? "Model Exchange: an output or a state derivative" : "Co-Simulation: an output");
-      return Status::Error;
+  // Each reference must name a Real variable of the role `fits` says.
+  auto resolve = [&](const std::uint32_t vrs[], std::size_t n, bool (*fits)(const Variable&, bool),
+                     const char* role, const char* rule, std::vector<const Variable*>& out) {
+    out.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Variable* v = def_.find(vrs[i]);
+      if (!v || v->type != VarType::Real || !fits(*v, me)) {
+        log_.error("%s: value reference %u is not %s of this FMU (%s); the call has no effect", fn,
+                   static_cast<unsigned>(vrs[i]), role, rule);
+        return false;
+      }
+      out.push_back(v);
     }
-    d_unknowns_.push_back(v);
-  }
-  for (std::size_t j = 0; j < nk; ++j) {
-    const Variable* v = def_.find(knowns[j]);
-    if (!v || v->type != VarType::Real || !(v->causality == Causality::Input || (me && v->state >= 0))) {
-      log_.error("%s: value reference %u is not a known of this FMU (%s); the call has no effect", fn,
-                 static_cast<unsigned>(knowns[j]),
-                 me ? "Model Exchange: a continuous state or an input" : "Co-Simulation: an input");
-      return Status::Error;
-    }
-    d_knowns_.push_back(v);
-  }
+    return true;
+  };
+  auto is_unknown = [](const Variable& v, bool me) {
+    return v.causality == Causality::Output || (me && v.state_of >= 0);
+  };
+  auto is_known = [](const Variable& v, bool me) { return v.causality == Causality::Input || (me && v.state >= 0); };
+  if (!resolve(unknowns, nu, is_unknown, "an unknown",
+               me ? "Model Exchange: an output or a state derivative" : "Co-Simulation: an output", d_unknowns_) ||
+      !resolve(knowns, nk, is_known, "a known",
+               me ? "Model Exchange: a continuous state or an input" : "Co-Simulation: an input", d_knowns_))
+    return Status::Error;
   for (std::size_t k = 0; k < want_seed; ++k) {
     if (!std::isfinite(seed[k])) {
       log_.error("%s: seed[%llu] = %g is not finite; the call has no effect", fn, static_cast<unsigned long long>(k),
