@@ -12,7 +12,11 @@ step, through
                  Python loop of mj_step;
   Pinocchio      constrained forward dynamics: fixed-step RK4 at 1 ms around
                  pinocchio.constraintDynamics (C++), the loop in Python; and,
-                 for context, the 4000 bare constraintDynamics calls alone.
+                 for context, the 4000 bare constraintDynamics calls alone;
+                 and the cost of its derivatives,
+                 computeConstraintDynamicsDerivatives after constraintDynamics,
+                 printed beside this project's (pkm_bench item 1b, run here:
+                 state_derivative_jacobians over state_derivative).
 
 For each: the median wall time per simulated second, the ratio of MuJoCo's
 time to it (how many times faster than MuJoCo), the largest ||C(q)|| over the
@@ -188,10 +192,48 @@ class PinocchioBench:
             per.append(time.perf_counter() - t0)
         return per
 
+    def derivatives(self, calls=2000):
+        """Per call: constraintDynamics alone, and followed by
+        computeConstraintDynamicsDerivatives (d ddq / d(q, v, tau), 16 x 48)."""
+        pm = self.pm
+        cd, m, data, cm, cdata, prox = pin.constraintDynamics, pm.model, pm.data, pm._cm, pm._cd, pm._prox
+        dd = pin.computeConstraintDynamicsDerivatives
+        q, v, f = self.q0, self.v0, self.tau[1]
+        t0 = time.perf_counter()
+        for _ in range(calls):
+            cd(m, data, q, v, f, cm, cdata, prox)
+        t1 = time.perf_counter()
+        for _ in range(calls):
+            cd(m, data, q, v, f, cm, cdata, prox)
+            dd(m, data, cm, cdata, prox)
+        t2 = time.perf_counter()
+        return (t1 - t0) / calls, (t2 - t1) / calls
+
     def test_run(self):
         out = _rows_from_q(self.run(STEPS_TEST, keep=True))
         out["t"] = np.arange(STEPS_TEST + 1) * H
         return out
+
+
+# --- derivatives -----------------------------------------------------------------------------------------------
+def derivatives_comparison(build, median):
+    """The cost of the dynamics' derivatives over the cost of the dynamics:
+    Pinocchio's computeConstraintDynamicsDerivatives after constraintDynamics
+    (this run, Python calls), and this project's state_derivative_jacobians
+    over state_derivative (pkm_bench item 1b, run now, if built)."""
+    t_cd, t_dd = median["pinocchio_dynamics_call"], median["pinocchio_derivatives_call"]
+    print(f"derivatives, Pinocchio: constraintDynamics {1e6 * t_cd:.1f} us, with "
+          f"computeConstraintDynamicsDerivatives {1e6 * t_dd:.1f} us per call (16 coordinates, 4 constraints, "
+          f"from Python): {t_dd / t_cd:.2f}x")
+    exe = build / "bench" / "pkm_bench"
+    if not exe.exists():
+        print(f"derivatives, this project: {exe} not built")
+        return
+    out = subprocess.run([str(exe)], capture_output=True, text=True, check=False).stdout
+    rows = [line.strip() for line in out.splitlines()
+            if "state_derivative (LegPartitioned, baseline)" in line or "state_derivative_jacobians:" in line]
+    for line in rows:
+        print(f"derivatives, this project (pkm_bench 1b): {' '.join(line.split())}")
 
 
 # --- the table -----------------------------------------------------------------------------------------------------
@@ -263,6 +305,8 @@ def main(argv=None):
         add("mujoco_loop", mj.python_loop(args.batches))
         add("pinocchio_rk4", pb.rk4(1))
         add("pinocchio_bare", pb.bare(1))
+        add("pinocchio_dynamics_call", [pb.derivatives()[0]])
+        add("pinocchio_derivatives_call", [pb.derivatives()[1]])
     median = {k: float(np.median(v)) for k, v in times.items()}
 
     log("accuracy: Pinocchio reference (DOP853, rtol 1e-13), and each engine's whole 1.5 s run")
@@ -302,6 +346,7 @@ def main(argv=None):
     print()
     print(table)
     print()
+    derivatives_comparison(build, median)
     for key in ("capi_rk4", "capi_cvode", "capi_cvode_tight", "capi_cvode_one_call"):
         ratio = t_mj / median[key]
         ok = ratio >= 10.0 and c_cases[key]["max_c"] <= 1e-12

@@ -38,9 +38,11 @@
 
 #include "autotest.hpp"
 #include "inverse_dynamics.hpp"
+#include "inverse_dynamics_derivatives.hpp"
 #include "lagrangian.hpp"
 #include "minimal_state.hpp"
 #include "plant.hpp"
+#include "reduced_dynamics_derivatives.hpp"
 #include "servo_kinematics.hpp"
 #include "trajectory.hpp"
 
@@ -398,6 +400,70 @@ int main() {
                 fmt_time(sd[i].median).c_str(), fmt_time(sd[i].min).c_str(), sd[i].per_batch,
                 sd[i].median / sd[0].median, target, sd_acc_err[i]);
   }
+  rule();
+
+  // ----------------------------------------- 1b. analytic derivatives (issue 13)
+  // The full Jacobian of the state derivative, A (8x8) and B (8x12), and the
+  // inverse dynamics' dF/d(p, pd, pdd, we), each against its own value
+  // measured here in the same run: one state_derivative (LegPartitioned,
+  // item 1's figure) and one cold inverse_dynamics. Central differences
+  // would need 24 state derivatives for A and B.
+  Figure jac, sd_same, idd, id_plain;
+  {
+    Vec8 yk = y_mid, ydot;
+    pkm::Mat8 A;
+    pkm::Mat8x12 B;
+    long k = 0;
+    double acc = 0;
+    Status bad = Status::Ok;
+    const Vec4 tau0 = Vec4::Zero();
+    jac = time_per_call([&] {
+      yk[0] = y_mid[0] + 1e-12 * static_cast<double>(k++ & 1023);
+      const Status s =
+          pkm::state_derivative_jacobians(model, yk, id_mid.F, tau0, Wrench::Zero(), pkm::kStopsFromState, ydot, A, B);
+      if (s != Status::Ok) bad = s;
+      acc += A(4, 0) + B(7, 3);
+    });
+    sd_same = time_per_call([&] {  // the baseline again, right beside it
+      yk[0] = y_mid[0] + 1e-12 * static_cast<double>(k++ & 1023);
+      const Status s = pkm::state_derivative(model, Formulation::LegPartitioned, yk, f_mid, ydot);
+      if (s != Status::Ok) bad = s;
+      acc += ydot[4];
+    });
+    pkm::InverseDynamicsPartials d;
+    pkm::InverseDynamicsResult r;
+    Pose pk = p;
+    idd = time_per_call([&] {
+      pk[0] = p[0] + 1e-12 * static_cast<double>(k++ & 1023);
+      const Status s = pkm::inverse_dynamics_derivatives(model, pk, pd, pdd, Wrench::Zero(), d);
+      if (s != Status::Ok) bad = s;
+      acc += d.dp(0, 0);
+    });
+    id_plain = time_per_call([&] {
+      pk[0] = p[0] + 1e-12 * static_cast<double>(k++ & 1023);
+      const Status s = pkm::inverse_dynamics(model, pk, pd, pdd, Wrench::Zero(), r, false);
+      if (s != Status::Ok) bad = s;
+      acc += r.F[0];
+    });
+    g_sink = acc;
+    if (bad != Status::Ok) {
+      std::printf("  !! derivatives failed: %s\n", pkm::status_name(bad));
+      ++failures;
+    }
+  }
+  const double jac_ratio = jac.median / sd_same.median;
+  std::printf("1b. Analytic derivatives at the same state (reduced_dynamics_derivatives.hpp)\n");
+  std::printf("   %-44s %12s %12s %10s %16s\n", "evaluation", "median/call", "min/call", "ratio", "target");
+  std::printf("   %-44s %12s %12s %10s\n", "state_derivative (LegPartitioned, baseline)",
+              fmt_time(sd_same.median).c_str(), fmt_time(sd_same.min).c_str(), "1.00x");
+  std::printf("   %-44s %12s %12s %9.2fx %16s\n", "state_derivative_jacobians: ydot, A 8x8, B 8x12",
+              fmt_time(jac.median).c_str(), fmt_time(jac.min).c_str(), jac_ratio,
+              (std::string("<= 3x  ") + ok_mark(jac_ratio, 3.0)).c_str());
+  std::printf("   %-44s %12s %12s %9.2fx\n", "  (central differences: 24 state derivatives)", "", "", 24.0);
+  std::printf("   %-44s %12s %12s %10s\n", "inverse_dynamics (cold, baseline)", fmt_time(id_plain.median).c_str(),
+              fmt_time(id_plain.min).c_str(), "1.00x");
+  std::printf("   %-44s %12s %12s %9.2fx\n", "inverse_dynamics_derivatives: F, dF 4x16", fmt_time(idd.median).c_str(),
+              fmt_time(idd.min).c_str(), idd.median / id_plain.median);
   rule();
 
   // ------------------------------------------------------- 2. inverse dynamics
@@ -782,6 +848,25 @@ int main() {
     w2.stop();
     alloc_row("    1000 inverse_dynamics, cold", w2, "0", true);
   }
+  // the analytic derivatives (item 1b)
+  {
+    Vec8 yk = y_mid, ydot;
+    pkm::Mat8 A;
+    pkm::Mat8x12 B;
+    pkm::InverseDynamicsPartials d;
+    double acc = 0;
+    AllocWindow w;
+    for (int k = 0; k < 1000; ++k) {
+      yk[0] = y_mid[0] + 1e-12 * k;
+      pkm::state_derivative_jacobians(model, yk, id_mid.F, Vec4::Zero(), Wrench::Zero(), pkm::kStopsFromState, ydot,
+                                      A, B);
+      pkm::inverse_dynamics_derivatives(model, yk.head<4>(), pd, pdd, Wrench::Zero(), d);
+      acc += A(4, 0) + d.dp(0, 0);
+    }
+    w.stop();
+    g_sink = acc;
+    alloc_row("    1000 state_derivative_jacobians + inverse_dynamics_derivatives", w, "0", true);
+  }
   // (ii) RK4 Plant::advance, 1 s in 1-ms calls, after initialisation
   auto plant_window = [&](const pkm::SolverSettings& st, pkm::InputSignal input, bool skip_first,
                           AllocWindow* out, Status* status) {
@@ -864,6 +949,7 @@ int main() {
   std::printf("   ID / sd(LegP): cold, warm 0.5 ms, same point, [**]   %8.2f %8.2f %8.2f %8.2f\n",
               id_cold.median / sd0, id_warm.median / sd0, id_same.median / sd0, id_stages.median / sd0);
   std::printf("   ID warm (0.5 ms away) / ID cold                      %8.2f\n", id_warm.median / id_cold.median);
+  std::printf("   Jacobians A, B / sd(LegP) (same run, item 1b)        %8.2f   (target <= 3)\n", jac_ratio);
   std::printf("   RK4 forward run / (8000 x sd(LegP))                  %8.2f   (integrator + input overhead)\n",
               rk4_fwd.fig.median / (8000.0 * sd0));
   std::printf("   RK4 bare round trip / forward only                   %8.2f   (~ 1 + ID[**] / sd = %.2f)\n",

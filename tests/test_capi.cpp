@@ -163,3 +163,101 @@ TEST(CApi, ReadingOutputsChangesNothing) {
   EXPECT_EQ(std::memcmp(y1, y2, sizeof y1), 0);
   for (int i = 0; i < 4; ++i) EXPECT_EQ(out.theta1[i], th1[i]);
 }
+
+// The derivatives through the C API: the layout (row-major, the inputs'
+// order) against central differences of the accelerations pkm_get_outputs
+// reports and of pkm_inverse_dynamics_machine; their accuracy is
+// test_derivatives' subject.
+namespace {
+
+struct MachineHandle {
+  pkm_model* m = nullptr;
+  MachineHandle() {
+    pkm_params p;
+    pkm_default_params(&p);
+    pkm_machine_params mp;
+    pkm_default_machine_params(&mp);
+    mp.friction_viscous = 1.5;
+    mp.payload_mass = 0.3;
+    mp.payload_com[0] = 0.02;
+    char err[256];
+    EXPECT_EQ(pkm_create_machine(&p, &mp, &m, err, sizeof err), PKM_OK) << err;
+  }
+  ~MachineHandle() { pkm_destroy(m); }
+};
+
+// Fourth-order central difference of s -> f(s)[0..3] at s = 0.
+template <class F>
+void d_ds4(F f, double h, double out[4]) {
+  double a[4], b[4], c[4], d[4];
+  f(-2 * h, a), f(-h, b), f(h, c), f(2 * h, d);
+  for (int i = 0; i < 4; ++i) out[i] = (a[i] - 8 * b[i] + 8 * c[i] - d[i]) / (12 * h);
+}
+
+}  // namespace
+
+TEST(CApi, ForwardDerivativesAreRowMajorInTheInputsOrder) {
+  MachineHandle h;
+  const double y[8] = {0.004, -0.003, 0.06, 0.05, 0.1, -0.05, 0.08, 0.7};
+  const double u[PKM_PLANT_INPUTS] = {2.7, 2.5, 2.9, 2.6, 0.3, -0.2, 0.5, 0.01, 0, 0, 0, 0};
+  double ydot[8], A[64], B[96];
+  ASSERT_EQ(pkm_forward_derivatives(h.m, y, u, ydot, A, B), PKM_OK);
+  // The accelerations pkm_get_outputs reports at a state for F and wrench = u[4..7].
+  auto acc = [&](const double* ys, const double* us, double out[4]) {
+    ASSERT_EQ(pkm_init_pose(h.m, 0.0, ys, ys + 4), PKM_OK);
+    pkm_outputs o;
+    ASSERT_EQ(pkm_get_outputs(h.m, us, us + 4, &o), PKM_OK);
+    for (int i = 0; i < 4; ++i) out[i] = o.acceleration[i];
+  };
+  double a0[4];
+  acc(y, u, a0);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(ydot[i], y[4 + i]);
+    EXPECT_NEAR(ydot[4 + i], a0[i], 1e-9 * (1 + std::fabs(a0[i])));
+  }
+  for (int k = 0; k < 16; ++k) {  // 8 state columns, then F and the wrench
+    double d[4];
+    d_ds4([&](double s, double out[4]) {
+      double ys[8], us[PKM_PLANT_INPUTS];
+      std::memcpy(ys, y, sizeof ys);
+      std::memcpy(us, u, sizeof us);
+      if (k < 8) ys[k] += s; else us[k - 8] += s;
+      acc(ys, us, out);
+    }, k < 8 ? 1e-5 : 1e-2, d);
+    for (int i = 0; i < 4; ++i) {
+      const double an = k < 8 ? A[8 * (4 + i) + k] : B[12 * (4 + i) + (k - 8)];
+      EXPECT_NEAR(an, d[i], 1e-5 * (1 + std::fabs(d[i]))) << "row " << 4 + i << " column " << k;
+    }
+  }
+  // A motor torque acts as (2 pi / screw_lead) times a force (MODEL_SPEC "Drives").
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      EXPECT_NEAR(B[12 * (4 + i) + 8 + j], 2 * M_PI / 0.004 * B[12 * (4 + i) + j], 1e-12 * std::fabs(B[12 * (4 + i) + 8 + j]));
+}
+
+TEST(CApi, InverseDerivativesAreRowMajorOverPoseRatesAccelerationsWrench) {
+  MachineHandle h;
+  const double x[16] = {0.004, -0.003, 0.06, 0.05, 0.1, -0.05, 0.08, 0.7, 0.8, -0.5, 1.1, 6.0, 0.3, -0.2, 0.5, 0.01};
+  double F[4], dF[64];
+  ASSERT_EQ(pkm_inverse_derivatives(h.m, x, x + 4, x + 8, x + 12, F, dF), PKM_OK);
+  auto forces = [&](const double* xs, double out[4]) {
+    pkm_inverse_machine_result r;
+    ASSERT_EQ(pkm_inverse_dynamics_machine(h.m, xs, xs + 4, xs + 8, xs + 12, &r), PKM_OK);
+    for (int i = 0; i < 4; ++i) out[i] = r.F[i];
+  };
+  double F0[4];
+  forces(x, F0);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(F[i], F0[i], 1e-11 * std::fabs(F0[i]));
+  for (int k = 0; k < 16; ++k) {
+    double d[4];
+    d_ds4([&](double s, double out[4]) {
+      double xs[16];
+      std::memcpy(xs, x, sizeof xs);
+      xs[k] += s;
+      forces(xs, out);
+    }, k < 4 ? 1e-5 : 1e-3, d);
+    for (int i = 0; i < 4; ++i)
+      EXPECT_NEAR(dF[16 * i + k], d[i], 1e-5 * (1 + std::fabs(d[i]))) << "row " << i << " column " << k;
+  }
+  EXPECT_EQ(pkm_inverse_derivatives(h.m, x, x + 4, x + 8, nullptr, F, nullptr), PKM_ERR_INVALID_ARGUMENT);
+}

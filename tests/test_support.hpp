@@ -2,6 +2,8 @@
 // differences (all derived from the spec, never from the code's outputs).
 #pragma once
 
+#include <algorithm>
+#include <cstdio>
 #include <random>
 #include <string>
 
@@ -61,6 +63,40 @@ Eigen::Matrix<double, N, 1> random_vec(unsigned seed, double scale) {
 template <class F>
 auto d_ds(F f, double h) -> decltype(f(0.0)) {
   return (f(-2 * h) - 8 * f(-h) + 8 * f(h) - f(2 * h)) / (12 * h);
+}
+
+/// d/ds f(s) at s = 0: central differences at h, h/2, h/4, h/8 and
+/// Richardson's table (error O(h^8)); *err is the size of the last
+/// correction, an estimate of the result's own error.
+template <class F>
+auto richardson(F f, double h, double* err) -> decltype(f(0.0)) {
+  using V = decltype(f(0.0));
+  constexpr int kLevels = 4;
+  V T[kLevels];
+  for (int k = 0; k < kLevels; ++k) {
+    const double hk = h / (1 << k);
+    T[k] = (f(hk) - f(-hk)) / (2 * hk);
+    double factor = 4.0;
+    for (int j = k - 1; j >= 0; --j, factor *= 4.0) T[j] = (factor * T[j + 1] - T[j]) / (factor - 1.0);
+    if (k == kLevels - 1) *err = (T[0] - T[1]).cwiseAbs().maxCoeff();
+  }
+  return T[0];
+}
+
+/// Column by column: |analytic - difference|_max over the column's largest
+/// analytic entry, and the same for the difference quotient's own error
+/// estimate (the quotient must be reliable for the comparison to mean anything).
+void expect_columns_match(const char* what, const Eigen::MatrixXd& an, const Eigen::MatrixXd& fd,
+                          const Eigen::VectorXd& fd_err, double tol) {
+  double worst = 0.0;
+  for (int k = 0; k < an.cols(); ++k) {
+    const double scale = std::max(an.col(k).cwiseAbs().maxCoeff(), 1e-12);
+    const double rel = (an.col(k) - fd.col(k)).cwiseAbs().maxCoeff() / scale;
+    EXPECT_LT(fd_err[k] / scale, 0.1 * tol) << what << " column " << k << ": the difference quotient is unreliable";
+    EXPECT_LT(rel, tol) << what << " column " << k << ": relative difference " << rel << " (bound " << tol << ")";
+    worst = std::max(worst, rel);
+  }
+  std::printf("%s: largest relative difference %.2e (bound %.0e)\n", what, worst, tol);
 }
 
 /// Relative difference with a floor on the scale.

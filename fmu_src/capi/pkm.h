@@ -209,6 +209,28 @@ PKM_API pkm_status pkm_inverse_dynamics_machine(pkm_model* m, const double pose[
                                                 const double acceleration[4], const double wrench[4],
                                                 pkm_inverse_machine_result* out);
 
+/* ---- Analytic derivatives (no finite differences), machine included. ---- */
+
+/* Number of plant inputs u, in this order: F[1..4] (N), Fe[1..3] (N),
+ * Me_z (N*m), tau[1..4] (N*m). */
+#define PKM_PLANT_INPUTS 12
+
+/* The state derivative ydot = (pd, pdd) at state[8] = (x, y, z, phi, dx, dy,
+ * dz, dphi) and inputs[12] (PKM_PLANT_INPUTS order; NULL: zero), with its
+ * Jacobians A = dydot/dstate (8x8, row-major) and B = dydot/dinputs (8x12,
+ * row-major). Each end stop acts when its joint is past it (at a stop's
+ * contact or release instant, the side the force is evaluated on).
+ * Independent of the forward state; ydot may be NULL. */
+PKM_API pkm_status pkm_forward_derivatives(pkm_model* m, const double state[8], const double inputs[12],
+                                           double ydot[8], double A[64], double B[96]);
+
+/* The inverse dynamics' forces F[4] (as pkm_inverse_dynamics_machine gives
+ * them) and their Jacobian dF[4x16] (row-major) with respect to
+ * (pose[4], velocity[4], acceleration[4], wrench[4]); wrench may be NULL. */
+PKM_API pkm_status pkm_inverse_derivatives(pkm_model* m, const double pose[4], const double velocity[4],
+                                           const double acceleration[4], const double wrench[4], double F[4],
+                                           double dF[64]);
+
 #ifdef __cplusplus
 }
 #endif

@@ -10,8 +10,10 @@
 
 #include "constraints.hpp"
 #include "inverse_dynamics.hpp"
+#include "inverse_dynamics_derivatives.hpp"
 #include "lagrangian.hpp"
 #include "plant.hpp"
+#include "reduced_dynamics_derivatives.hpp"
 
 struct pkm_model {
   explicit pkm_model(const pkm::Model& m) : plant(m) {}
@@ -256,6 +258,39 @@ pkm_status pkm_inverse_dynamics_machine(pkm_model* m, const double pose[4], cons
   copy(r.tau, out->tau);
   copy<12>(r.lambda, out->lambda);
   out->beyond_stops = r.beyond_stops;
+  return PKM_OK;
+}
+
+pkm_status pkm_forward_derivatives(pkm_model* m, const double state[8], const double inputs[12], double ydot[8],
+                                   double A[64], double B[96]) {
+  if (!m || !state || !A || !B) return PKM_ERR_INVALID_ARGUMENT;
+  const pkm::Vec8 y = Eigen::Map<const pkm::Vec8>(state);
+  const double zero[PKM_PLANT_INPUTS] = {};
+  const double* u = inputs ? inputs : zero;
+  pkm::Vec8 yd;
+  pkm::Mat8 Ay;
+  pkm::Mat8x12 By;
+  const Status s = pkm::state_derivative_jacobians(m->plant.model(), y, vec4(u), vec4(u + 8), vec4(u + 4),
+                                                   pkm::kStopsFromState, yd, Ay, By);
+  if (s != Status::Ok) return fail(m, s, "pkm_forward_derivatives");
+  if (ydot) copy<8>(yd, ydot);
+  Eigen::Map<Eigen::Matrix<double, 8, 8, Eigen::RowMajor>> A_out(A);
+  Eigen::Map<Eigen::Matrix<double, 8, 12, Eigen::RowMajor>> B_out(B);
+  A_out = Ay;
+  B_out = By;
+  return PKM_OK;
+}
+
+pkm_status pkm_inverse_derivatives(pkm_model* m, const double pose[4], const double velocity[4],
+                                   const double acceleration[4], const double wrench[4], double F[4], double dF[64]) {
+  if (!m || !pose || !velocity || !acceleration || !F || !dF) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::InverseDynamicsPartials d;
+  const Status s = pkm::inverse_dynamics_derivatives(m->plant.model(), vec4(pose), vec4(velocity),
+                                                     vec4(acceleration), vec4(wrench), d);
+  if (s != Status::Ok) return fail(m, s, "pkm_inverse_derivatives");
+  copy(d.F, F);
+  Eigen::Map<Eigen::Matrix<double, 4, 16, Eigen::RowMajor>> J(dF);
+  J << d.dp, d.dpd, d.dpdd, d.dwe;
   return PKM_OK;
 }
 

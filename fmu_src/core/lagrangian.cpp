@@ -6,18 +6,10 @@
 #include "machine.hpp"
 
 namespace pkm {
-namespace {
-
-// Derivatives with respect to theta2 of the two non-constant entries of
-// M_leg: M13 = m_r l/2 c2 and M22.
-struct LegMassSlopes { double dM13, dM22; };
-
 LegMassSlopes leg_mass_slopes(const Params& p, const LegConfig& c) {
   const double k = p.I_rod[0] - p.I_rod[1] - 0.25 * p.m_rod * p.l * p.l;
   return {-0.5 * p.m_rod * p.l * c.s2, 2.0 * k * c.s2 * c.c2};
 }
-
-}  // namespace
 
 Mat3 leg_mass_matrix(const Model& m, const LegConfig& c) {
   const Params& p = m.p;

@@ -27,6 +27,11 @@ namespace pkm {
 /// Leg mass matrix, the rotor's reflected mass included in (0, 0).
 Mat3 leg_mass_matrix(const Model& m, const LegConfig& c);
 
+/// Derivatives with respect to theta2 of the two non-constant entries of
+/// M_leg: M13 = m_r l/2 c2 and M22.
+struct LegMassSlopes { double dM13, dM22; };
+LegMassSlopes leg_mass_slopes(const Params& p, const LegConfig& c);
+
 /// The platform with its payload about P at angle phi (cphi, sphi).
 struct PlatformInertia {
   double mass, Izz;  // m_p + m_l; Izz + I_l + m_l |c|^2

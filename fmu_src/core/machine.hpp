@@ -31,11 +31,22 @@ inline double friction_force(const Params& p, double rhod) {
   return F;
 }
 
+/// dF_fric/drhod.
+inline double friction_slope(const Params& p, double rhod) {
+  double s = -p.friction_viscous;
+  if (p.friction_coulomb != 0.0) {
+    const double th = std::tanh(rhod / p.friction_velocity);
+    s -= p.friction_coulomb / p.friction_velocity * (1.0 - th * th);
+  }
+  return s;
+}
+
 /// One joint against its end stops.
 struct StopContact {
   double depth = 0;   // delta >= 0, m (0: within the travel)
   double rate = 0;    // delta_dot, m/s (0 when depth is 0)
   double force = 0;   // F_stop on rho, signed along +z, N
+  int side = 0;       // -1: the lower stop (depth = rho_min - rho), +1: the upper, 0: none
 };
 
 inline StopContact stop_contact(const Params& p, double rho, double rhod) {
@@ -44,10 +55,12 @@ inline StopContact stop_contact(const Params& p, double rho, double rhod) {
     c.depth = p.rho_min - rho;
     c.rate = -rhod;
     c.force = std::fmax(0.0, p.stop_stiffness * c.depth + p.stop_damping * c.rate);
+    c.side = -1;
   } else if (rho > p.rho_max) {
     c.depth = rho - p.rho_max;
     c.rate = rhod;
     c.force = -std::fmax(0.0, p.stop_stiffness * c.depth + p.stop_damping * c.rate);
+    c.side = 1;
   }
   return c;
 }
@@ -73,10 +86,12 @@ inline StopContact stop_contact(const Params& p, int leg, unsigned stops, double
     c.depth = p.rho_min - rho;
     c.rate = -rhod;
     c.force = std::fmax(0.0, p.stop_stiffness * c.depth + p.stop_damping * c.rate);
+    c.side = -1;
   } else if (stops & (1u << (4 + leg))) {
     c.depth = rho - p.rho_max;
     c.rate = rhod;
     c.force = -std::fmax(0.0, p.stop_stiffness * c.depth + p.stop_damping * c.rate);
+    c.side = 1;
   }
   return c;
 }
@@ -87,6 +102,20 @@ inline double passive_joint_force(const Params& p, double rho, double rhod) {
 }
 inline double passive_joint_force(const Params& p, int leg, unsigned stops, double rho, double rhod) {
   return friction_force(p, rhod) + stop_contact(p, leg, stops, rho, rhod).force;
+}
+
+/// d/d(rho, rhod) of passive_joint_force (the friction's tanh is smooth;
+/// a stop contributes (-k, -d) while it pushes and nothing otherwise: its
+/// kinks at contact and release take the side the force is evaluated on).
+struct PassiveSlopes { double drho = 0, drhod = 0; };
+inline PassiveSlopes passive_joint_force_slopes(const Params& p, int leg, unsigned stops, double rho, double rhod) {
+  PassiveSlopes s;
+  s.drhod = friction_slope(p, rhod);
+  if (stop_contact(p, leg, stops, rho, rhod).force != 0.0) {
+    s.drho = -p.stop_stiffness;
+    s.drhod -= p.stop_damping;
+  }
+  return s;
 }
 
 /// Energy stored in the stop's spring, 1/2 k delta^2 (J).
@@ -100,6 +129,23 @@ inline double stop_potential(const Params& p, double rho) {
 inline double dissipated_power(const Params& p, int leg, unsigned stops, double rho, double rhod) {
   const StopContact c = stop_contact(p, leg, stops, rho, rhod);
   return -friction_force(p, rhod) * rhod + (std::fabs(c.force) - p.stop_stiffness * c.depth) * c.rate;
+}
+
+/// d/d(rho, rhod) of dissipated_power. With s = side (d depth/drho =
+/// d rate/drhod = s): friction -(F_fric' rhod + F_fric); a pushing stop
+/// (d rate^2) 2 d rate s on rhod; a released one (-k depth rate) -k s rate
+/// on rho and -k depth s on rhod.
+inline PassiveSlopes dissipated_power_slopes(const Params& p, int leg, unsigned stops, double rho, double rhod) {
+  PassiveSlopes s;
+  s.drhod = -(friction_slope(p, rhod) * rhod + friction_force(p, rhod));
+  const StopContact c = stop_contact(p, leg, stops, rho, rhod);
+  if (c.force != 0.0) {
+    s.drhod += 2.0 * p.stop_damping * c.rate * c.side;
+  } else if (c.side != 0) {
+    s.drho -= p.stop_stiffness * c.side * c.rate;
+    s.drhod -= p.stop_stiffness * c.depth * c.side;
+  }
+  return s;
 }
 
 /// Number of end-stop event indicators: rho_i - rho_min (i = 0..3), then

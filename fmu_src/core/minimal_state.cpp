@@ -32,32 +32,39 @@ Vec16 with_passive_forces(const Model& m, const Vec16& q, const Vec16& qd, const
   return out;
 }
 
+Status reduced_terms(const Model& m, const Vec8& y, const Vec16& f, unsigned stops, ReducedDynamics& rd,
+                     JointMotion* joints) {
+  // Hot path: no angles, no trigonometry but phi's (the leg's cos/sin
+  // come algebraically from the closed-form inverse kinematics).
+  const Pose pose = y.head<4>();
+  const Pose pd = y.tail<4>();
+  const PlatformConfig pc = platform_config(pose);
+  for (int i = 0; i < kLegs; ++i) {
+    LegConfig c;
+    Status s = leg_inverse_kinematics(m, i, pc, c);
+    if (s != Status::Ok) return s;
+    s = rd.prepare_leg(m, i, c, pc);
+    if (s != Status::Ok) return s;
+    const Vec3 qd_leg = rd.leg_velocity(i, pd);
+    rd.add_leg(m, i, qd_leg, pd[3], f[leg_offset(i)] + passive_joint_force(m.p, i, stops, c.rho, qd_leg[0]));
+    if (joints) {
+      joints->rho[i] = c.rho;
+      joints->rhod[i] = qd_leg[0];
+    }
+  }
+  return Status::Ok;
+}
+
 Status state_derivative(const Model& m, Formulation form, const Vec8& y, const Vec16& f, Vec8& ydot,
                         MechanismState* full, JointMotion* joints, unsigned stops) {
   if (!y.allFinite() || !f.allFinite()) return Status::NonFinite;
   ydot.head<4>() = y.tail<4>();
   if (form == Formulation::LegPartitioned && full == nullptr) {
-    // Hot path: no angles, no trigonometry but phi's (the leg's cos/sin
-    // come algebraically from the closed-form inverse kinematics).
-    const Pose pose = y.head<4>();
-    const Pose pd = y.tail<4>();
-    const PlatformConfig pc = platform_config(pose);
     ReducedDynamics rd;
-    for (int i = 0; i < kLegs; ++i) {
-      LegConfig c;
-      Status s = leg_inverse_kinematics(m, i, pc, c);
-      if (s != Status::Ok) return s;
-      s = rd.prepare_leg(m, i, c, pc);
-      if (s != Status::Ok) return s;
-      const Vec3 qd_leg = rd.leg_velocity(i, pd);
-      rd.add_leg(m, i, qd_leg, pd[3], f[leg_offset(i)] + passive_joint_force(m.p, i, stops, c.rho, qd_leg[0]));
-      if (joints) {
-        joints->rho[i] = c.rho;
-        joints->rhod[i] = qd_leg[0];
-      }
-    }
+    Status s = reduced_terms(m, y, f, stops, rd, joints);
+    if (s != Status::Ok) return s;
     Pose pdd;
-    const Status s = rd.solve_platform(m, f.segment<4>(kPlatform), pdd);
+    s = rd.solve_platform(m, f.segment<4>(kPlatform), pdd);
     if (s == Status::Ok) ydot.tail<4>() = pdd;
     return s;
   }

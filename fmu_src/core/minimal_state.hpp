@@ -39,6 +39,13 @@ Status state_derivative(const Model& m, Formulation form, const Vec8& y, const V
                         MechanismState* full = nullptr, JointMotion* joints = nullptr,
                         unsigned stops = ~0u);
 
+class ReducedDynamics;
+/// The leg-partitioned reduced terms at y (reduced_dynamics.hpp), every leg
+/// prepared and added with its share of f and its passive joint force; the
+/// solve is left to the caller. `joints` as in state_derivative.
+Status reduced_terms(const Model& m, const Vec8& y, const Vec16& f, unsigned stops, ReducedDynamics& rd,
+                     JointMotion* joints = nullptr);
+
 /// f plus the passive joint forces at (q, qd).
 Vec16 with_passive_forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f,
                           unsigned stops = ~0u);

@@ -25,7 +25,7 @@ Status ReducedDynamics::prepare_leg_kinematics(const Model& m, int leg, const Le
   const double a = -p.l * c.s1 * c.c2 + p.h_prime * c.c1, b = p.l * c.c1 * c.c2 + p.h_prime * c.s1;
   const double e = -p.l * c.c1 * c.s2, f = -p.l * c.s1 * c.s2, g = p.l * c.c2;
   const double inv_D = 1.0 / (a * f - b * e);
-  Mat3 Jinv;
+  Mat3& Jinv = L.Jinv;
   Jinv << b * g * inv_D, -a * g * inv_D, 1.0,
           f * inv_D,     -e * inv_D,     0.0,
           -b * inv_D,    a * inv_D,      0.0;
@@ -63,19 +63,26 @@ void ReducedDynamics::add_leg(const Model& m, int leg, const Vec3& qd_leg, doubl
   rhs_.noalias() += L.A.transpose() * L.r;
 }
 
-Status ReducedDynamics::solve_platform(const Model& m, const Wrench& we, Pose& a) const {
+void ReducedDynamics::reduced_system(const Model& m, const Wrench& we, Mat4& Mr, Vec4& rhs) const {
   // The upper triangle of the reduced mass matrix (add_leg fills only it),
   // plus the platform with its payload (lagrangian.hpp): M_p, V_p, G_p.
   const PlatformInertia pi = platform_inertia(m, cphi_, sphi_);
-  Mat4 Mr = Mr_;
+  Mr = Mr_;
   Mr.diagonal() += Vec4(pi.mass, pi.mass, pi.mass, pi.Izz);
   Mr(0, 3) -= pi.mwy;
   Mr(1, 3) += pi.mwx;
-  Vec4 rhs = rhs_ + we;
+  Mr.triangularView<Eigen::StrictlyLower>() = Mr.transpose();
+  rhs = rhs_ + we;
   const double w2 = phid_ * phid_;
   rhs[0] += pi.mwx * w2;
   rhs[1] += pi.mwy * w2;
   rhs[2] -= pi.mass * m.p.g;
+}
+
+Status ReducedDynamics::solve_platform(const Model& m, const Wrench& we, Pose& a) const {
+  Mat4 Mr;
+  Vec4 rhs;
+  reduced_system(m, we, Mr, rhs);
   // LDL^T of the symmetric positive definite 4x4, written out (no square
   // roots): Mr = U^T D U with unit upper-triangular U, then two substitutions.
   double d[4];

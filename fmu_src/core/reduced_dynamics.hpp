@@ -40,16 +40,27 @@ class ReducedDynamics {
   /// Only the platform's accelerations (the integrators' hot path).
   Status solve_platform(const Model& m, const Wrench& we, Pose& pdd) const;
 
- private:
+  /// The reduced system Mr pdd = rhs with the platform, its payload and the
+  /// external wrench included (Mr full and symmetric; valid after add_leg
+  /// for every leg).
+  void reduced_system(const Model& m, const Wrench& we, Mat4& Mr, Vec4& rhs) const;
+
   struct Leg {
     LegConfig c;
     Vec3 attach;  // Rz(phi) r_Qi
     Mat3 Linv;    // L_i^{-1}
+    Mat3 Jinv;    // J_i^{-1} = L_i^{-1} Rz(beta_i)
     Mat34 A;      // L_i^{-1} P_i
     Mat3 M;       // leg mass matrix
     Vec3 b;       // -L_i^{-1} gamma_i
     Vec3 r;       // f_i - V_i - G_i - M_i b_i
   };
+  /// Leg i's terms (valid after prepare_leg; b and r after add_leg).
+  const Leg& leg(int i) const { return legs_[i]; }
+  double cos_phi() const { return cphi_; }
+  double sin_phi() const { return sphi_; }
+
+ private:
   std::array<Leg, kLegs> legs_;
   Mat4 Mr_ = Mat4::Zero();
   double cphi_ = 1, sphi_ = 0, phid_ = 0;  // the platform's angle and rate (payload terms)

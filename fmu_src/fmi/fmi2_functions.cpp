@@ -212,9 +212,9 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
                                         const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
-  (void)vUnknown_ref, (void)nUnknown, (void)vKnown_ref, (void)nKnown, (void)dvKnown, (void)dvUnknown;
   return call(c, "fmi2GetDirectionalDerivative", [&](Instance& i) {
-    return i.not_supported("fmi2GetDirectionalDerivative", "providesDirectionalDerivative = false");
+    return i.partial_derivative("fmi2GetDirectionalDerivative", false, vUnknown_ref, nUnknown, vKnown_ref, nKnown,
+                                dvKnown, nKnown, dvUnknown, nUnknown);
   });
 }
 

@@ -309,27 +309,27 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance c, const fmi3Byte serializedStat
               [&](Instance& i) { return i.deserialize_fmu_state(serializedState, size, FMUState); });
 }
 
-// ---------------------------------------------------------------- not provided
+// ---------------------------------------------------------------- partial derivatives
 
 fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference unknowns[], size_t nUnknowns,
                                         const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
                                         size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
-  (void)unknowns, (void)nUnknowns, (void)knowns, (void)nKnowns, (void)seed, (void)nSeed, (void)sensitivity,
-      (void)nSensitivity;
   return call(c, "fmi3GetDirectionalDerivative", [&](Instance& i) {
-    return i.not_supported("fmi3GetDirectionalDerivative", "providesDirectionalDerivatives = false");
+    return i.partial_derivative("fmi3GetDirectionalDerivative", false, unknowns, nUnknowns, knowns, nKnowns, seed,
+                                nSeed, sensitivity, nSensitivity);
   });
 }
 
 fmi3Status fmi3GetAdjointDerivative(fmi3Instance c, const fmi3ValueReference unknowns[], size_t nUnknowns,
                                     const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
                                     size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
-  (void)unknowns, (void)nUnknowns, (void)knowns, (void)nKnowns, (void)seed, (void)nSeed, (void)sensitivity,
-      (void)nSensitivity;
   return call(c, "fmi3GetAdjointDerivative", [&](Instance& i) {
-    return i.not_supported("fmi3GetAdjointDerivative", "providesAdjointDerivatives = false");
+    return i.partial_derivative("fmi3GetAdjointDerivative", true, unknowns, nUnknowns, knowns, nKnowns, seed, nSeed,
+                                sensitivity, nSensitivity);
   });
 }
+
+// ---------------------------------------------------------------- not provided
 
 fmi3Status fmi3EnterConfigurationMode(fmi3Instance c) {
   return call(c, "fmi3EnterConfigurationMode", [&](Instance& i) {

@@ -123,6 +123,15 @@ class Instance {
   Status get_nominals(double x[], std::size_t n);
   Status get_number_of(const char* what, std::size_t count, std::size_t* n);
 
+  // ---- partial derivatives (directional_derivatives.cpp)
+  /// fmi2/fmi3GetDirectionalDerivative (adjoint = false: sensitivity =
+  /// J seed) and fmi3GetAdjointDerivative (adjoint = true: sensitivity =
+  /// J^T seed), J = d(unknowns)/d(knowns). n_seed and n_sensitivity as FMI
+  /// 3.0 passes them (FMI 2.0: the counts they must have).
+  Status partial_derivative(const char* function, bool adjoint, const std::uint32_t unknowns[], std::size_t nu,
+                            const std::uint32_t knowns[], std::size_t nk, const double seed[], std::size_t n_seed,
+                            double sensitivity[], std::size_t n_sensitivity);
+
   // ---- not provided
   Status not_supported(const char* function, const char* why);
 
@@ -204,6 +213,10 @@ class Instance {
   bool input_derivatives_set_ = false;  // SetRealInputDerivatives was used (or a state restored)
   std::unordered_set<SavedState*> states_;  // FMU states this instance created and nobody freed yet
   std::atomic<bool> busy_{false};           // a call is running (Busy)
+  // partial_derivative's buffers (kept to reuse their capacity).
+  std::vector<const Variable*> d_unknowns_, d_knowns_, d_asked_;
+  std::vector<std::size_t> d_rows_;
+  std::vector<double> d_jacobian_, d_asked_jacobian_;
 
  public:
   /// Forgets a state freed through any instance (FreeFMUState).

@@ -13,6 +13,8 @@
 
 namespace pkm_fmi {
 
+struct Variable;
+
 /// What a hook may see of its instance.
 struct Context {
   Logger& log;
@@ -67,6 +69,20 @@ class ModelData {
   /// Event mode: the discrete reaction to what the indicators located.
   /// terminate = true asks the importer to stop (with a logged reason).
   virtual Status event_update(Context& ctx, bool& terminate) { (void)ctx; terminate = false; return Status::OK; }
+
+  // ---- Partial derivatives (directional_derivatives.cpp; models whose
+  // definition sets provides_derivatives)
+  /// d(unknowns[i])/d(knowns[j]) at the current time, state and inputs into
+  /// J[i * nk + j]. The layer has checked the references (each unknown an
+  /// output or a state derivative, each known a continuous state or an
+  /// input) and asks only about unknowns that depend on one of the knowns.
+  /// Error with a logged message naming an unknown it cannot differentiate.
+  virtual Status partial_derivatives(Context& ctx, const Variable* const unknowns[], std::size_t nu,
+                                     const Variable* const knowns[], std::size_t nk, double J[]) {
+    (void)unknowns, (void)nu, (void)knowns, (void)nk, (void)J;
+    ctx.log.error("partial derivatives are not provided by this model");
+    return Status::Error;
+  }
 };
 
 }  // namespace pkm_fmi

@@ -167,13 +167,16 @@ std::string fmi2(const ModelDefinition& d) {
        d.guid() + "\"\n  description=\"" + xml_escape(d.title) + "\"\n  generationTool=\"" + kGenerationTool +
        "\"\n  variableNamingConvention=\"structured\"\n  numberOfEventIndicators=\"" +
        std::to_string(d.n_event_indicators) + "\">\n";
+  const std::string derivatives2 =
+      d.provides_derivatives ? "\n    providesDirectionalDerivative=\"true\"" : "";
   x += "  <ModelExchange\n    modelIdentifier=\"" + std::string(d.identifier) +
        "\"\n    completedIntegratorStepNotNeeded=\"true\"\n    canGetAndSetFMUstate=\"true\"\n"
-       "    canSerializeFMUstate=\"true\"/>\n";
+       "    canSerializeFMUstate=\"true\"" + derivatives2 + "/>\n";
   x += "  <CoSimulation\n    modelIdentifier=\"" + std::string(d.identifier) +
        "\"\n    canHandleVariableCommunicationStepSize=\"true\"\n    canInterpolateInputs=\"" +
        (d.can_interpolate_inputs ? "true" : "false") +
-       "\"\n    maxOutputDerivativeOrder=\"0\"\n    canGetAndSetFMUstate=\"true\"\n    canSerializeFMUstate=\"true\"/>\n";
+       "\"\n    maxOutputDerivativeOrder=\"0\"\n    canGetAndSetFMUstate=\"true\"\n    canSerializeFMUstate=\"true\"" +
+       derivatives2 + "/>\n";
   x += unit_definitions(d) + log_categories() + default_experiment(d);
   x += "  <ModelVariables>\n";
   for (std::size_t i = 0; i < d.n_variables; ++i) {
@@ -208,12 +211,16 @@ std::string fmi3(const ModelDefinition& d) {
   x += "<fmiModelDescription\n  fmiVersion=\"3.0\"\n  modelName=\"" + std::string(d.identifier) +
        "\"\n  instantiationToken=\"" + d.guid() + "\"\n  description=\"" + xml_escape(d.title) +
        "\"\n  generationTool=\"" + kGenerationTool + "\"\n  variableNamingConvention=\"structured\">\n";
+  const std::string derivatives3 =
+      d.provides_derivatives
+          ? "\n    providesDirectionalDerivatives=\"true\"\n    providesAdjointDerivatives=\"true\""
+          : "";
   x += "  <ModelExchange\n    modelIdentifier=\"" + std::string(d.identifier) +
        "\"\n    canGetAndSetFMUState=\"true\"\n    canSerializeFMUState=\"true\"\n"
-       "    needsCompletedIntegratorStep=\"false\"/>\n";
+       "    needsCompletedIntegratorStep=\"false\"" + derivatives3 + "/>\n";
   x += "  <CoSimulation\n    modelIdentifier=\"" + std::string(d.identifier) +
        "\"\n    canGetAndSetFMUState=\"true\"\n    canSerializeFMUState=\"true\"\n"
-       "    canHandleVariableCommunicationStepSize=\"true\"/>\n";
+       "    canHandleVariableCommunicationStepSize=\"true\"" + derivatives3 + "/>\n";
   x += unit_definitions(d) + type_definitions(d) + log_categories() + default_experiment(d);
   x += "  <ModelVariables>\n";
   for (std::size_t i = 0; i < d.n_variables; ++i) {

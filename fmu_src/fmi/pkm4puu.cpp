@@ -31,10 +31,12 @@
 // Co-Simulation, and the end stops (rho_i - rho_min, rho_max - rho_i), whose
 // crossings are events logged under logEvents.
 #include <cmath>
+#include <cstring>
 #include <iterator>
 #include <memory>
 
 #include "constraints.hpp"
+#include "reduced_dynamics_derivatives.hpp"
 #include "machine.hpp"
 #include "mechanism_parameters.hpp"
 #include "models.hpp"
@@ -112,6 +114,8 @@ struct PlantData final : MechanismData {
   Status get_derivatives(Context& ctx, double dx[]) override;
   Status get_event_indicators(Context& ctx, double z[]) override;
   Status event_update(Context& ctx, bool& terminate) override;
+  Status partial_derivatives(Context& ctx, const Variable* const unknowns[], std::size_t nu,
+                             const Variable* const knowns[], std::size_t nk, double J[]) override;
 
   /// The absolute time of the plant (its own time is the time since startTime), for messages.
   double absolute_time(const Context& ctx) const { return ctx.start_time + plant->time(); }
@@ -439,6 +443,79 @@ Status PlantData::get_derivatives(Context& ctx, double dx[]) {
   return Status::OK;
 }
 
+// ---------------------------------------------------------------- partial derivatives
+
+// Analytic (reduced_dynamics_derivatives.hpp) at the current state and
+// inputs, the end stops acting when their joint is past them: der(x) ..
+// der(dphi), der(actuator_work) (= Fa . drho + we . pd) and
+// der(dissipated_energy) (machine.hpp, dissipated_power_slopes), the states
+// as outputs, rho[i] and drho[i]. The other computed variables are refused
+// with Error (not differentiated yet).
+Status PlantData::partial_derivatives(Context& ctx, const Variable* const unknowns[], std::size_t nu,
+                                      const Variable* const knowns[], std::size_t nk, double J[]) {
+  const char* fn = "GetDirectionalDerivative";
+  const Status st = ready(ctx, fn);
+  if (st != Status::OK) return st;
+  const pkm::Vec4 F(u[0], u[1], u[2], u[3]), we(u[4], u[5], u[6], u[7]), tau(u[8], u[9], u[10], u[11]);
+  const pkm::Vec8& y = plant->state();
+  pkm::Vec8 ydot;
+  pkm::Mat8 A;
+  pkm::Mat8x12 B;
+  pkm::JointJacobians joints;
+  const pkm::Status s =
+      pkm::state_derivative_jacobians(plant->model(), y, F, tau, we, pkm::kStopsFromState, ydot, A, B, &joints);
+  if (s != pkm::Status::Ok) {
+    ctx.log.error("%s: the derivatives at t = %.17g cannot be evaluated: %s", fn, plant->time(), pkm::status_name(s));
+    return Status::Error;
+  }
+  const pkm::Vec4 rhod = joints.J_rho * y.tail<4>();
+  pkm::Vec4 rho;
+  if (pkm::actuator_positions(plant->model(), y.head<4>(), rho) != pkm::Status::Ok) {
+    ctx.log.error("%s: the actuator positions at t = %.17g cannot be evaluated", fn, plant->time());
+    return Status::Error;
+  }
+  // One row over [the 10 states, the 12 inputs u] per unknown.
+  Eigen::Matrix<double, 1, kStates + kInputs> row;
+  for (std::size_t i = 0; i < nu; ++i) {
+    const Variable& v = *unknowns[i];
+    row.setZero();
+    if (v.state_of >= 0 && v.state_of < 8) {
+      row.head<8>() = A.row(v.state_of);
+      row.tail<kInputs>() = B.row(v.state_of);
+    } else if (v.state_of == 8) {  // der(actuator_work)
+      const pkm::Vec4 Fa = F + plant->model().drive_ratio * tau;
+      row.head<4>() = Fa.transpose() * joints.drhod_dp;
+      row.segment<4>(4) = Fa.transpose() * joints.J_rho + we.transpose();
+      row.segment<4>(kStates) = rhod.transpose();
+      row.segment<4>(kStates + 4) = y.tail<4>().transpose();
+      row.segment<4>(kStates + 8) = plant->model().drive_ratio * rhod.transpose();
+    } else if (v.state_of == 9) {  // der(dissipated_energy): sum over the joints
+      for (int l = 0; l < 4; ++l) {
+        const pkm::PassiveSlopes d = pkm::dissipated_power_slopes(plant->model().p, l, pkm::kStopsFromState, rho[l], rhod[l]);
+        row.head<4>() += d.drho * joints.J_rho.row(l) + d.drhod * joints.drhod_dp.row(l);
+        row.segment<4>(4) += d.drhod * joints.J_rho.row(l);
+      }
+    } else if (v.state >= 0) {
+      row[v.state] = 1.0;
+    } else if (std::strncmp(v.name, "rho[", 4) == 0) {
+      row.head<4>() = joints.J_rho.row(v.index);
+    } else if (std::strncmp(v.name, "drho[", 5) == 0) {
+      row.head<4>() = joints.drhod_dp.row(v.index);
+      row.segment<4>(4) = joints.J_rho.row(v.index);
+    } else {
+      ctx.log.error("%s: the partial derivatives of %s are not provided (analytic so far: the states' "
+                    "derivatives, the states, rho[1..4] and drho[1..4])",
+                    fn, v.name);
+      return Status::Error;
+    }
+    for (std::size_t j = 0; j < nk; ++j) {
+      const Variable& k = *knowns[j];
+      J[i * nk + j] = row[k.state >= 0 ? k.state : kStates + k.index];
+    }
+  }
+  return Status::OK;
+}
+
 Status PlantData::get_event_indicators(Context& ctx, double z[]) {
   const Status st = ready(ctx, "GetEventIndicators");
   if (st != Status::OK) return st;
@@ -716,6 +793,7 @@ const ModelDefinition kDefinition{
     /*default_step=*/1e-3,
     /*default_stop=*/2.0,
     &create,
+    /*provides_derivatives=*/true,
 };
 
 }  // namespace

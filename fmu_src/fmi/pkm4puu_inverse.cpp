@@ -25,11 +25,13 @@
 // the master how close it is.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <iterator>
 #include <memory>
 
 #include "constraints.hpp"
 #include "inverse_dynamics.hpp"
+#include "inverse_dynamics_derivatives.hpp"
 #include "mechanism_parameters.hpp"
 #include "models.hpp"
 #include "workspace_guard.hpp"
@@ -61,7 +63,14 @@ struct InverseData final : MechanismData {
   void save(StateWriter& w) const override;
   bool load(StateReader& r, Context& ctx) override;
 
+  Status partial_derivatives(Context& ctx, const Variable* const unknowns[], std::size_t nu,
+                             const Variable* const knowns[], std::size_t nk, double J[]) override;
+
   Status make(Context& ctx, const char* function, pkm::Model& out) const;
+  /// The model to evaluate with: the instance's, or in initialisation mode
+  /// one made into `temporary` from the current parameters; nullptr (logged)
+  /// if there is none.
+  const pkm::Model* current_model(Context& ctx, const char* function, pkm::Model& temporary) const;
 };
 
 Status InverseData::make(Context& ctx, const char* function, pkm::Model& out) const {
@@ -86,18 +95,16 @@ Status InverseData::exit_initialization(Context& ctx) {
   return Status::OK;
 }
 
+const pkm::Model* InverseData::current_model(Context& ctx, const char* function, pkm::Model& temporary) const {
+  if (ctx.initialization_mode) return make(ctx, function, temporary) == Status::OK ? &temporary : nullptr;
+  if (!model) ctx.log.error("%s: outputs not available (initialisation did not succeed)", function);
+  return model.get();
+}
+
 Status InverseData::update_outputs(Context& ctx, unsigned) {  // one group: everything
   pkm::Model temporary;
-  const pkm::Model* m = model.get();
-  if (ctx.initialization_mode) {
-    const Status st = make(ctx, "get (initialization mode)", temporary);
-    if (st != Status::OK) return st;
-    m = &temporary;
-  }
-  if (!m) {
-    ctx.log.error("get: outputs not available (initialisation did not succeed)");
-    return Status::Error;
-  }
+  const pkm::Model* m = current_model(ctx, "get", temporary);
+  if (!m) return Status::Error;
   const pkm::Pose p(pose[0], pose[1], pose[2], pose[3]);
   const pkm::Pose pd(vel[0], vel[1], vel[2], vel[3]);
   const pkm::Pose pdd(acc[0], acc[1], acc[2], acc[3]);
@@ -146,6 +153,47 @@ Status InverseData::update_outputs(Context& ctx, unsigned) {  // one group: ever
                     lower ? m->p.rho_min : m->p.rho_max);
   }
   return Status::Warning;
+}
+
+// Analytic (inverse_dynamics_derivatives.hpp): F, tau, rho and drho with
+// respect to the inputs; the multipliers are refused with Error (not
+// differentiated yet).
+Status InverseData::partial_derivatives(Context& ctx, const Variable* const unknowns[], std::size_t nu,
+                                        const Variable* const knowns[], std::size_t nk, double J[]) {
+  const char* fn = "GetDirectionalDerivative";
+  pkm::Model temporary;
+  const pkm::Model* m = current_model(ctx, fn, temporary);
+  if (!m) return Status::Error;
+  pkm::InverseDynamicsPartials d;
+  const pkm::Status s = pkm::inverse_dynamics_derivatives(*m, pkm::Pose(pose), pkm::Pose(vel), pkm::Pose(acc),
+                                                          pkm::Wrench(wrench), d);
+  if (s != pkm::Status::Ok) {
+    ctx.log.error("%s: the derivatives at x = %g m, y = %g m, z = %g m, phi = %g rad cannot be evaluated: %s", fn,
+                  pose[0], pose[1], pose[2], pose[3], pkm::status_name(s));
+    return Status::Error;
+  }
+  // One row over the 16 inputs (value references 1..16: pose, rates, accelerations, wrench) per unknown.
+  Eigen::Matrix<double, 1, 16> row;
+  for (std::size_t i = 0; i < nu; ++i) {
+    const Variable& v = *unknowns[i];
+    row.setZero();
+    if (std::strncmp(v.name, "F[", 2) == 0 || std::strncmp(v.name, "tau[", 4) == 0) {
+      const double scale = v.name[0] == 'F' ? 1.0 : 1.0 / m->drive_ratio;  // tau = F p / (2 pi)
+      row << d.dp.row(v.index), d.dpd.row(v.index), d.dpdd.row(v.index), d.dwe.row(v.index);
+      row *= scale;
+    } else if (std::strncmp(v.name, "rho[", 4) == 0) {
+      row.head<4>() = d.J_rho.row(v.index);
+    } else if (std::strncmp(v.name, "drho[", 5) == 0) {
+      row.head<4>() = d.drhod_dp.row(v.index);
+      row.segment<4>(4) = d.J_rho.row(v.index);
+    } else {
+      ctx.log.error("%s: the partial derivatives of %s are not provided (analytic so far: F, tau, rho and drho)", fn,
+                    v.name);
+      return Status::Error;
+    }
+    for (std::size_t j = 0; j < nk; ++j) J[i * nk + j] = row[static_cast<int>(knowns[j]->vr) - 1];
+  }
+  return Status::OK;
 }
 
 void InverseData::save(StateWriter& w) const { w.u8(model ? 1 : 0); }
@@ -237,6 +285,8 @@ constexpr Variable kVariables[] = {
 #undef INV_SCALAR
 
 static_assert(sorted_by_vr(kVariables, std::size(kVariables)), "the table must be sorted by value reference");
+static_assert(kVariables[1].vr == 1 && kVariables[16].vr == 16 && kVariables[17].vr == 20,
+              "partial_derivatives: the inputs are value references 1..16, in the order of their row");
 
 std::unique_ptr<ModelData> create() { return std::make_unique<InverseData>(); }
 
@@ -263,6 +313,7 @@ const ModelDefinition kDefinition{
     /*default_step=*/1e-3,
     /*default_stop=*/2.0,
     &create,
+    /*provides_derivatives=*/true,
 };
 
 }  // namespace

@@ -169,6 +169,9 @@ struct ModelDefinition {
   double default_step;             // DefaultExperiment stepSize
   double default_stop;             // DefaultExperiment stopTime
   std::unique_ptr<ModelData> (*create)();
+  /// Directional and adjoint derivatives (ModelData::partial_derivatives):
+  /// providesDirectionalDerivative(s), providesAdjointDerivatives.
+  bool provides_derivatives = false;
 
   /// The variable with this value reference, nullptr if none.
   const Variable* find(std::uint32_t vr) const;

@@ -1,0 +1,266 @@
+// Analytic derivatives of the forward and inverse dynamics
+// (reduced_dynamics_derivatives.hpp, inverse_dynamics_derivatives.hpp)
+// against central differences of the same model's plain functions
+// (state_derivative, inverse_dynamics) with Richardson extrapolation:
+// at several poses (home, the auto-test's end pose, off-centre and rotated),
+// with nonzero rates and every machine term on, and with an end stop pushing.
+#include <cstdio>
+
+#include "inverse_dynamics.hpp"
+#include "inverse_dynamics_derivatives.hpp"
+#include "lagrangian.hpp"
+#include "machine.hpp"
+#include "minimal_state.hpp"
+#include "reduced_dynamics_derivatives.hpp"
+#include "rk4.hpp"
+#include "test_support.hpp"
+
+using namespace pkm_test;
+
+namespace {
+
+/// Every machine term on: rotors, payload off the centre, viscous and
+/// Coulomb friction with a velocity scale that keeps tanh's slope visible.
+Params machine_params() {
+  Params p;
+  p.rotor_inertia = 2e-7;
+  p.friction_viscous = 1.5;
+  p.friction_coulomb = 0.2;
+  p.friction_velocity = 0.05;
+  p.payload_mass = 0.3;
+  p.payload_com = {0.02, -0.012};
+  p.payload_Izz = 1.2e-4;
+  return p;
+}
+
+struct Case {
+  const char* name;
+  Pose pose, vel;
+};
+
+// Home, the auto-test's end pose (MODEL_SPEC), off-centre and rotated the
+// other way; each with rates in every coordinate.
+const Case kCases[] = {
+    {"home", Pose(0.0, 0.0, 0.05, 0.0), Pose(0.12, -0.08, 0.10, 0.9)},
+    {"autotest end", Pose(0.005, -0.005, 0.07, deg(4)), Pose(-0.05, 0.11, -0.07, -0.6)},
+    {"off-centre rotated", Pose(-0.007, 0.006, 0.058, -0.07), Pose(0.09, 0.04, 0.13, 1.3)},
+};
+
+const Vec4 kF(2.7, 2.5, 2.9, 2.6);             // N
+const Vec4 kTau(1e-3, -2e-3, 1.5e-3, 0.0);     // N*m
+const Wrench kWe(0.3, -0.2, 0.5, 0.01);        // N, N*m
+
+/// pdd at y for the inputs u = (F, Fe, Me_z, tau) by the plain state function.
+Pose plain_pdd(const Model& m, const Vec8& y, const Eigen::Matrix<double, 12, 1>& u) {
+  const Vec16 f = generalized_forces(m, u.head<4>(), u.tail<4>(), u.segment<4>(4));
+  Vec8 ydot;
+  EXPECT_EQ(state_derivative(m, Formulation::LegPartitioned, y, f, ydot), Status::Ok);
+  return ydot.tail<4>();
+}
+
+/// The state Jacobians against Richardson differences of state_derivative;
+/// `h` scales every step (an end stop's kink must stay out of reach).
+void check_forward(const Model& m, const Case& c, double h) {
+  SCOPED_TRACE(c.name);
+  Vec8 y;
+  y << c.pose, c.vel;
+  Eigen::Matrix<double, 12, 1> u;
+  u << kF, kWe, kTau;
+  Vec8 ydot;
+  Mat8 A;
+  Mat8x12 B;
+  JointJacobians joints;
+  ASSERT_EQ(state_derivative_jacobians(m, y, kF, kTau, kWe, kStopsFromState, ydot, A, B, &joints), Status::Ok);
+  EXPECT_EQ(ydot.tail<4>(), plain_pdd(m, y, u)) << "the value is the plain state function's";
+  EXPECT_EQ(ydot.head<4>(), c.vel);
+  // dpd/dy: identity on the rates, nothing else; dpd/du = 0.
+  Mat8 top = Mat8::Zero();
+  top.topRightCorner<4, 4>().setIdentity();
+  EXPECT_EQ(A.topRows<4>(), top.topRows<4>());
+  EXPECT_EQ(B.topRows<4>(), (Eigen::Matrix<double, 4, 12>::Zero()));
+
+  // Steps: pose 0.3 mm and 3 mrad, rates 5 mm/s and 50 mrad/s, forces 1 N,
+  // moments 0.01 N*m, torques 5 mN*m (the dynamics are linear in u).
+  const double hy[8] = {3e-4, 3e-4, 3e-4, 3e-3, 5e-3, 5e-3, 5e-3, 5e-2};
+  Eigen::MatrixXd fd(4, 8 + 12);
+  Eigen::VectorXd err(8 + 12);
+  for (int k = 0; k < 8; ++k) {
+    fd.col(k) = richardson([&](double s) {
+      Vec8 ys = y;
+      ys[k] += s;
+      return plain_pdd(m, ys, u);
+    }, h * hy[k], &err[k]);
+  }
+  for (int k = 0; k < 12; ++k) {
+    const double hu = k < 7 ? 1.0 : (k == 7 ? 1e-2 : 5e-3);
+    fd.col(8 + k) = richardson([&](double s) {
+      Eigen::Matrix<double, 12, 1> us = u;
+      us[k] += s;
+      return plain_pdd(m, y, us);
+    }, hu, &err[8 + k]);
+  }
+  Eigen::MatrixXd an(4, 20);
+  an << A.bottomRows<4>(), B.bottomRows<4>();
+  expect_columns_match("d pdd / d(p, pd)", an.leftCols(8), fd.leftCols(8), err.head(8), 1e-7);
+  expect_columns_match("d pdd / du", an.rightCols(12), fd.rightCols(12), err.tail(12), 1e-7);
+
+  // The sliders' rows: d rho/dp, d rhod/dp and d rhod/dpd = d rho/dp, from
+  // the joints the plain state function reports.
+  Eigen::MatrixXd fd_joints(8, 8), an_joints(8, 8);
+  Eigen::VectorXd err_joints(8);
+  for (int k = 0; k < 8; ++k) {
+    fd_joints.col(k) = richardson([&](double s) {
+      Vec8 ys = y, yd;
+      ys[k] += s;
+      JointMotion jm;
+      EXPECT_EQ(state_derivative(m, Formulation::LegPartitioned, ys, Vec16::Zero(), yd, nullptr, &jm), Status::Ok);
+      Vec8 out;
+      out << jm.rho, jm.rhod;
+      return out;
+    }, h * hy[k], &err_joints[k]);
+  }
+  an_joints << joints.J_rho, Mat4::Zero(), joints.drhod_dp, joints.J_rho;
+  expect_columns_match("d (rho, rhod) / d(p, pd)", an_joints, fd_joints, err_joints, 1e-7);
+}
+
+}  // namespace
+
+TEST(ForwardDerivatives, IdealMechanismMatchesRichardsonDifferences) {
+  const Model m = default_model();
+  for (const Case& c : kCases) check_forward(m, c, 1.0);
+}
+
+TEST(ForwardDerivatives, EveryMachineTermOnMatchesRichardsonDifferences) {
+  const Model m = model_of(machine_params());
+  for (const Case& c : kCases) check_forward(m, c, 1.0);
+}
+
+TEST(ForwardDerivatives, PushingEndStopMatchesRichardsonDifferences) {
+  // Leg 1's upper stop 1 mm below its joint at the case's pose: the stop
+  // pushes (k delta = 100 N dominates d delta_dot), smooth within 1 mm.
+  Params p = machine_params();
+  const Case& c = kCases[2];
+  Vec4 rho;
+  ASSERT_EQ(actuator_positions(default_model(), c.pose, rho), Status::Ok);
+  p.rho_max = rho[0] - 1e-3;
+  const Model m = model_of(p);
+  ASSERT_GT(std::fabs(stop_force(m.p, rho[0], 0.0)), 0.0);
+  check_forward(m, c, 0.05);  // steps of at most 50 um in the pose
+}
+
+TEST(InverseDerivatives, MatchRichardsonDifferencesOfTheInverseDynamics) {
+  const Model m = model_of(machine_params());
+  const Pose acc(0.8, -0.5, 1.1, 6.0);
+  for (const Case& c : kCases) {
+    SCOPED_TRACE(c.name);
+    InverseDynamicsPartials d;
+    ASSERT_EQ(inverse_dynamics_derivatives(m, c.pose, c.vel, acc, kWe, d), Status::Ok);
+    // The force itself: the full Eqs. 10-11 of inverse_dynamics, an
+    // independent route (Newton, servo Jacobian, 12x12 multipliers).
+    auto forces = [&](const Pose& p, const Pose& v, const Pose& a, const Wrench& we) {
+      InverseDynamicsResult r;
+      EXPECT_EQ(inverse_dynamics(m, p, v, a, we, r), Status::Ok);
+      return Vec4(r.F);
+    };
+    const Vec4 F = forces(c.pose, c.vel, acc, kWe);
+    EXPECT_LT(rel_diff(d.F, F), 1e-12) << d.F.transpose() << " vs " << F.transpose();
+
+    const double h[4] = {3e-4, 1e-2, 0.1, 1.0};  // steps for p (phi: 10x), pd, pdd, we
+    Eigen::MatrixXd an(4, 16), fd(4, 16);
+    Eigen::VectorXd err(16);
+    an << d.dp, d.dpd, d.dpdd, d.dwe;
+    for (int block = 0; block < 4; ++block)
+      for (int k = 0; k < 4; ++k) {
+        const double hk = h[block] * (block < 2 && k == 3 ? 10.0 : 1.0);
+        fd.col(4 * block + k) = richardson([&](double s) {
+          Pose x[4] = {c.pose, c.vel, acc, kWe};
+          x[block][k] += s;
+          return forces(x[0], x[1], x[2], x[3]);
+        }, hk, &err[4 * block + k]);
+      }
+    expect_columns_match("dF / d(p, pd, pdd, we)", an, fd, err, 1e-7);
+  }
+}
+
+TEST(MachineDerivatives, PassiveForceAndDissipationSlopesMatchRichardsonDifferences) {
+  // Friction alone (within the travel), a pushing stop, a released stop
+  // (k delta + d delta_dot < 0: the force is held at 0, the spring's energy
+  // flows back), each stop from the state and held on (machine.hpp).
+  const Params p = machine_params();
+  struct Joint { const char* what; double rho, rhod; unsigned stops; };
+  const Joint joints[] = {
+      {"within the travel", 0.06, 0.03, kStopsFromState},
+      {"pushing lower stop", p.rho_min - 1e-3, 0.02, kStopsFromState},
+      {"pushing upper stop, held", p.rho_max + 1e-3, -0.02, 1u << 4},
+      {"released lower stop", p.rho_min - 1e-4, 0.2, kStopsFromState},
+      {"released upper stop, held", p.rho_max + 1e-4, -0.2, 1u << 4},
+  };
+  for (const Joint& j : joints) {
+    SCOPED_TRACE(j.what);
+    const PassiveSlopes f = passive_joint_force_slopes(p, 0, j.stops, j.rho, j.rhod);
+    const PassiveSlopes d = dissipated_power_slopes(p, 0, j.stops, j.rho, j.rhod);
+    Eigen::MatrixXd an(2, 2), fd(2, 2);
+    Eigen::VectorXd err(2);
+    an << f.drho, f.drhod, d.drho, d.drhod;
+    auto both = [&](double rho, double rhod) {
+      Eigen::VectorXd v(2);
+      v << passive_joint_force(p, 0, j.stops, rho, rhod), dissipated_power(p, 0, j.stops, rho, rhod);
+      return v;
+    };
+    fd.col(0) = richardson([&](double s) { return both(j.rho + s, j.rhod); }, 2e-5, &err[0]);
+    fd.col(1) = richardson([&](double s) { return both(j.rho, j.rhod + s); }, 2e-3, &err[1]);
+    expect_columns_match("d(F_passive, P_dissipated)/d(rho, rhod)", an, fd, err, 1e-7);
+  }
+}
+
+TEST(ForwardDerivatives, LinearisationPredictsAPerturbedMotionToSecondOrder) {
+  // The machine held at rest at the home pose (holding forces: an
+  // equilibrium), every term on. A perturbation eps (dy0, du) moves the
+  // nonlinear plant y' = f(y, u) for 50 ms; the linearisation
+  // dy' = A dy + B du at the equilibrium predicts it with an error that
+  // shrinks as eps^2 (Taylor): halving eps divides it by about 4.
+  const Model m = model_of(machine_params());
+  Vec16 q;
+  ASSERT_EQ(closed_form_position(m, Pose(0.0, 0.0, 0.05, 0.0), q), Status::Ok);
+  Vec4 F0;
+  ASSERT_EQ(holding_forces(m, q, Wrench::Zero(), F0), Status::Ok);
+  Vec8 y0;
+  y0 << 0.0, 0.0, 0.05, 0.0, 0.0, 0.0, 0.0, 0.0;
+  Vec8 ydot;
+  Mat8 A;
+  Mat8x12 B;
+  ASSERT_EQ(state_derivative_jacobians(m, y0, F0, Vec4::Zero(), Wrench::Zero(), kStopsFromState, ydot, A, B),
+            Status::Ok);
+  ASSERT_LT(ydot.cwiseAbs().maxCoeff(), 1e-12) << "an equilibrium";
+  Vec8 dy0;
+  dy0 << 1e-3, -8e-4, 5e-4, 1e-2, 1e-2, 5e-3, -8e-3, 0.1;  // m, rad, m/s, rad/s
+  Eigen::Matrix<double, 12, 1> du;
+  du << 0.05, -0.03, 0.02, 0.04, 0.1, -0.05, 0.08, 2e-3, 1e-4, 0.0, -1e-4, 5e-5;
+  const double h = 1e-4, T = 0.05;
+  const int steps = static_cast<int>(std::lround(T / h));
+  auto prediction_error = [&](double eps) {
+    const Eigen::Matrix<double, 12, 1> u = eps * du;
+    auto plant = [&](double, const Vec8& y, Vec8& yd) {
+      return state_derivative(m, Formulation::LegPartitioned, y,
+                              generalized_forces(m, F0 + u.head<4>(), u.tail<4>(), u.segment<4>(4)), yd);
+    };
+    auto linear = [&](double, const Vec8& d, Vec8& dd) {
+      dd = A * d + B * u;
+      return Status::Ok;
+    };
+    Vec8 y = y0 + eps * dy0, d = eps * dy0;
+    for (int k = 0; k < steps; ++k) {
+      EXPECT_EQ(rk4_step(plant, k * h, h, y), Status::Ok);
+      EXPECT_EQ(rk4_step(linear, k * h, h, d), Status::Ok);
+    }
+    return (y - y0 - d).cwiseAbs().maxCoeff() / (eps * dy0.cwiseAbs().maxCoeff());
+  };
+  const double e1 = prediction_error(0.5), e2 = prediction_error(0.25), e3 = prediction_error(0.125);
+  std::printf("relative prediction error over 50 ms: eps 1/2: %.2e, 1/4: %.2e, 1/8: %.2e\n", e1, e2, e3);
+  // Relative to the perturbation the error is first order in eps: halving
+  // eps halves it (the absolute error is second order; a wrong A or B
+  // would leave a first-order absolute error, a ratio near 1).
+  EXPECT_LT(e1, 0.02) << "the linearisation predicts the motion";
+  EXPECT_NEAR(e1 / e2, 2.0, 0.15);
+  EXPECT_NEAR(e2 / e3, 2.0, 0.15);
+}
