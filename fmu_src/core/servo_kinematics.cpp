@@ -50,18 +50,6 @@ Status closed_form_position(const Model& m, const Pose& pose, Vec16& q) {
   return Status::Ok;
 }
 
-Status closed_form_sliders(const Model& m, const Pose& pose, Vec4& rho) {
-  if (!pose.allFinite()) return Status::NonFinite;
-  const PlatformConfig pc = platform_config(pose);
-  for (int i = 0; i < kLegs; ++i) {
-    LegConfig c;
-    const Status s = leg_inverse_kinematics(m, i, pc, c);
-    if (s != Status::Ok) return s;
-    rho[i] = c.rho;
-  }
-  return Status::Ok;
-}
-
 Status solve_position(const Model& m, const Pose& pose, Vec16& q, const NewtonOptions& opt,
                       NewtonReport* report) {
   if (!pose.allFinite() || !q.allFinite()) return Status::NonFinite;

@@ -29,9 +29,6 @@ Status solve_position(const Model& m, const Pose& pose, Vec16& q,
 /// Initial guess for the position problem from the closed-form leg
 /// inverse kinematics (elbow-down). Status::Unreachable off the workspace.
 Status closed_form_position(const Model& m, const Pose& pose, Vec16& q);
-/// The slider positions rho_i alone from the same closed form, without the
-/// angles (no trigonometric calls but phi's).
-Status closed_form_sliders(const Model& m, const Pose& pose, Vec4& rho);
 
 /// Phi_q = [C_q; 0 I4] factorised once at a configuration, for the
 /// velocity and acceleration problems that share it.

@@ -41,7 +41,6 @@
 #include "mechanism_parameters.hpp"
 #include "models.hpp"
 #include "plant.hpp"
-#include "servo_kinematics.hpp"
 #include "workspace_guard.hpp"
 
 namespace pkm_fmi {
@@ -341,7 +340,7 @@ Status PlantData::update_outputs(Context& ctx, unsigned groups) {
   }
   if (groups & kGroupSliders) {
     pkm::Vec4 r;
-    const pkm::Status s = pkm::closed_form_sliders(plant->model(), plant->state().head<4>(), r);
+    const pkm::Status s = pkm::actuator_positions(plant->model(), plant->state().head<4>(), r);
     if (s != pkm::Status::Ok) {
       return cannot_assemble(s);
     }
