@@ -1,0 +1,41 @@
+# Link-time optimisation where the speed ships: the FMU binaries, libpkm,
+# the auto-test app and the benchmarks. The libraries they share with the
+# tests (pkm_core, pkm_capi, pkm_fmi_models) are compiled to fat LTO objects
+# (the intermediate code and ordinary machine code), so that the tests and
+# the build tools link the machine code without a link-time optimisation
+# pass of their own: about 20 such links of 10-30 s each were a third of the
+# test command's build. The tests that check the shipped binaries load the
+# FMUs themselves (dlopen), which are optimised at link time as before.
+#
+#   PKM_LTO  (option, ON) in Release builds; OFF: no LTO anywhere.
+#   pkm_without_lto(<target>...)  links those targets without LTO.
+include_guard(GLOBAL)
+option(PKM_LTO "Link-time optimisation in Release builds (inlines the small kinematics helpers across files)" ON)
+set(PKM_LTO_ACTIVE OFF)
+if(PKM_LTO AND CMAKE_BUILD_TYPE STREQUAL "Release")
+  include(CheckIPOSupported)
+  check_ipo_supported(RESULT _pkm_ipo OUTPUT _pkm_ipo_why LANGUAGES C CXX)
+  if(_pkm_ipo)
+    set(CMAKE_INTERPROCEDURAL_OPTIMIZATION ON)
+    set(PKM_LTO_ACTIVE ON)
+  else()
+    message(STATUS "PKM: link-time optimisation not available: ${_pkm_ipo_why}")
+  endif()
+endif()
+
+function(pkm_fat_lto_objects)
+  if(PKM_LTO_ACTIVE AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    foreach(_t IN LISTS ARGN)
+      target_compile_options(${_t} PRIVATE -ffat-lto-objects)
+    endforeach()
+  endif()
+endfunction()
+
+function(pkm_without_lto)
+  foreach(_t IN LISTS ARGN)
+    set_target_properties(${_t} PROPERTIES INTERPROCEDURAL_OPTIMIZATION OFF)
+    if(PKM_LTO_ACTIVE AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+      target_link_options(${_t} PRIVATE -fno-lto)
+    endif()
+  endforeach()
+endfunction()
