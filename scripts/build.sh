@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing (scripts/setup.sh), then configures and builds
 # everything in build/ (Ninja, Release).
+#   scripts/build.sh [--configure-only]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 ./scripts/setup.sh
@@ -10,4 +11,5 @@ if [ -f build/CMakeCache.txt ] && ! grep -q '^CMAKE_GENERATOR:INTERNAL=Ninja$' b
   rm -rf build/CMakeCache.txt build/CMakeFiles
 fi
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+if [ "${1:-}" = "--configure-only" ]; then exit 0; fi
 cmake --build build -j2
