@@ -114,6 +114,8 @@ def load(path=None):
     lib.pkm_get_outputs.restype = i
     lib.pkm_get_state.argtypes = [vp, dp, dp, dp]
     lib.pkm_get_state.restype = i
+    lib.pkm_set_state.argtypes = [vp, ct.c_double, dp, dp]
+    lib.pkm_set_state.restype = i
     # the machine around the mechanism
     lib.pkm_default_machine_params.argtypes = [P(MachineParams)]
     lib.pkm_default_machine_params.restype = None
