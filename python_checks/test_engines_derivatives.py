@@ -14,7 +14,8 @@ itself): that assembly against Richardson-extrapolated central differences
 of Pinocchio's own reduced ydot.
 
 Compared: pkm_forward_derivatives through the C API, and the Model Exchange
-FMU's fmi2GetDirectionalDerivative through fmpy; the ideal machine, and the
+FMU's fmi2GetDirectionalDerivative through fmpy (and pkm_inverse_derivatives
+against the same reference, inverted); the ideal machine, and the
 machine with every term that acts in free motion (rotor inertia, viscous and
 Coulomb friction, an off-centre payload); at home and four off-home states of
 the workspace, all moving, with forces, a wrench and motor torques.
@@ -213,6 +214,36 @@ def test_model_exchange_directional_derivatives_match_pinocchio(fmu_derivatives,
     worst = check_against_pinocchio(fmu_derivatives, pinocchio, case, "Model Exchange FMU")
     print(f"Model Exchange FMU, {case}: largest column-relative difference from Pinocchio: "
           f"A {worst[0]:.2e}, B {worst[1]:.2e}")
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_inverse_derivatives_invert_pinocchio_forward_ones(pkm_library, pinocchio, case):
+    """pkm_inverse_derivatives against the same Pinocchio reference: the
+    inverse dynamics F(p, pd, pdd, w) solves pdd(p, pd, F, w) = pdd for F, so
+    by the implicit function theorem, with B_F = dpdd/dF:
+    B_F dF/dpdd = I, B_F dF/d(p, pd) = -dpdd/d(p, pd), B_F dF/dw = -dpdd/dw;
+    and F itself = F + (2 pi / p) tau of the forward state. Compared in the
+    acceleration domain, with the forward check's metric (consistent units,
+    column-relative, the floor from the whole A block: at "home, leaving",
+    pure vertical motion, every rate derivative vanishes), 1e-6."""
+    ref = pinocchio[0][case]
+    lib = pkm_capi.load(pkm_library)
+    g = gear(CASES[case])
+    worst = 0.0
+    with pkm_capi.Model(lib, machine=CASES[case]) as m:
+        for name, (pose, rate) in STATES.items():
+            ydot, A, B = ref[name]
+            F, dF = m.inverse_derivatives(pose, rate, ydot[4:], U[4:8])
+            assert np.abs(F - (U[:4] + g * U[8:])).max() <= 1e-9 * np.abs(U[:4]).max(), f"{case}, {name}: F"
+            B_F = B[4:, :4]
+            implied_A, implied_B = A.copy(), B.copy()  # kinematic rows and the F, tau columns as they are
+            implied_A[4:] = -B_F @ dF[:, :8]
+            implied_B[4:, 4:8] = -B_F @ dF[:, 12:16]
+            eA, eB = errors(implied_A, implied_B, A, B, g)
+            eI = np.abs(B_F @ dF[:, 8:12] - np.eye(4)).max()
+            assert eA <= TOL and eB <= TOL and eI <= TOL, f"{case}, {name}: A {eA:.2e}, B {eB:.2e}, I {eI:.2e}"
+            worst = max(worst, eA, eB, eI)
+    print(f"\n{case}: dF against Pinocchio's forward derivatives: {worst:.2e}")
 
 
 def test_machine_terms_change_the_derivatives(pinocchio):
