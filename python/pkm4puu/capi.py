@@ -12,12 +12,18 @@ directory is $PKM_BUILD_DIR (default <repo>/build), as for the FMU checks.
 import ctypes as ct
 from pathlib import Path
 
+import numpy as np
+
 from .fmu import REPO, build_dir
 
 PKM_OK = 0
 PKM_SOLVER_CVODE, PKM_SOLVER_RK4 = 0, 1
 PKM_CVODE_ADAMS, PKM_CVODE_BDF = 0, 1
 PKM_FORM_AUGMENTED, PKM_FORM_NULLSPACE_QR, PKM_FORM_LEG_PARTITIONED = 0, 1, 2
+# pkm_forward_derivatives: the state (x, y, z, phi, dx, dy, dz, dphi) and the
+# plant's inputs, in pkm.h's order (PKM_PLANT_INPUTS)
+PLANT_STATES = 8
+PLANT_INPUTS = 12  # F[1..4] (N), Fe[1..3] (N), Me_z (N m), tau[1..4] (N m)
 
 D4 = ct.c_double * 4
 # Every struct the library writes into ends in this reserve, so that fields
@@ -108,6 +114,8 @@ def load(path=None):
     lib.pkm_get_outputs.restype = i
     lib.pkm_get_state.argtypes = [vp, dp, dp, dp]
     lib.pkm_get_state.restype = i
+    lib.pkm_set_state.argtypes = [vp, ct.c_double, dp, dp]
+    lib.pkm_set_state.restype = i
     # the machine around the mechanism
     lib.pkm_default_machine_params.argtypes = [P(MachineParams)]
     lib.pkm_default_machine_params.restype = None
@@ -119,7 +127,15 @@ def load(path=None):
     lib.pkm_get_machine_outputs.restype = i
     lib.pkm_inverse_dynamics_machine.argtypes = [vp, dp, dp, dp, dp, P(InverseMachineResult)]
     lib.pkm_inverse_dynamics_machine.restype = i
+    # analytic derivatives
+    lib.pkm_forward_derivatives.argtypes = [vp, dp, dp, dp, dp, dp]
+    lib.pkm_forward_derivatives.restype = i
+    lib.pkm_inverse_derivatives.argtypes = [vp, dp, dp, dp, dp, dp, dp]
+    lib.pkm_inverse_derivatives.restype = i
     return lib
+
+
+_DP = ct.POINTER(ct.c_double)
 
 
 def _d4(a):
@@ -246,6 +262,34 @@ class Model:
         self._check(self.lib.pkm_inverse_dynamics_machine(self.handle, _d4(pose), _d4(velocity), _d4(acceleration),
                                                           _d4(wrench), ct.byref(r)), "pkm_inverse_dynamics_machine")
         return r
+
+    def forward_derivatives(self, state, inputs=None):
+        """pkm_forward_derivatives: (ydot (8,), A (8, 8), B (8, 12)) of the
+        reduced forward dynamics at state (x, y, z, phi, dx, dy, dz, dphi) and
+        inputs (PLANT_INPUTS order; None: zero), as numpy arrays."""
+        y = np.ascontiguousarray(state, dtype=float)
+        if y.shape != (PLANT_STATES,):
+            raise ValueError(f"state must have {PLANT_STATES} values, not shape {y.shape}")
+        u = None
+        if inputs is not None:
+            u = np.ascontiguousarray(inputs, dtype=float)
+            if u.shape != (PLANT_INPUTS,):
+                raise ValueError(f"inputs must have {PLANT_INPUTS} values, not shape {u.shape}")
+        yd = np.empty(PLANT_STATES)
+        A, B = np.empty((PLANT_STATES, PLANT_STATES)), np.empty((PLANT_STATES, PLANT_INPUTS))
+        self._check(self.lib.pkm_forward_derivatives(
+            self.handle, y.ctypes.data_as(_DP), None if u is None else u.ctypes.data_as(_DP), yd.ctypes.data_as(_DP),
+            A.ctypes.data_as(_DP), B.ctypes.data_as(_DP)), "pkm_forward_derivatives")
+        return yd, A, B
+
+    def inverse_derivatives(self, pose, velocity, acceleration, wrench=None):
+        """pkm_inverse_derivatives: (F (4,), dF (4, 16)), dF with respect to
+        (pose, velocity, acceleration, wrench)."""
+        F, dF = np.empty(4), np.empty((4, 16))
+        self._check(self.lib.pkm_inverse_derivatives(self.handle, _d4(pose), _d4(velocity), _d4(acceleration),
+                                                     _d4(wrench), F.ctypes.data_as(_DP), dF.ctypes.data_as(_DP)),
+                    "pkm_inverse_derivatives")
+        return F, dF
 
     def outputs(self, F=None, wrench=None):
         o = Outputs()
