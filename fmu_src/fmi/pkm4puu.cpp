@@ -94,6 +94,7 @@ struct PlantData final : MechanismData {
   unsigned stops_beyond = 0;
   // Co-Simulation: end-stop events located so far (logged per step).
   long contact_events = 0;
+
   // The simulated machine (nullptr before initialisation).
   std::unique_ptr<pkm::Plant> plant;
 
@@ -118,8 +119,12 @@ struct PlantData final : MechanismData {
 
   /// The absolute time of the plant (its own time is the time since startTime), for messages.
   double absolute_time(const Context& ctx) const { return ctx.start_time + plant->time(); }
+  /// The model and solver settings of the current parameters (Error, logged, if unusable).
+  Status configuration(Context& ctx, const char* function, pkm::Model& model, pkm::SolverSettings& s) const;
   /// A Plant for the current parameters (not yet initialised).
   Status make_plant(Context& ctx, const char* function, std::unique_ptr<pkm::Plant>& out) const;
+  /// Whether the plant exists and was built from these parameters and settings.
+  bool built_from(const pkm::Model& model, const pkm::SolverSettings& s) const;
   /// make_plant, then the consistent initial state from x0..phi0, dx0..dphi0.
   Status build(Context& ctx, const char* function);
   /// The plant, built from the current parameters in initialisation mode.
@@ -133,6 +138,26 @@ struct PlantData final : MechanismData {
 
 Status PlantData::make_plant(Context& ctx, const char* function, std::unique_ptr<pkm::Plant>& out) const {
   pkm::Model model;
+  pkm::SolverSettings s;
+  const Status st = configuration(ctx, function, model, s);
+  if (st != Status::OK) return st;
+  auto plant_new = std::make_unique<pkm::Plant>(model);
+  std::string why;
+  if (plant_new->set_solver(s, &why) != pkm::Status::Ok) {
+    ctx.log.error("%s: parameter %s", function, why.c_str());
+    return Status::Error;
+  }
+  out = std::move(plant_new);
+  return Status::OK;
+}
+
+bool PlantData::built_from(const pkm::Model& model, const pkm::SolverSettings& s) const {
+  static_assert(sizeof(pkm::Params) % sizeof(double) == 0, "Params holds doubles only: no padding to compare");
+  return plant && std::memcmp(&plant->model().p, &model.p, sizeof(pkm::Params)) == 0 && plant->solver() == s;
+}
+
+Status PlantData::configuration(Context& ctx, const char* function, pkm::Model& model,
+                                pkm::SolverSettings& s) const {
   std::string why;
   if (pkm::make_model(params, model, &why) != pkm::Status::Ok) {
     ctx.log.error("%s: %s", function, why.c_str());
@@ -152,7 +177,7 @@ Status PlantData::make_plant(Context& ctx, const char* function, std::unique_ptr
                   function, static_cast<int>(formulation));
     return Status::Error;
   }
-  pkm::SolverSettings s;
+  s = pkm::SolverSettings{};
   s.solver = static_cast<pkm::Solver>(solver);
   s.rk4_step = rk4_step;
   s.rtol = rtol;
@@ -161,12 +186,11 @@ Status PlantData::make_plant(Context& ctx, const char* function, std::unique_ptr
   s.formulation = static_cast<pkm::Formulation>(formulation);
   s.max_jacobian_condition = limits.max_jacobian_condition;
   s.min_leg_measure = limits.min_leg_measure;
-  auto plant_new = std::make_unique<pkm::Plant>(model);
-  if (plant_new->set_solver(s, &why) != pkm::Status::Ok) {
-    ctx.log.error("%s: parameter %s", function, why.c_str());
+  const std::string invalid = pkm::validate(s);
+  if (!invalid.empty()) {
+    ctx.log.error("%s: parameter %s", function, invalid.c_str());
     return Status::Error;
   }
-  out = std::move(plant_new);
   return Status::OK;
 }
 
@@ -180,6 +204,7 @@ Status PlantData::build(Context& ctx, const char* function) {
   if (s != pkm::Status::Ok) {
     const char* what = s == pkm::Status::Unreachable ? "cannot be assembled elbow-down"
                        : s == pkm::Status::Singular  ? "lies beyond the singularity limits"
+                       : s == pkm::Status::SolverFailure ? "cannot be integrated (the solver could not be set up)"
                                                      : "cannot be used";
     ctx.log.error("%s: the initial state x0 = %.9g m, y0 = %.9g m, z0 = %.9g m, phi0 = %.9g rad (velocity dx0 = %g, "
                   "dy0 = %g, dz0 = %g m/s, dphi0 = %g rad/s) %s: %s: %s",
@@ -569,8 +594,10 @@ void PlantData::save(StateWriter& w) const {
 }
 
 bool PlantData::load(StateReader& r, Context& ctx) {
-  plant.reset();
-  if (r.u8() == 0) return r.ok();
+  if (r.u8() == 0) {
+    plant.reset();
+    return r.ok();
+  }
   const double t = r.f64();
   pkm::Vec8 y;
   pkm::Vec4 ref;
@@ -583,16 +610,23 @@ bool PlantData::load(StateReader& r, Context& ctx) {
     ctx.log.error("SetFMUState: malformed FMU state (end-stop record %#x names no stop)", beyond);
     return false;
   }
-  std::unique_ptr<pkm::Plant> p;
-  if (make_plant(ctx, "SetFMUState", p) != Status::OK) return false;
-  const pkm::Status s = p->restore(t, y, ref, e);
+  // The plant, with its solver's objects, is kept when the restored
+  // parameters are those it was built with (restore() restarts its
+  // integrator): a restore allocates nothing. Otherwise a new one.
+  pkm::Model model;
+  pkm::SolverSettings settings;
+  if (configuration(ctx, "SetFMUState", model, settings) != Status::OK) return false;
+  std::unique_ptr<pkm::Plant> fresh;
+  if (!built_from(model, settings) && make_plant(ctx, "SetFMUState", fresh) != Status::OK) return false;
+  pkm::Plant& p = fresh ? *fresh : *plant;
+  const pkm::Status s = p.restore(t, y, ref, e);
   if (s != pkm::Status::Ok) {
     ctx.log.error("SetFMUState: the saved state at t = %.17g cannot be restored: %s%s%s", t, pkm::status_name(s),
-                  p->last_error().empty() ? "" : ": ", p->last_error().c_str());
+                  p.last_error().empty() ? "" : ": ", p.last_error().c_str());
     return false;
   }
-  plant = std::move(p);
-  contact_events = plant->contact_events();  // counted per Plant: a restored one starts anew
+  if (fresh) plant = std::move(fresh);
+  contact_events = plant->contact_events();  // the count continues from here
   stops_beyond = beyond;
   return true;
 }
