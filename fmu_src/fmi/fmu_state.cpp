@@ -281,6 +281,7 @@ Status Instance::get_fmu_state(void** state) {
     *state = s;
   }
   save(s->bytes);
+  data_->state_saved();
   log_.event("%s: state saved at t = %.17g (%llu bytes)", fn, time_,
              static_cast<unsigned long long>(s->bytes.size()));
   return Status::OK;

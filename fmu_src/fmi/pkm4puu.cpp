@@ -9,11 +9,23 @@
 //
 // Time stepping: every fmi2DoStep integrates with inputs
 // u(t) = u + du (t - t_step_start) (du from fmi2SetRealInputDerivatives,
-// reset to 0 whenever u is set) and restarts CVODE at the step start
-// (Plant::advance with continuous = false): the result of a step depends
-// only on the state and inputs at its start, so a restored FMU state
-// continues bit-identically. After a step the inputs hold their
-// extrapolated values u + du h, the inputs at the new time.
+// reset to 0 whenever u is set). After a step the inputs hold their
+// extrapolated values u + du h, the inputs at the new time. CVODE continues
+// its history across the communication point (Plant::advance with
+// continuous = true: no restart) when the inputs did not jump there
+// (inputs_continue): every input at the step start equals its value at the
+// end of the previous step within kInputJump (relative: rounding) -- inputs
+// held constant, or a ramp whose values and slopes the master sets each
+// step (a change of slope is a kink, which CVODE's error test resolves).
+// A value that differs is a jump, and CVODE restarts at the step start:
+// integrating across a jump from the old history costs accuracy (pkm_tick_bench:
+// 1e-6 m after 1 s with midpoint-held forces, or with value and slope sampled
+// from a curved signal, whose lines miss each other by u'' h^2 / 2, against
+// 6e-9 m restarted).
+// FMU states: CVODE's history is not part of a saved state. The next step
+// after a GetFMUState restarts, as the first step after a SetFMUState does
+// (PlantData::state_saved), so a restored run continues bit for bit like
+// the original one (RK4 keeps no history: nothing changes for it).
 //
 // Outputs are computed lazily by group (the state's copies, the legs, the
 // dynamics, the machine, the health measures: kGroup* below), each on the
@@ -54,6 +66,13 @@ constexpr int kInputs = 12;  // F[1..4], Fe[1..3], Me_z, tau[1..4]
 // weight at the default initial pose, the start value of F[1..4] (so that a
 // plant nothing drives stays where it is).
 constexpr double kHoldingForce = 2.655616050;
+// An input jumps at a communication point when it differs from its value at
+// the end of the previous step by more than this, relative to 1 + |value|
+// (in N, N*m): far above the rounding of a master that evaluates a ramp
+// a + b t where the FMU extrapolated u + b h (a few 1e-16), far below any
+// jump that matters (a jump of 1e-12 N moves the platform by ~1e-16 m in a
+// millisecond).
+constexpr double kInputJump = 1e-12;
 
 // The output groups (Variable::group): a get computes only the groups it
 // reads, each once until the state, time or inputs change.
@@ -94,11 +113,20 @@ struct PlantData final : MechanismData {
   unsigned stops_beyond = 0;
   // Co-Simulation: end-stop events located so far (logged per step).
   long contact_events = 0;
-
+  // Co-Simulation: the inputs at the end of the last step and whether CVODE
+  // may continue from there (no restart, failure or saved state since).
+  double u_end[kInputs] = {};
+  bool may_continue = false;
   // The simulated machine (nullptr before initialisation).
   std::unique_ptr<pkm::Plant> plant;
 
-  void reset() override { plant.reset(); }
+  void reset() override {
+    plant.reset();
+    may_continue = false;
+  }
+  void state_saved() override { may_continue = false; }
+  /// Whether every input continues its value at the end of the last step (kInputJump).
+  bool inputs_continue() const;
   Status exit_initialization(Context& ctx) override;
   Status do_step(Context& ctx, double t, double h, double& t_reached) override;
   Status check_step(Context& ctx, double h) const override;
@@ -215,6 +243,7 @@ Status PlantData::build(Context& ctx, const char* function) {
   plant = std::move(p);
   contact_events = plant->contact_events();
   stops_beyond = beyond_stops();
+  may_continue = false;
   return Status::OK;
 }
 
@@ -281,12 +310,15 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
     ctx.log.error("DoStep: the inputs extrapolated with their derivatives to t = %.17g are not finite", t_end);
     return Status::Error;
   }
-  const pkm::Status s = plant->advance(t_end, in.signal(), /*continuous=*/false);
+  const bool continuous = may_continue && inputs_continue();
+  const pkm::Status s = plant->advance(t_end, in.signal(), continuous);
   t_reached = plant->time();
   // The inputs now refer to the time reached.
   if (t_reached != t_start)
     for (int k = 0; k < kInputs; ++k)
       if (du[k] != 0.0) u[k] += du[k] * (t_reached - t_start);
+  may_continue = s == pkm::Status::Ok;
+  std::memcpy(u_end, u, sizeof u_end);
   if (plant->contact_events() != contact_events) {
     contact_events = plant->contact_events();
     // Also with logEvents off: the record of the stops passed stays current.
@@ -314,6 +346,12 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
                     pkm::status_name(s), plant->last_error().empty() ? "" : ": ", plant->last_error().c_str());
       return Status::Error;
   }
+}
+
+bool PlantData::inputs_continue() const {
+  for (int k = 0; k < kInputs; ++k)
+    if (!(std::abs(u[k] - u_end[k]) <= kInputJump * (1.0 + std::abs(u_end[k])))) return false;
+  return true;
 }
 
 Status PlantData::check_step(Context& ctx, double h) const {
@@ -628,6 +666,7 @@ bool PlantData::load(StateReader& r, Context& ctx) {
   if (fresh) plant = std::move(fresh);
   contact_events = plant->contact_events();  // the count continues from here
   stops_beyond = beyond;
+  may_continue = false;  // the integrator restarts here, as the original run does after saving
   return true;
 }
 
