@@ -11,8 +11,10 @@
  * Scenario: 1000 batches of 1000 ticks, each batch the same simulated second
  * from the home pose (the FMU state saved after initialisation is restored
  * between batches, outside the timing, so the platform never leaves the
- * workspace), F[1..4] = the static holding force (MODEL_SPEC) + 0.2 cos(2 pi
- * 3 t) N on F[1].
+ * workspace), F[1..4] = the static holding force (MODEL_SPEC), plus on F[1]
+ * with RK4 0.2 cos(2 pi 3 t) N held over each tick (its midpoint value),
+ * with CVODE the ramp 0.2 t N given as value and slope each tick (CVODE
+ * continues across the ticks; it restarts at each batch's restore).
  *
  * What the outliers are: the model's work at tick k of a batch is the same in
  * every batch (same state, same inputs, bit for bit), the machine's
@@ -76,8 +78,12 @@ static int run(const Fmu* f, const Refs* r, int solver, double* ticks /* BATCHES
   for (k = 0; k < TICKS; ++k) {
     const double t = k * H, w = 2.0 * PI * FREQUENCY;
     for (i = 0; i < 4; ++i) u[k][i] = STATIC_FORCE, du[k][i] = 0.0;
-    u[k][0] += AMPLITUDE * cos(w * t);
-    du[k][0] = -AMPLITUDE * w * sin(w * t);
+    if (solver == 0) { /* a continuous ramp, value and slope: CVODE continues across ticks */
+      u[k][0] += AMPLITUDE * t;
+      du[k][0] = AMPLITUDE;
+    } else { /* held over the tick */
+      u[k][0] += AMPLITUDE * cos(w * (t + 0.5 * H));
+    }
   }
   for (b = 0; b < BATCHES; ++b) {
     if (f->fmi2SetFMUstate(c, home) != fmi2OK) return 0;
