@@ -2,7 +2,9 @@
  * loading a built FMU binary with dlopen, a logger that stays silent unless
  * the FMU reports an error, reading modelDescription.xml's attributes, the
  * clock and the machine's description. Static functions, one copy per
- * harness; define PKM_HARNESS_NAME (the program's name, for messages) first. */
+ * harness (the benchmarks, and the C tests tests/fmu_allocations.c and
+ * tests/fmu_alloc_faults.c); define PKM_HARNESS_NAME (the program's name,
+ * for messages) first. */
 #ifndef PKM_BENCH_FMU_HARNESS_H
 #define PKM_BENCH_FMU_HARNESS_H
 
@@ -18,6 +20,13 @@
 #include "fmi2FunctionTypes.h"
 #include "fmi_functions.h"
 
+/* Each harness uses some of the functions below. */
+#if defined(__GNUC__)
+#define PKM_HARNESS_FN static __attribute__((unused))
+#else
+#define PKM_HARNESS_FN static
+#endif
+
 #ifndef PKM_HARNESS_NAME
 #error "define PKM_HARNESS_NAME before including fmu_harness.h"
 #endif
@@ -32,7 +41,7 @@ typedef struct {
 
 /* dlsym returns an object pointer; ISO C has no conversion to a function
  * pointer, POSIX guarantees the representation: copy the bytes. */
-static int load_symbol(void* handle, const char* name, void* fn_ptr, size_t fn_size) {
+PKM_HARNESS_FN int load_symbol(void* handle, const char* name, void* fn_ptr, size_t fn_size) {
   void* p = dlsym(handle, name);
   if (!p) {
     fprintf(stderr, PKM_HARNESS_NAME ": symbol %s not found\n", name);
@@ -46,7 +55,7 @@ static int load_symbol(void* handle, const char* name, void* fn_ptr, size_t fn_s
   return 1;
 }
 
-static int load_fmu(const char* path, Fmu* f) {
+PKM_HARNESS_FN int load_fmu(const char* path, Fmu* f) {
   int ok = 1;
   memset(f, 0, sizeof *f);
   f->handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
@@ -60,7 +69,7 @@ static int load_fmu(const char* path, Fmu* f) {
   return ok;
 }
 
-static const char* status_name(fmi2Status s) {
+PKM_HARNESS_FN const char* status_name(fmi2Status s) {
   switch (s) {
     case fmi2OK: return "fmi2OK";
     case fmi2Warning: return "fmi2Warning";
@@ -73,7 +82,7 @@ static const char* status_name(fmi2Status s) {
 }
 
 /* Silent unless the FMU reports an error. */
-static void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status, fmi2String category,
+PKM_HARNESS_FN void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status, fmi2String category,
                    fmi2String message, ...) {
   va_list ap;
   (void)env;
@@ -85,7 +94,7 @@ static void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status
   fputc('\n', stderr);
 }
 
-static char* read_text(const char* path) {
+PKM_HARNESS_FN char* read_text(const char* path) {
   FILE* fp = fopen(path, "rb");
   char* text = NULL;
   long n;
@@ -104,7 +113,7 @@ static char* read_text(const char* path) {
 }
 
 /* The value of attribute `name` ("name=\"") inside [begin, end), copied to out. */
-static int attribute(const char* begin, const char* end, const char* name, char* out, size_t size) {
+PKM_HARNESS_FN int attribute(const char* begin, const char* end, const char* name, char* out, size_t size) {
   char key[64];
   const char* p = begin;
   size_t klen;
@@ -122,18 +131,34 @@ static int attribute(const char* begin, const char* end, const char* name, char*
   return 1;
 }
 
-static double now_seconds(void) {
+/* The value reference of the ScalarVariable called `name` in the model
+ * description `text`; -1 if none. */
+PKM_HARNESS_FN long find_value_reference(const char* text, const char* name) {
+  const char* p = text;
+  while ((p = strstr(p, "<ScalarVariable")) != NULL) {
+    const char* end = strstr(p, "</ScalarVariable>");
+    char buf[128];
+    if (!end) break;
+    if (attribute(p, end, "name", buf, sizeof buf) && strcmp(buf, name) == 0 &&
+        attribute(p, end, "valueReference", buf, sizeof buf))
+      return strtol(buf, NULL, 10);
+    p = end;
+  }
+  return -1;
+}
+
+PKM_HARNESS_FN double now_seconds(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static int compare_double(const void* a, const void* b) {
+PKM_HARNESS_FN int compare_double(const void* a, const void* b) {
   const double x = *(const double*)a, y = *(const double*)b;
   return (x > y) - (x < y);
 }
 
-static void print_machine(void) {
+PKM_HARNESS_FN void print_machine(void) {
   struct utsname u;
   char line[512], cpu[256] = "unknown";
   FILE* fp = fopen("/proc/cpuinfo", "r");
@@ -164,7 +189,7 @@ static void print_machine(void) {
  * (PKM_FMU_PLANT_XML), otherwise the FMU layout's
  * <stage>/binaries/<platform>/<id>.so -> <stage>/modelDescription.xml.
  * The caller frees the result. */
-static char* default_xml_path(const char* so) {
+PKM_HARNESS_FN char* default_xml_path(const char* so) {
   const char* suffix = "modelDescription.xml";
   size_t n = strlen(so);
   int slashes = 0;
@@ -186,6 +211,6 @@ static char* default_xml_path(const char* so) {
   return path;
 }
 
-static void* allocate_memory(size_t nobj, size_t size) { return calloc(nobj, size); }
+PKM_HARNESS_FN void* allocate_memory(size_t nobj, size_t size) { return calloc(nobj, size); }
 
 #endif /* PKM_BENCH_FMU_HARNESS_H */

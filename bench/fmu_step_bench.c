@@ -84,21 +84,6 @@ typedef struct {
   const char* text;
 } ModelDescription;
 
-/* The value reference of the ScalarVariable called `name`; -1 if none. */
-static long value_reference(const ModelDescription* md, const char* name) {
-  const char* p = md->text;
-  while ((p = strstr(p, "<ScalarVariable")) != NULL) {
-    const char* end = strstr(p, "</ScalarVariable>");
-    char buf[128];
-    if (!end) break;
-    if (attribute(p, end, "name", buf, sizeof buf) && strcmp(buf, name) == 0 &&
-        attribute(p, end, "valueReference", buf, sizeof buf))
-      return strtol(buf, NULL, 10);
-    p = end;
-  }
-  return -1;
-}
-
 static int parse_model_description(const char* text, ModelDescription* md) {
   const char* root = strstr(text, "<fmiModelDescription");
   const char* root_end = root ? strchr(root, '>') : NULL;
@@ -225,7 +210,7 @@ static int run(const Fmu* f, const ModelDescription* md, const References* r, in
 /* ------------------------------------------------------------------ main */
 
 static int lookup(const ModelDescription* md, const char* name, fmi2ValueReference* vr) {
-  const long v = value_reference(md, name);
+  const long v = find_value_reference(md->text, name);
   if (v < 0) {
     fprintf(stderr, "pkm_fmu_bench: no variable %s in the model description\n", name);
     return 0;

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 namespace pkm {
 
@@ -18,7 +19,27 @@ namespace {
 
 Eigen::Map<Vec10> as_vec(N_Vector v) { return Eigen::Map<Vec10>(N_VGetArrayPointer(v)); }
 
+// Out of memory while SUNDIALS creates its vectors: SUNDIALS 6's N_VClone
+// writes into the clone before anyone checks it for NULL (a crash inside
+// CVodeInit). The vectors of this integrator clone through clone_or_spare
+// instead: when a clone cannot be allocated it hands out the integrator's
+// spare vector (allocated first, never destroyed through its ops) and notes
+// the failure; init() then frees everything and reports it. The integrator
+// being set up on this thread (clones happen only inside init()):
+thread_local CvodeIntegrator* t_initializing = nullptr;
+
+void keep_spare(N_Vector) {}
+
 }  // namespace
+
+N_Vector CvodeIntegrator::clone_or_spare(N_Vector w) {
+  N_Vector v = N_VClone_Serial(w);  // copies w's ops: its clones clone through here too
+  if (v) return v;
+  CvodeIntegrator* me = t_initializing;
+  if (!me || !me->spare_) return nullptr;
+  me->out_of_memory_ = true;
+  return me->spare_;
+}
 
 CvodeIntegrator::~CvodeIntegrator() { release(); }
 
@@ -29,6 +50,9 @@ void CvodeIntegrator::release() {
   if (A_) SUNMatDestroy(A_);
   if (y_) N_VDestroy(y_);
   if (atol_) N_VDestroy(atol_);
+  if (spare_) N_VDestroy_Serial(spare_);  // its ops' destroy is keep_spare
+  spare_ = nullptr;
+  out_of_memory_ = false;
   atol_ = nullptr;
   if (ctx_) SUNContext_Free(&ctx_);
   mem_ = nullptr;
@@ -54,28 +78,65 @@ int CvodeIntegrator::root_trampoline(double t, N_Vector y, double* g, void* self
 
 void CvodeIntegrator::error_handler(int code, const char* module, const char* function, char* msg,
                                     void* self) {
-  // Keep the message for the caller's logger; never print.
+  // Keep the message for the caller's logger; never print. No exception
+  // leaves this C callback (out of memory: the message is lost).
   auto* me = static_cast<CvodeIntegrator*>(self);
-  me->error_ = std::string(module ? module : "CVODE") + "/" + (function ? function : "?") + " (" +
-               std::to_string(code) + "): " + (msg ? msg : "");
+  try {
+    me->error_ = std::string(module ? module : "CVODE") + "/" + (function ? function : "?") + " (" +
+                 std::to_string(code) + "): " + (msg ? msg : "");
+  } catch (...) {
+  }
 }
 
 Status CvodeIntegrator::init(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user, int n_roots,
                              RootFn roots) {
+  t_initializing = this;
+  Status s = Status::SolverFailure;
+  try {
+    s = create(method, rtol, atol, rhs, user, n_roots, roots);
+  } catch (...) {  // std::bad_alloc from error_
+  }
+  t_initializing = nullptr;
+  if (s == Status::Ok && out_of_memory_) s = Status::SolverFailure;
+  if (s != Status::Ok) {
+    const bool oom = out_of_memory_;
+    release();
+    if (oom) error_ = "out of memory";
+  }
+  return s;
+}
+
+Status CvodeIntegrator::create(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user, int n_roots,
+                               RootFn roots) {
   release();
   error_.clear();
+  steps_before_reset_ = 0;
   if (!(rtol > 0.0) || !(atol > 0.0) || !std::isfinite(rtol) || !std::isfinite(atol) || !rhs)
     return Status::InvalidArgument;
   rhs_ = rhs;
   roots_ = roots;
   user_ = user;
   if (SUNContext_Create(nullptr, &ctx_) != 0) return Status::SolverFailure;
+  spare_ = N_VNew_Serial(10, ctx_);
+  if (!spare_) return Status::SolverFailure;
+  spare_->ops->nvdestroy = &keep_spare;
+  spare_->ops->nvclone = &CvodeIntegrator::clone_or_spare;
   y_ = N_VNew_Serial(10, ctx_);
+  if (!y_) return Status::SolverFailure;
+  y_->ops->nvclone = &CvodeIntegrator::clone_or_spare;
   mem_ = CVodeCreate(method == CvodeMethod::BDF ? CV_BDF : CV_ADAMS, ctx_);
-  if (!y_ || !mem_) return Status::SolverFailure;
+  if (!mem_) return Status::SolverFailure;
   CVodeSetErrHandlerFn(mem_, &CvodeIntegrator::error_handler, this);
   N_VConst(0.0, y_);
   int flag = CVodeInit(mem_, &CvodeIntegrator::rhs_trampoline, 0.0, y_);
+  if (flag != CV_SUCCESS) {
+    // Out of memory inside CVodeInit: it has freed its vectors already, and
+    // CVodeFree would free them again (SUNDIALS 6). Only the memory block
+    // CVodeCreate allocated remains.
+    std::free(mem_);
+    mem_ = nullptr;
+    return Status::SolverFailure;
+  }
   flag |= CVodeSetUserData(mem_, this);
   // Every component under rtol and atol, the two running energy integrals
   // (8, 9; atol in J) too. Kept out of the error test (as CVODES treats
@@ -88,6 +149,7 @@ Status CvodeIntegrator::init(CvodeMethod method, double rtol, double atol, Rhs r
   // each), so the integrand's jump there costs no step.
   atol_ = N_VNew_Serial(10, ctx_);
   if (!atol_) return Status::SolverFailure;
+  atol_->ops->nvclone = &CvodeIntegrator::clone_or_spare;
   for (int k = 0; k < 10; ++k) N_VGetArrayPointer(atol_)[k] = atol;
   flag |= CVodeSVtolerances(mem_, rtol, atol_);
   // Enough for a long communication interval at the natural step (~1 ms),
@@ -120,6 +182,7 @@ Status CvodeIntegrator::init(CvodeMethod method, double rtol, double atol, Rhs r
 Status CvodeIntegrator::reset(double t0, const Vec10& y0) {
   if (!mem_) return Status::NotInitialized;
   as_vec(y_) = y0;
+  steps_before_reset_ = steps();
   if (CVodeReInit(mem_, t0, y_) != CV_SUCCESS) return Status::SolverFailure;
   needs_reset_ = false;
   return Status::Ok;
@@ -170,13 +233,7 @@ Status CvodeIntegrator::advance(double t_out, Vec10& y_out, double& t_reached, b
 long CvodeIntegrator::steps() const {
   long n = 0;
   if (mem_) CVodeGetNumSteps(mem_, &n);
-  return n;
-}
-
-long CvodeIntegrator::rhs_evaluations() const {
-  long n = 0;
-  if (mem_) CVodeGetNumRhsEvals(mem_, &n);
-  return n;
+  return steps_before_reset_ + n;
 }
 
 }  // namespace pkm

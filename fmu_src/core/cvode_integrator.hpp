@@ -55,17 +55,20 @@ class CvodeIntegrator {
   /// +1 / -1 for an indicator that rose / fell through zero, else 0.
   Status advance(double t_out, Vec10& y_out, double& t_reached, bool& root_found, int* root_dirs = nullptr);
 
-  bool ready() const { return mem_ != nullptr; }
   bool needs_reset() const { return needs_reset_; }
   const std::string& last_error() const { return error_; }
+  /// Internal steps taken since init(), across restarts (the work per
+  /// communication step: pkm_bench). The derivative evaluations are the
+  /// caller's to count (Plant::rhs_evaluations).
   long steps() const;
-  long rhs_evaluations() const;
 
  private:
   static int rhs_trampoline(double t, _generic_N_Vector* y, _generic_N_Vector* ydot, void* self);
   static int root_trampoline(double t, _generic_N_Vector* y, double* g, void* self);
   static void error_handler(int code, const char* module, const char* function, char* msg,
                             void* self);
+  Status create(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user, int n_roots, RootFn roots);
+  static _generic_N_Vector* clone_or_spare(_generic_N_Vector* w);
   void release();
 
   _SUNContext* ctx_ = nullptr;
@@ -75,10 +78,13 @@ class CvodeIntegrator {
   _generic_SUNMatrix* A_ = nullptr;                // BDF: dense Jacobian
   _generic_SUNLinearSolver* LS_ = nullptr;         // BDF: dense LU
   _generic_SUNNonlinearSolver* NLS_ = nullptr;     // Adams: fixed point
+  _generic_N_Vector* spare_ = nullptr;  // handed out when a clone cannot be allocated (clone_or_spare)
+  bool out_of_memory_ = false;
   Rhs rhs_ = nullptr;
   RootFn roots_ = nullptr;
   void* user_ = nullptr;
   bool needs_reset_ = true;
+  long steps_before_reset_ = 0;  // steps() of the histories before the current one
   std::string error_;
 };
 

@@ -31,6 +31,5 @@ Status CvodeIntegrator::advance(double, Vec10&, double&, bool&, int*) {
 }
 
 long CvodeIntegrator::steps() const { return 0; }
-long CvodeIntegrator::rhs_evaluations() const { return 0; }
 
 }  // namespace pkm

@@ -29,6 +29,12 @@ struct SolverSettings {
   GuardLimits limits() const { return {max_jacobian_condition, min_leg_measure}; }
 };
 
+inline bool operator==(const SolverSettings& a, const SolverSettings& b) {
+  return a.solver == b.solver && a.rk4_step == b.rk4_step && a.rtol == b.rtol && a.atol == b.atol &&
+         a.cvode_method == b.cvode_method && a.formulation == b.formulation &&
+         a.max_jacobian_condition == b.max_jacobian_condition && a.min_leg_measure == b.min_leg_measure;
+}
+
 /// The range of rk4_step (s): a thousandth of the paper's 1 ms resolves the
 /// stiffest default dynamics (the end stops ring at about 6 ms) many times
 /// over; above 1 s RK4 says nothing about this machine.
@@ -179,6 +185,8 @@ class Plant {
   double jacobian_condition() const;
 
   long rhs_evaluations() const { return rhs_count_; }
+  /// CVODE's internal steps so far (0 with RK4, whose steps are rk4_step).
+  long cvode_steps() const { return cvode_ready_ ? cvode_.steps() : 0; }
   const std::string& last_error() const { return error_; }
 
  private:
@@ -198,6 +206,9 @@ class Plant {
   unsigned contact_mask(const Vec10& x) const;
   /// RK4 substep while a joint is past a stop (resolves the stop's spring).
   double contact_step() const;
+  /// Creates CVODE's objects (once, when it is the solver), so that no step
+  /// allocates: at initialize() and restore().
+  Status prepare_cvode();
   Status advance_rk4(double t_end);
   Status advance_cvode(double t_end, bool continuous);
   /// check_configuration of y's pose against the settings' limits; on

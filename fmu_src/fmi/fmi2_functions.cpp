@@ -44,16 +44,27 @@ int as_int(const E& e) {
   return v;
 }
 
-// fmi2CallbackLogger treats the message as a printf format: '%' is escaped.
+// fmi2CallbackLogger treats the message as a printf format: '%' is escaped
+// (on the stack when it fits: logging inside a step allocates nothing).
 void emit(void* callback, void* env, const char* instance, Status status, const char* category,
           const char* message) {
-  std::string escaped;
-  for (const char* p = message; *p; ++p) {
-    escaped += *p;
-    if (*p == '%') escaped += '%';
+  char small[2048];
+  std::string large;
+  std::size_t n = 0;
+  for (const char* p = message; *p; ++p) n += (*p == '%') ? 2 : 1;
+  char* out = small;
+  if (n >= sizeof small) {
+    large.resize(n + 1);
+    out = &large[0];
   }
+  char* q = out;
+  for (const char* p = message; *p; ++p) {
+    *q++ = *p;
+    if (*p == '%') *q++ = '%';
+  }
+  *q = '\0';
   reinterpret_cast<fmi2CallbackLogger>(callback)(env, instance, static_cast<fmi2Status>(static_cast<int>(status)),
-                                                 category, escaped.c_str());
+                                                 category, out);
 }
 
 template <class Body>
@@ -109,6 +120,11 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
                                                      : pkm_fmi::Interface::ModelExchange,
                             fmuGUID, std::move(log));
   } catch (...) {
+    // Out of memory (nothing else throws here): said through the callback
+    // directly, the Logger may be what could not be built.
+    if (functions && functions->logger)
+      functions->logger(functions->componentEnvironment, instanceName ? instanceName : "", fmi2Error,
+                        "logStatusError", "fmi2Instantiate: out of memory; no instance created");
     return nullptr;
   }
 }

@@ -3,6 +3,7 @@
 // Compiled once per FMU, with PKM_FMI_DEFINITION naming the function that
 // returns its ModelDefinition. No exception crosses the C ABI. Every
 // variable is a scalar (no Dimension), so nValues equals nValueReferences.
+#include <cstdio>
 #include <cstring>
 #include <exception>
 
@@ -63,6 +64,13 @@ Instance* instantiate(const char* fn, Interface interface, fmi3String name, fmi3
     }
     return Instance::create(definition(), 3, interface, token, std::move(log));
   } catch (...) {
+    // Out of memory (nothing else throws here): said through the callback
+    // directly, the Logger may be what could not be built.
+    if (log_message) {
+      char message[160];
+      std::snprintf(message, sizeof message, "%s: out of memory; no instance created", fn);
+      log_message(env, fmi3Error, "logStatusError", message);
+    }
     return nullptr;
   }
 }

@@ -104,6 +104,11 @@ void Instance::save(std::vector<unsigned char>& out) const {
   w.u64(fnv1a(out.data(), out.size()));
 }
 
+void Instance::reserve_state_buffers() {
+  load_values_.reserve(stored_count(def_));
+  save(load_backup_);  // an initialised model's state has its final size
+}
+
 bool Instance::check_header(const unsigned char* bytes, std::size_t size, const char* function) {
   if (!bytes || size < kHeaderSize + kTrailerSize || std::memcmp(bytes, kMagic, sizeof kMagic) != 0) {
     log_.error("%s: not a serialised FMU state of this FMU (size %llu, no magic number)", function,
@@ -155,9 +160,9 @@ bool Instance::times_consistent(double start, bool stop_defined, double stop, do
   return false;
 }
 
-bool Instance::load(const std::vector<unsigned char>& bytes, const char* function) {
-  if (!check_header(bytes.data(), bytes.size(), function)) return false;
-  StateReader r(bytes.data() + kHeaderSize, bytes.size() - kHeaderSize - kTrailerSize);
+bool Instance::load(const unsigned char* bytes, std::size_t size, const char* function, bool keep_backup) {
+  if (!check_header(bytes, size, function)) return false;
+  StateReader r(bytes + kHeaderSize, size - kHeaderSize - kTrailerSize);
   const std::uint32_t mode = r.u32();
   const bool stop_defined = r.u8() != 0;
   const bool terminated = r.u8() != 0;
@@ -178,9 +183,11 @@ bool Instance::load(const std::vector<unsigned char>& bytes, const char* functio
                interface == 0 ? "Model Exchange" : "Co-Simulation", interface_name(interface_));
     return false;
   }
-  // Read every value before changing anything.
+  // Read every value before changing anything (into a buffer reserved at
+  // instantiation: restoring a state allocates nothing).
   std::size_t k = 0;
-  std::vector<double> values;
+  std::vector<double>& values = load_values_;
+  values.clear();
   values.reserve(count);
   for (std::size_t i = 0; i < def_.n_variables; ++i) {
     const Variable& v = def_.variables[i];
@@ -222,9 +229,9 @@ bool Instance::load(const std::vector<unsigned char>& bytes, const char* functio
       return false;
     }
   }
-  // Commit, keeping a copy of the current state to fall back to.
-  std::vector<unsigned char> backup;
-  save(backup);
+  // Commit, keeping a copy of the current state to fall back to (its buffer
+  // sized once initialised, reused).
+  if (keep_backup) save(load_backup_);
   k = 0;
   for (std::size_t i = 0; i < def_.n_variables; ++i) {
     const Variable& v = def_.variables[i];
@@ -244,12 +251,14 @@ bool Instance::load(const std::vector<unsigned char>& bytes, const char* functio
   last_successful_time_ = last_time;
   elapsed_ = elapsed;
   valid_groups_ = 0;
-  data_->reset();
   Context ctx = context();
+  // The model replaces what it derived (its solver restarts); it may keep
+  // its objects when the parameters are unchanged.
   const bool ok = data_->load(r, ctx) && r.ok() && r.at_end();
   if (ok) return true;
   log_.error("%s: the FMU state cannot be restored; the previous state is kept", function);
-  if (!load(backup, function)) mode_ = kError;  // cannot happen: the backup was just written
+  // Cannot fail: the backup was just written.
+  if (!keep_backup || !load(load_backup_.data(), load_backup_.size(), function, false)) mode_ = kError;
   return false;
 }
 
@@ -272,6 +281,7 @@ Status Instance::get_fmu_state(void** state) {
     *state = s;
   }
   save(s->bytes);
+  data_->state_saved();
   log_.event("%s: state saved at t = %.17g (%llu bytes)", fn, time_,
              static_cast<unsigned long long>(s->bytes.size()));
   return Status::OK;
@@ -285,7 +295,7 @@ Status Instance::set_fmu_state(void* state) {
     log_.error("%s: not an FMU state of this FMU", fn);
     return Status::Error;
   }
-  if (!load(s->bytes, fn)) return Status::Error;
+  if (!load(s->bytes.data(), s->bytes.size(), fn, true)) return Status::Error;
   log_.event("%s: state restored at t = %.17g (%s)", fn, time_, mode_name(mode_));
   return Status::OK;
 }

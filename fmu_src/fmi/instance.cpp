@@ -192,6 +192,7 @@ Status Instance::exit_initialization_mode() {
   const Status s = data_->exit_initialization(ctx);
   valid_groups_ = 0;
   if (succeeded(s)) {
+    reserve_state_buffers();
     mode_ = interface_ == Interface::CoSimulation ? kStepMode : kEventMode;
     time_ = last_successful_time_ = start_time_;
     elapsed_ = 0.0;

@@ -194,7 +194,12 @@ class Instance {
   /// The times of a state being loaded: finite and in order (else logged).
   bool times_consistent(double start, bool stop_defined, double stop, double time, double last_successful,
                         double elapsed, const char* function);
-  bool load(const std::vector<unsigned char>& bytes, const char* function);
+  /// Restores a serialised state; keep_backup: on failure return to the
+  /// current state (saved into load_backup_ first).
+  bool load(const unsigned char* bytes, std::size_t size, const char* function, bool keep_backup);
+  /// The buffers save() and load() reuse so that SetFMUState allocates
+  /// nothing once initialised (sized at instantiation and initialisation).
+  void reserve_state_buffers();
 
   std::uint64_t tag_;  // identifies a live Instance of this version behind a handle
   const ModelDefinition& def_;
@@ -222,6 +227,9 @@ class Instance {
   std::vector<const Variable*> d_unknowns_, d_knowns_, d_asked_;
   std::vector<std::size_t> d_rows_;
   std::vector<double> d_jacobian_, d_asked_jacobian_;
+  // load()'s buffers (reserve_state_buffers).
+  std::vector<double> load_values_;
+  std::vector<unsigned char> load_backup_;
 
  public:
   /// Forgets a state freed through any instance (FreeFMUState).

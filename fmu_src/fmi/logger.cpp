@@ -33,22 +33,25 @@ void Logger::select(const bool (&named)[kLogCategoryCount], bool on) {
 
 void Logger::vlog(Status status, LogCategory c, const char* fmt, va_list args) {
   if (!enabled(c)) return;
-  char small[512];
+  // On the stack when it fits (every message of this FMU does): logging an
+  // event inside a step allocates nothing.
+  char small[1024];
   va_list copy;
   va_copy(copy, args);
   const int n = std::vsnprintf(small, sizeof small, fmt, copy);
   va_end(copy);
-  std::string text;
+  const char* name = name_.c_str();
+  const char* category = kLogCategoryNames[static_cast<unsigned>(c)];
   if (n < 0) {
-    text = fmt;
+    emit_(callback_, env_, name, status, category, fmt);
   } else if (static_cast<std::size_t>(n) < sizeof small) {
-    text.assign(small, static_cast<std::size_t>(n));
+    emit_(callback_, env_, name, status, category, small);
   } else {
-    text.resize(static_cast<std::size_t>(n) + 1);
+    std::string text(static_cast<std::size_t>(n) + 1, '\0');
     std::vsnprintf(&text[0], text.size(), fmt, args);
     text.resize(static_cast<std::size_t>(n));
+    emit_(callback_, env_, name, status, category, text.c_str());
   }
-  emit_(callback_, env_, name_.c_str(), status, kLogCategoryNames[static_cast<unsigned>(c)], text.c_str());
 }
 
 #define PKM_FMI_LOG_AS(method, status, category) \

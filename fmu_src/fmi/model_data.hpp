@@ -54,6 +54,11 @@ class ModelData {
   /// From t to t + h (t is the current time). On return t_reached is the last
   /// time the state is valid for: t + h for OK, the last good point for Discard.
   virtual Status do_step(Context& ctx, double t, double h, double& t_reached) = 0;
+  /// GetFMUState: the state was saved here. A model whose integrator carries
+  /// history across steps that the saved state does not hold restarts it at
+  /// the next step, as a run restored from the state will: both continue
+  /// bit for bit alike.
+  virtual void state_saved() {}
   /// Before do_step, nothing changed yet: Error (reason logged) if a step of
   /// h would exceed the model's work budget. The instance stays usable.
   virtual Status check_step(Context& ctx, double h) const { (void)ctx, (void)h; return Status::OK; }

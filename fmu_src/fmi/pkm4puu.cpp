@@ -9,11 +9,23 @@
 //
 // Time stepping: every fmi2DoStep integrates with inputs
 // u(t) = u + du (t - t_step_start) (du from fmi2SetRealInputDerivatives,
-// reset to 0 whenever u is set) and restarts CVODE at the step start
-// (Plant::advance with continuous = false): the result of a step depends
-// only on the state and inputs at its start, so a restored FMU state
-// continues bit-identically. After a step the inputs hold their
-// extrapolated values u + du h, the inputs at the new time.
+// reset to 0 whenever u is set). After a step the inputs hold their
+// extrapolated values u + du h, the inputs at the new time. CVODE continues
+// its history across the communication point (Plant::advance with
+// continuous = true: no restart) when the inputs did not jump there
+// (inputs_continue): every input at the step start equals its value at the
+// end of the previous step within kInputJump (relative: rounding) -- inputs
+// held constant, or a ramp whose values and slopes the master sets each
+// step (a change of slope is a kink, which CVODE's error test resolves).
+// A value that differs is a jump, and CVODE restarts at the step start:
+// integrating across a jump from the old history costs accuracy (pkm_tick_bench:
+// 1e-6 m after 1 s with midpoint-held forces, or with value and slope sampled
+// from a curved signal, whose lines miss each other by u'' h^2 / 2, against
+// 6e-9 m restarted).
+// FMU states: CVODE's history is not part of a saved state. The next step
+// after a GetFMUState restarts, as the first step after a SetFMUState does
+// (PlantData::state_saved), so a restored run continues bit for bit like
+// the original one (RK4 keeps no history: nothing changes for it).
 //
 // Outputs are computed lazily by group (the state's copies, the legs, the
 // dynamics, the machine, the health measures: kGroup* below), each on the
@@ -54,6 +66,13 @@ constexpr int kInputs = 12;  // F[1..4], Fe[1..3], Me_z, tau[1..4]
 // weight at the default initial pose, the start value of F[1..4] (so that a
 // plant nothing drives stays where it is).
 constexpr double kHoldingForce = 2.655616050;
+// An input jumps at a communication point when it differs from its value at
+// the end of the previous step by more than this, relative to 1 + |value|
+// (in N, N*m): far above the rounding of a master that evaluates a ramp
+// a + b t where the FMU extrapolated u + b h (a few 1e-16), far below any
+// jump that matters (a jump of 1e-12 N moves the platform by ~1e-16 m in a
+// millisecond).
+constexpr double kInputJump = 1e-12;
 
 // The output groups (Variable::group): a get computes only the groups it
 // reads, each once until the state, time or inputs change.
@@ -94,10 +113,20 @@ struct PlantData final : MechanismData {
   unsigned stops_beyond = 0;
   // Co-Simulation: end-stop events located so far (logged per step).
   long contact_events = 0;
+  // Co-Simulation: the inputs at the end of the last step and whether CVODE
+  // may continue from there (no restart, failure or saved state since).
+  double u_end[kInputs] = {};
+  bool may_continue = false;
   // The simulated machine (nullptr before initialisation).
   std::unique_ptr<pkm::Plant> plant;
 
-  void reset() override { plant.reset(); }
+  void reset() override {
+    plant.reset();
+    may_continue = false;
+  }
+  void state_saved() override { may_continue = false; }
+  /// Whether every input continues its value at the end of the last step (kInputJump).
+  bool inputs_continue() const;
   Status exit_initialization(Context& ctx) override;
   Status do_step(Context& ctx, double t, double h, double& t_reached) override;
   Status check_step(Context& ctx, double h) const override;
@@ -118,8 +147,12 @@ struct PlantData final : MechanismData {
 
   /// The absolute time of the plant (its own time is the time since startTime), for messages.
   double absolute_time(const Context& ctx) const { return ctx.start_time + plant->time(); }
+  /// The model and solver settings of the current parameters (Error, logged, if unusable).
+  Status configuration(Context& ctx, const char* function, pkm::Model& model, pkm::SolverSettings& s) const;
   /// A Plant for the current parameters (not yet initialised).
   Status make_plant(Context& ctx, const char* function, std::unique_ptr<pkm::Plant>& out) const;
+  /// Whether the plant exists and was built from these parameters and settings.
+  bool built_from(const pkm::Model& model, const pkm::SolverSettings& s) const;
   /// make_plant, then the consistent initial state from x0..phi0, dx0..dphi0.
   Status build(Context& ctx, const char* function);
   /// The plant, built from the current parameters in initialisation mode.
@@ -133,6 +166,26 @@ struct PlantData final : MechanismData {
 
 Status PlantData::make_plant(Context& ctx, const char* function, std::unique_ptr<pkm::Plant>& out) const {
   pkm::Model model;
+  pkm::SolverSettings s;
+  const Status st = configuration(ctx, function, model, s);
+  if (st != Status::OK) return st;
+  auto plant_new = std::make_unique<pkm::Plant>(model);
+  std::string why;
+  if (plant_new->set_solver(s, &why) != pkm::Status::Ok) {
+    ctx.log.error("%s: parameter %s", function, why.c_str());
+    return Status::Error;
+  }
+  out = std::move(plant_new);
+  return Status::OK;
+}
+
+bool PlantData::built_from(const pkm::Model& model, const pkm::SolverSettings& s) const {
+  static_assert(sizeof(pkm::Params) % sizeof(double) == 0, "Params holds doubles only: no padding to compare");
+  return plant && std::memcmp(&plant->model().p, &model.p, sizeof(pkm::Params)) == 0 && plant->solver() == s;
+}
+
+Status PlantData::configuration(Context& ctx, const char* function, pkm::Model& model,
+                                pkm::SolverSettings& s) const {
   std::string why;
   if (pkm::make_model(params, model, &why) != pkm::Status::Ok) {
     ctx.log.error("%s: %s", function, why.c_str());
@@ -152,7 +205,7 @@ Status PlantData::make_plant(Context& ctx, const char* function, std::unique_ptr
                   function, static_cast<int>(formulation));
     return Status::Error;
   }
-  pkm::SolverSettings s;
+  s = pkm::SolverSettings{};
   s.solver = static_cast<pkm::Solver>(solver);
   s.rk4_step = rk4_step;
   s.rtol = rtol;
@@ -161,12 +214,11 @@ Status PlantData::make_plant(Context& ctx, const char* function, std::unique_ptr
   s.formulation = static_cast<pkm::Formulation>(formulation);
   s.max_jacobian_condition = limits.max_jacobian_condition;
   s.min_leg_measure = limits.min_leg_measure;
-  auto plant_new = std::make_unique<pkm::Plant>(model);
-  if (plant_new->set_solver(s, &why) != pkm::Status::Ok) {
-    ctx.log.error("%s: parameter %s", function, why.c_str());
+  const std::string invalid = pkm::validate(s);
+  if (!invalid.empty()) {
+    ctx.log.error("%s: parameter %s", function, invalid.c_str());
     return Status::Error;
   }
-  out = std::move(plant_new);
   return Status::OK;
 }
 
@@ -180,6 +232,7 @@ Status PlantData::build(Context& ctx, const char* function) {
   if (s != pkm::Status::Ok) {
     const char* what = s == pkm::Status::Unreachable ? "cannot be assembled elbow-down"
                        : s == pkm::Status::Singular  ? "lies beyond the singularity limits"
+                       : s == pkm::Status::SolverFailure ? "cannot be integrated (the solver could not be set up)"
                                                      : "cannot be used";
     ctx.log.error("%s: the initial state x0 = %.9g m, y0 = %.9g m, z0 = %.9g m, phi0 = %.9g rad (velocity dx0 = %g, "
                   "dy0 = %g, dz0 = %g m/s, dphi0 = %g rad/s) %s: %s: %s",
@@ -190,6 +243,7 @@ Status PlantData::build(Context& ctx, const char* function) {
   plant = std::move(p);
   contact_events = plant->contact_events();
   stops_beyond = beyond_stops();
+  may_continue = false;
   return Status::OK;
 }
 
@@ -256,12 +310,15 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
     ctx.log.error("DoStep: the inputs extrapolated with their derivatives to t = %.17g are not finite", t_end);
     return Status::Error;
   }
-  const pkm::Status s = plant->advance(t_end, in.signal(), /*continuous=*/false);
+  const bool continuous = may_continue && inputs_continue();
+  const pkm::Status s = plant->advance(t_end, in.signal(), continuous);
   t_reached = plant->time();
   // The inputs now refer to the time reached.
   if (t_reached != t_start)
     for (int k = 0; k < kInputs; ++k)
       if (du[k] != 0.0) u[k] += du[k] * (t_reached - t_start);
+  may_continue = s == pkm::Status::Ok;
+  std::memcpy(u_end, u, sizeof u_end);
   if (plant->contact_events() != contact_events) {
     contact_events = plant->contact_events();
     // Also with logEvents off: the record of the stops passed stays current.
@@ -289,6 +346,12 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
                     pkm::status_name(s), plant->last_error().empty() ? "" : ": ", plant->last_error().c_str());
       return Status::Error;
   }
+}
+
+bool PlantData::inputs_continue() const {
+  for (int k = 0; k < kInputs; ++k)
+    if (!(std::abs(u[k] - u_end[k]) <= kInputJump * (1.0 + std::abs(u_end[k])))) return false;
+  return true;
 }
 
 Status PlantData::check_step(Context& ctx, double h) const {
@@ -569,8 +632,10 @@ void PlantData::save(StateWriter& w) const {
 }
 
 bool PlantData::load(StateReader& r, Context& ctx) {
-  plant.reset();
-  if (r.u8() == 0) return r.ok();
+  if (r.u8() == 0) {
+    plant.reset();
+    return r.ok();
+  }
   const double t = r.f64();
   pkm::Vec8 y;
   pkm::Vec4 ref;
@@ -583,17 +648,25 @@ bool PlantData::load(StateReader& r, Context& ctx) {
     ctx.log.error("SetFMUState: malformed FMU state (end-stop record %#x names no stop)", beyond);
     return false;
   }
-  std::unique_ptr<pkm::Plant> p;
-  if (make_plant(ctx, "SetFMUState", p) != Status::OK) return false;
-  const pkm::Status s = p->restore(t, y, ref, e);
+  // The plant, with its solver's objects, is kept when the restored
+  // parameters are those it was built with (restore() restarts its
+  // integrator): a restore allocates nothing. Otherwise a new one.
+  pkm::Model model;
+  pkm::SolverSettings settings;
+  if (configuration(ctx, "SetFMUState", model, settings) != Status::OK) return false;
+  std::unique_ptr<pkm::Plant> fresh;
+  if (!built_from(model, settings) && make_plant(ctx, "SetFMUState", fresh) != Status::OK) return false;
+  pkm::Plant& p = fresh ? *fresh : *plant;
+  const pkm::Status s = p.restore(t, y, ref, e);
   if (s != pkm::Status::Ok) {
     ctx.log.error("SetFMUState: the saved state at t = %.17g cannot be restored: %s%s%s", t, pkm::status_name(s),
-                  p->last_error().empty() ? "" : ": ", p->last_error().c_str());
+                  p.last_error().empty() ? "" : ": ", p.last_error().c_str());
     return false;
   }
-  plant = std::move(p);
-  contact_events = plant->contact_events();  // counted per Plant: a restored one starts anew
+  if (fresh) plant = std::move(fresh);
+  contact_events = plant->contact_events();  // the count continues from here
   stops_beyond = beyond;
+  may_continue = false;  // the integrator restarts here, as the original run does after saving
   return true;
 }
 
