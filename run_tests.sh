@@ -2,23 +2,25 @@
 # The test command: builds everything, runs the C++ tests (ctest), then the
 # Python checks (pytest) when python_checks/ holds any test_*.py file.
 #
-# The short fuzz run (ctest's hardening_fuzz_short: its own clang sanitizer
-# build, then 45 s of fuzzing) is the longest chain, so it starts as soon as
-# build/ is configured and runs beside everything else at a lower priority:
-# it takes the cores the main build leaves idle, then runs beside the tests.
+# The sanitizer tests (ctest label "sanitized": their own clang build with
+# AddressSanitizer and UndefinedBehaviorSanitizer, then 45 s of fuzzing and
+# the fmpy checks against the instrumented FMUs) are the longest chain, so
+# they start as soon as build/ is configured and run beside everything else
+# at a lower priority: they take the cores the main build leaves idle, then
+# run beside the tests.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")"
 ./scripts/build.sh --configure-only
-fuzz='^hardening_fuzz_short$'
-fuzz_log=build/hardening_fuzz_short.log
+sanitized_log=build/sanitized_tests.log
 # In a process group of its own (setsid), so that a failure before the end
 # stops the whole run (ctest, the script, the compilers) and leaves nothing behind.
-setsid nice -n 10 ctest --test-dir build --output-on-failure --no-tests=error -R "$fuzz" >"$fuzz_log" 2>&1 &
-fuzz_pid=$!
-trap 'kill -- -"$fuzz_pid" 2>/dev/null || true' EXIT
+setsid nice -n 10 ctest --test-dir build --output-on-failure --no-tests=error -j2 -L sanitized \
+  >"$sanitized_log" 2>&1 &
+sanitized_pid=$!
+trap 'kill -- -"$sanitized_pid" 2>/dev/null || true' EXIT
 ./scripts/build.sh
 # --no-tests=error: a build that registered no test must fail, not pass silently.
-ctest --test-dir build --output-on-failure -j2 --no-tests=error -E "$fuzz"
+ctest --test-dir build --output-on-failure -j2 --no-tests=error -LE sanitized
 status=0
 # Only call pytest when there are tests, so its exit code 5 (no tests) cannot occur.
 if compgen -G "python_checks/test_*.py" >/dev/null; then
@@ -26,12 +28,13 @@ if compgen -G "python_checks/test_*.py" >/dev/null; then
 else
   echo "run_tests: no python_checks/test_*.py, pytest skipped" >&2
 fi
-echo "run_tests: waiting for the short fuzz run (log: $fuzz_log)" >&2
-if wait "$fuzz_pid"; then
-  echo "run_tests: hardening_fuzz_short passed (log: $fuzz_log)"
+echo "run_tests: waiting for the sanitizer tests (log: $sanitized_log)" >&2
+if wait "$sanitized_pid"; then
+  grep -E "tests passed|Passed|Skipped|Not Run" "$sanitized_log" || true
+  echo "run_tests: the sanitizer tests passed (log: $sanitized_log)"
 else
-  cat "$fuzz_log"
-  echo "run_tests: hardening_fuzz_short FAILED" >&2
+  cat "$sanitized_log"
+  echo "run_tests: the sanitizer tests FAILED" >&2
   status=1
 fi
 trap - EXIT

@@ -133,8 +133,14 @@ function(pkm_add_fmu id)
     LINK_DEPENDS "${F_VERSION_SCRIPT}")
   if(CMAKE_SYSTEM_NAME STREQUAL "Linux")
     # Portable binary: nothing but libc/libm/ld-linux needed at run time.
+    # Except under clang's sanitizers (PKM_FUZZ): the binary then takes the
+    # sanitizer runtime from the process (LD_PRELOAD, scripts/check_sanitized_fmpy.sh).
+    set(_no_undefined "LINKER:--no-undefined")
+    if(PKM_FUZZ)
+      set(_no_undefined)
+    endif()
     target_link_options(${id} PRIVATE
-      "LINKER:--version-script=${F_VERSION_SCRIPT}" "LINKER:--no-undefined" "LINKER:--exclude-libs,ALL"
+      "LINKER:--version-script=${F_VERSION_SCRIPT}" ${_no_undefined} "LINKER:--exclude-libs,ALL"
       -static-libstdc++ -static-libgcc)
   elseif(MINGW)
     target_link_options(${id} PRIVATE -static)

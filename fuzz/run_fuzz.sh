@@ -4,11 +4,15 @@
 # -DPKM_FUZZ=ON; the default gcc build is untouched) and runs it.
 #
 #   fuzz/run_fuzz.sh [--build-dir DIR] [--seconds N | --runs N] [--jobs N] [-- libFuzzer options...]
+#   fuzz/run_fuzz.sh [--build-dir DIR] --build-only
 #   fuzz/run_fuzz.sh [--build-dir DIR] --coverage-report
 #
 # Defaults: --build-dir build-fuzz, --seconds 60, one job. The corpus grows in
 # DIR/corpus (seeded from fuzz/seed_corpus.tar.gz); findings (crash-*, leak-*,
 # timeout-*, oom-*) are written to DIR/findings/.
+# --build-only builds the harness and, from the same instrumented objects, the
+# FMU archives (DIR/<id>.fmu, DIR/fmi3/<id>.fmu) that
+# scripts/check_sanitized_fmpy.sh drives through fmpy; no fuzzing.
 # --coverage-report builds a source-coverage variant in DIR-cov, replays the
 # seed corpus and DIR/corpus through it and prints llvm-cov's region, line
 # and branch coverage of fmu_src/ (no fuzzing).
@@ -23,6 +27,7 @@ seconds=60
 runs=""
 jobs=1
 coverage=0
+build_only=0
 extra=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -31,6 +36,7 @@ while [ $# -gt 0 ]; do
     --runs) runs="$2"; shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
     --coverage-report) coverage=1; shift ;;
+    --build-only) build_only=1; shift ;;
     --) shift; extra=("$@"); break ;;
     *) echo "run_fuzz: unknown argument $1" >&2; exit 2 ;;
   esac
@@ -60,7 +66,7 @@ if [ "$coverage" -eq 1 ]; then
   if [ -z "$profdata" ] || [ -z "$llvmcov" ]; then echo "run_fuzz: llvm-profdata/llvm-cov not found" >&2; exit 77; fi
   if [ ! -f "$cov/CMakeCache.txt" ]; then
     CC="$cc" CXX="$cxx" cmake -S "$root" -B "$cov" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPKM_FUZZ=ON \
-      -DPKM_BUILD_TESTS=OFF -DPKM_BUILD_BENCHMARKS=OFF -DPKM_LTO=OFF "${fmi_headers[@]}" \
+      -DPKM_BUILD_TESTS=OFF -DPKM_BUILD_BENCHMARKS=OFF -DPKM_LTO=OFF -DPKM_PLATFORMS=OFF "${fmi_headers[@]}" \
       -DCMAKE_CXX_FLAGS="-fprofile-instr-generate -fcoverage-mapping" \
       -DCMAKE_EXE_LINKER_FLAGS="-fprofile-instr-generate" >"$cov/configure.log" 2>&1 || {
       cat "$cov/configure.log" >&2; exit 1; }
@@ -86,11 +92,15 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
   CC="$cc" CXX="$cxx" cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPKM_FUZZ=ON \
     -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
-    -DPKM_BUILD_TESTS=OFF -DPKM_BUILD_BENCHMARKS=OFF -DPKM_LTO=OFF "${fmi_headers[@]}" >"$build/configure.log" 2>&1 || {
-    cat "$build/configure.log" >&2; exit 1; }
+    -DPKM_BUILD_TESTS=OFF -DPKM_BUILD_BENCHMARKS=OFF -DPKM_LTO=OFF -DPKM_PLATFORMS=OFF "${fmi_headers[@]}" \
+    >"$build/configure.log" 2>&1 || { cat "$build/configure.log" >&2; exit 1; }
 fi
-cmake --build "$build" --target pkm_fmi_fuzzer -j"$(nproc)" >"$build/build.log" 2>&1 || {
+cmake --build "$build" --target pkm_fmi_fuzzer pkm_fmus -j"$(nproc)" >"$build/build.log" 2>&1 || {
   tail -50 "$build/build.log" >&2; exit 1; }
+if [ "$build_only" -eq 1 ]; then
+  echo "run_fuzz: built $build/fuzz/pkm_fmi_fuzzer and the instrumented FMUs in $build" >&2
+  exit 0
+fi
 
 mkdir -p "$build/corpus" "$build/findings"
 # Seeds: fuzz/seed_corpus.tar.gz, the corpus of a 30-minute run merged by

@@ -113,7 +113,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
   }
 }
 
-void fmi2FreeInstance(fmi2Component c) { delete Instance::from(c, definition(), 2); }
+void fmi2FreeInstance(fmi2Component c) { Instance::free(c, definition(), 2, "fmi2FreeInstance"); }
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {

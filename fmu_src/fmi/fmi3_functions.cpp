@@ -124,7 +124,7 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3Stri
   return nullptr;
 }
 
-void fmi3FreeInstance(fmi3Instance c) { delete Instance::from(c, definition(), 3); }
+void fmi3FreeInstance(fmi3Instance c) { Instance::free(c, definition(), 3, "fmi3FreeInstance"); }
 
 fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean toleranceDefined, fmi3Float64 tolerance,
                                        fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {

@@ -75,6 +75,18 @@ Status Instance::internal_error(const char* function, const char* what) {
   return Status::Error;
 }
 
+void Instance::free(void* handle, const ModelDefinition& def, int fmi_version, const char* function) {
+  Instance* inst = from(handle, def, fmi_version);
+  if (!inst) return;
+  if (inst->busy_.exchange(true, std::memory_order_acquire)) {
+    inst->log_.error("%s: called while another call on this instance is running (from another thread?): the "
+                     "instance is not freed",
+                     function);
+    return;
+  }
+  delete inst;
+}
+
 Status Instance::concurrent_call(const char* function) {
   log_.error("%s: called while another call on this instance is running (from another thread?): an instance must "
              "be used by one thread at a time; the call has no effect",

@@ -157,6 +157,11 @@ class Instance {
   };
   Status concurrent_call(const char* function);
 
+  /// fmi2FreeInstance / fmi3FreeInstance: deletes the instance behind
+  /// `handle`, unless a call on it is running on another thread; then it logs
+  /// the misuse and leaves the instance alive (a leak, not a use after free).
+  static void free(void* handle, const ModelDefinition& def, int fmi_version, const char* function);
+
   const ModelDefinition& definition() const { return def_; }
   std::uint32_t mode() const { return mode_; }
   Interface interface() const { return interface_; }
