@@ -36,7 +36,6 @@ usage: .venv/bin/python bench/derivatives_bench.py [--build DIR] [--rounds R] [-
 """
 import argparse
 import ctypes as ct
-import os
 import platform
 import subprocess
 import sys
@@ -47,22 +46,11 @@ import numpy as np
 import pinocchio as pin
 
 from pkm4puu import capi, motions
+from pkm4puu.cli import machine_description
 from pkm4puu.fmu import REPO
 from pkm4puu.references.pinocchio_derivatives import PinocchioReducedDerivatives
 
 T_STATE = 1.0  # s into the auto-test
-
-
-def machine():
-    cpu = "unknown"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{platform.system()} {platform.machine()}, {cpu}, {os.cpu_count()} cores"
 
 
 def per_call(fn, calls):
@@ -188,7 +176,7 @@ def main(argv=None):
     c1b = [] if args.no_pkm_bench else pkm_bench_1b(build, log)
     dA, dB, dydot = cases.agreement()
 
-    print(f"{prog}: {machine()}; python {platform.python_version()}, pinocchio {pin.__version__}")
+    print(f"{prog}: {machine_description()}; python {platform.python_version()}, pinocchio {pin.__version__}")
     print(f"at the auto-test's state at t = {T_STATE:g} s with its inverse-dynamics forces; {args.rounds} interleaved "
           f"rounds of {args.calls} calls per case: median of the rounds (best round)")
     print()

@@ -37,7 +37,6 @@ usage: .venv/bin/python bench/engines_bench.py [--build DIR] [--rounds R] [--bat
 import argparse
 import csv
 import math
-import os
 import platform
 import subprocess
 import sys
@@ -52,6 +51,7 @@ import mujoco.rollout
 import pinocchio as pin
 
 from pkm4puu import motions, spec
+from pkm4puu.cli import machine_description
 from pkm4puu.fmu import REPO
 from pkm4puu.references import mujoco_model
 from pkm4puu.references.engine_comparison import deviation, pinocchio_reference
@@ -237,18 +237,6 @@ def derivatives_comparison(build, median):
 
 
 # --- the table -----------------------------------------------------------------------------------------------------
-def machine():
-    cpu = "unknown"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{platform.system()} {platform.machine()}, {cpu}, {os.cpu_count()} cores"
-
-
 def deviation_at(run, ref):
     """deviation() at the run's own output times (one-call cases have only a few)."""
     idx = np.rint(np.asarray(run["t"]) / H).astype(int)
@@ -337,7 +325,7 @@ def main(argv=None):
 
     print(c_stdout.rstrip())
     print()
-    print(f"engines_bench: {machine()}; python {platform.python_version()}, mujoco {mujoco.__version__}, "
+    print(f"engines_bench: {machine_description()}; python {platform.python_version()}, mujoco {mujoco.__version__}, "
           f"pinocchio {pin.__version__}")
     print(f"one simulated second of the comparison test at a 1 ms step; {args.rounds} interleaved rounds of "
           f"{args.batches} batches (Pinocchio: 1 per round): median of the rounds' medians, and the best batch; "

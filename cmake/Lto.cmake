@@ -1,10 +1,10 @@
 # Link-time optimisation where the speed ships: the FMU binaries, libpkm,
 # the auto-test app and the benchmarks. The libraries they share with the
-# tests (pkm_core, pkm_capi, pkm_fmi_models) are compiled to fat LTO objects
-# (the intermediate code and ordinary machine code), so that the tests and
-# the build tools link the machine code without a link-time optimisation
-# pass of their own: about 20 such links of 10-30 s each were a third of the
-# test command's build. The tests that check the shipped binaries load the
+# tests (pkm_core, pkm_capi, pkm_fmi_models, pkm_autotest_lib) are compiled
+# to fat LTO objects (the intermediate code and ordinary machine code), so
+# that the tests and the build tools link the machine code without a
+# link-time optimisation pass of their own: about 20 such links of 10-30 s
+# each were a third of the test command's build. The tests that check the shipped binaries load the
 # FMUs themselves (dlopen), which are optimised at link time as before.
 #
 #   PKM_LTO  (option, ON) in Release builds; OFF: no LTO anywhere.

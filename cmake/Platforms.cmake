@@ -61,7 +61,8 @@ foreach(_t IN ITEMS win64 aarch64)
                -DPKM_CROSS_PREFIX=${_prefix} -DFMI2_HEADERS_DIR=${FMI2_HEADERS_DIR}
                -DPKM_FMU_PYTHON=${PKM_FMU_PYTHON} -DPKM_TRACE_REFERENCE=${PKM_TRACE_DIR}
     BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR> -j2
-                  --target PKM4PUU PKM4PUU_Inverse test_fmi_lifecycle test_fmi_autotest_chain
+                  --target PKM4PUU PKM4PUU_Inverse fmi_state_machine fmi_variables fmi_fmu_state fmi_stepping
+                          fmi_logging fmi_autotest_chain
     BUILD_ALWAYS ON
     BUILD_BYPRODUCTS ${_products}
     INSTALL_COMMAND ""
@@ -70,7 +71,7 @@ foreach(_t IN ITEMS win64 aarch64)
   set(PKM_${_t}_BINARIES ${_products})
   if(PKM_BUILD_TESTS)
     # The sub-build's FMI tests under the emulator; the auto-test compares
-    # with the linux64 run's trace (test_fmi_autotest_chain writes it).
+    # with the linux64 run's trace (fmi_autotest_chain writes it).
     add_test(NAME platform_${_t}_fmi_tests
              COMMAND ${CMAKE_CTEST_COMMAND} --test-dir ${_bin} --output-on-failure --no-tests=error)
     set_tests_properties(platform_${_t}_fmi_tests PROPERTIES FIXTURES_REQUIRED linux64_traces TIMEOUT 900)

@@ -46,7 +46,8 @@ from dataclasses import dataclass
 import matplotlib
 import numpy as np
 
-from pkm4puu.cli import add_common_args, find_fmus, Log
+from pkm4puu.cli import add_common_args, start, write_outputs
+from pkm4puu.plots import save_figure
 from pkm4puu.drawing import RUN_COLUMNS, write_run_csv
 from pkm4puu.fmu import Fmu
 from pkm4puu.interface import ACC, DRHO, F, POSE, RHO, RK4, START_P0, VEL
@@ -296,9 +297,7 @@ def plot(runs, ratio, params, path):
     for ax in axes:
         ax.grid(True, alpha=0.3)
         ax.axvline(T_MOVE, color="grey", lw=0.8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
 
 
 def main(argv=None):
@@ -311,9 +310,7 @@ def main(argv=None):
     ap.add_argument("--viscous", type=float, default=VISCOUS,
                     help="viscous friction of each joint (N s/m, default %(default)s)")
     ap.add_argument("--t-end", type=float, default=T_END, help="run length (s, default %(default)s)")
-    args = ap.parse_args(argv)
-    log = Log("closed_loop_control")
-    fmus = find_fmus(args.build, log)
+    args, log, fmus = start(ap, argv)
     if fmus is None:
         return 1
     if min(args.payload, args.coulomb, args.viscous) < 0 or args.t_end <= 0:
@@ -326,13 +323,9 @@ def main(argv=None):
         log(f"error: {exc}")
         return 1
     print(summary(runs, ratio, params), flush=True)
-    args.out.mkdir(parents=True, exist_ok=True)
-    paths = [args.out / "closed_loop.csv", args.out / "closed_loop_tracking.png", args.out / "closed_loop_run.csv"]
-    write_csv(runs, paths[0])
-    plot(runs, ratio, params, paths[1])
-    write_run_csv(paths[2], runs["ff"].t, runs["ff"].run)
-    for p in paths:
-        log(f"wrote {p}")
+    write_outputs(args.out, log, {"closed_loop.csv": lambda p: write_csv(runs, p),
+                                  "closed_loop_tracking.png": lambda p: plot(runs, ratio, params, p),
+                                  "closed_loop_run.csv": lambda p: write_run_csv(p, runs["ff"].t, runs["ff"].run)})
     if ratio < MIN_RATIO:
         log(f"note: friction compensation cut the RMS error by {ratio:.1f}, less than the {MIN_RATIO:g} the test "
             "requires with the default machine")

@@ -48,7 +48,8 @@ from pathlib import Path
 import numpy as np
 
 import pkm4puu
-from pkm4puu.cli import add_common_args, find_fmus, Log
+from pkm4puu.cli import add_common_args, start, write_outputs
+from pkm4puu.plots import save_figure
 from pkm4puu.fmu import Fmu
 from pkm4puu.interface import ACC, F, POSE, RK4, START_P0, VEL
 from pkm4puu.motions import motion
@@ -333,9 +334,7 @@ def plot(results, masses, durations, path):
     fig.suptitle(f"Auto-test sweep on Dask: {len(masses)} payloads x {len(durations)} durations = {len(results)} "
                  "runs\n(inverse FMU, told the payload -> forces -> plant FMU with the payload, open loop, RK4 "
                  "1 ms)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    save_figure(fig, path, dpi=100)
 
 
 def _edges(c):
@@ -377,9 +376,7 @@ def main(argv=None):
     ap.add_argument("--mass-max", type=float, default=MASS_MAX, help="largest payload (kg, default %(default)s)")
     ap.add_argument("--t-min", type=float, default=T_MIN, help="shortest duration (s, default %(default)s)")
     ap.add_argument("--t-max", type=float, default=T_MAX, help="longest duration (s, default %(default)s)")
-    args = ap.parse_args(argv)
-    log = Log("dask_sweep")
-    fmus = find_fmus(args.build, log)
+    args, log, fmus = start(ap, argv)
     if fmus is None:
         return 1
     if args.n_mass < 1 or args.n_duration < 1 or args.mass_max < 0 or not 0 < args.t_min <= args.t_max:
@@ -416,12 +413,8 @@ def main(argv=None):
         log(f"error: {type(exc).__name__}: {exc}")
         return 1
     print(summary(results, wall, where), flush=True)
-    args.out.mkdir(parents=True, exist_ok=True)
-    paths = [args.out / "sweep.csv", args.out / "sweep_maps.png"]
-    write_csv(results, paths[0])
-    plot(results, masses, durations, paths[1])
-    for p in paths:
-        log(f"wrote {p}")
+    write_outputs(args.out, log, {"sweep.csv": lambda p: write_csv(results, p),
+                                  "sweep_maps.png": lambda p: plot(results, masses, durations, p)})
     return 0
 
 

@@ -33,7 +33,8 @@ from dataclasses import dataclass
 import matplotlib
 import numpy as np
 
-from pkm4puu.cli import add_common_args, find_fmus, Log
+from pkm4puu.cli import add_common_args, start, write_outputs
+from pkm4puu.plots import save_figure
 from pkm4puu.fmu import Fmu
 from pkm4puu.interface import ACC, arr, DRHO, F, POSE, RHO, VEL
 from pkm4puu.motions import motion
@@ -199,9 +200,7 @@ def plot(profiles, path, motor=MOTOR, machine=None):
                   f"{1e3 * machine['payload_com[2]']:g}) mm; at rest each motor holds the weight", fontsize=8.5)
     ax2.legend(fontsize=7)
     ax2.grid(True, alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
 
 
 def main(argv=None):
@@ -209,9 +208,7 @@ def main(argv=None):
     add_common_args(ap)
     ap.add_argument("--durations", type=float, nargs="+", default=list(DURATIONS),
                     help="move times T of the auto-test's path (s, default %(default)s)")
-    args = ap.parse_args(argv)
-    log = Log("drive_sizing")
-    fmus = find_fmus(args.build, log)
+    args, log, fmus = start(ap, argv)
     if fmus is None:
         return 1
     if min(args.durations) <= 0:
@@ -226,12 +223,8 @@ def main(argv=None):
         log(f"error: {exc}")
         return 1
     print(table(profiles), flush=True)
-    args.out.mkdir(parents=True, exist_ok=True)
-    paths = [args.out / "drive_sizing.csv", args.out / "drive_sizing.png"]
-    write_csv(profiles, paths[0])
-    plot(profiles, paths[1])
-    for p in paths:
-        log(f"wrote {p}")
+    write_outputs(args.out, log, {"drive_sizing.csv": lambda p: write_csv(profiles, p),
+                                  "drive_sizing.png": lambda p: plot(profiles, p)})
     return 0
 
 

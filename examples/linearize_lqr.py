@@ -52,7 +52,8 @@ import matplotlib
 import numpy as np
 import scipy.linalg as sla
 
-from pkm4puu.cli import add_common_args, find_fmus, Log
+from pkm4puu.cli import add_common_args, start, write_outputs
+from pkm4puu.plots import save_figure
 from pkm4puu.drawing import RUN_COLUMNS
 from pkm4puu.fmu import Fmu
 from pkm4puu.interface import ACC, DRHO, F, POSE, RHO, RK4, VEL, start_pose
@@ -418,9 +419,7 @@ def plot(s, path):
     ax2.legend(fontsize=7, loc="upper right")
     for ax in (ax0, ax1, ax2):
         ax.grid(True, alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
 
 
 def main(argv=None):
@@ -429,9 +428,7 @@ def main(argv=None):
     ap.add_argument("--t-end", type=float, default=T_END, help="closed-loop run length (s, default %(default)s)")
     ap.add_argument("--offset", type=float, default=1e3 * OFFSET,
                     help="initial offset from the path (mm, default %(default)s)")
-    args = ap.parse_args(argv)
-    log = Log("linearize_lqr")
-    fmus = find_fmus(args.build, log)
+    args, log, fmus = start(ap, argv)
     if fmus is None:
         return 1
     if args.t_end <= 0 or not 0 <= args.offset <= 5:
@@ -443,12 +440,8 @@ def main(argv=None):
         log(f"error: {exc}")
         return 1
     print(summary(s), flush=True)
-    args.out.mkdir(parents=True, exist_ok=True)
-    paths = [args.out / "linearize_lqr.csv", args.out / "linearize_lqr.png"]
-    write_csv(s, paths[0])
-    plot(s, paths[1])
-    for p in paths:
-        log(f"wrote {p}")
+    write_outputs(args.out, log, {"linearize_lqr.csv": lambda p: write_csv(s, p),
+                                  "linearize_lqr.png": lambda p: plot(s, p)})
     return 0
 
 

@@ -51,7 +51,8 @@ from xml.sax.saxutils import quoteattr
 import matplotlib
 import numpy as np
 
-from pkm4puu.cli import add_common_args, find_fmus, Log
+from pkm4puu.cli import add_common_args, start, write_outputs
+from pkm4puu.plots import save_figure
 from pkm4puu.interface import ACC, F, POSE, START_P0, VEL
 from pkm4puu.motions import motion, p
 from pkm4puu.spec import STEP as H, T_MOVE
@@ -260,9 +261,7 @@ def plot(runs, path, solver):
         ax.set_ylim(bottom=1e-12)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
 
 
 def main(argv=None):
@@ -270,9 +269,7 @@ def main(argv=None):
     add_common_args(ap)
     ap.add_argument("--solver", choices=sorted(SOLVERS), default="cvode",
                     help="the plant's integrator (default %(default)s)")
-    args = ap.parse_args(argv)
-    log = Log("ssp_cosim")
-    fmus = find_fmus(args.build, log)
+    args, log, fmus = start(ap, argv)
     if fmus is None:
         return 1
     args.out.mkdir(parents=True, exist_ok=True)
@@ -294,11 +291,8 @@ def main(argv=None):
     print(f"auto-test in libcosim from {ssp.name} (plant {args.solver.upper()}), max errors over {T_MOVE:g} s:")
     for name, r in runs.items():
         print(f"  {name:<36} {r.pos_err.max():.3e} m  {r.phi_err.max():.3e} rad")
-    paths = [args.out / "ssp_autotest.csv", args.out / "ssp_autotest_errors.png"]
-    write_csv(runs, paths[0])
-    plot(runs, paths[1], args.solver)
-    for p in paths:
-        log(f"wrote {p}")
+    write_outputs(args.out, log, {"ssp_autotest.csv": lambda p: write_csv(runs, p),
+                                  "ssp_autotest_errors.png": lambda p: plot(runs, p, args.solver)})
     good = runs[next(iter(cases))]
     ok = good.pos_err.max() <= TOL_POS and good.phi_err.max() <= TOL_PHI
     if not ok:

@@ -12,12 +12,22 @@ namespace {
 using Mat28 = Eigen::Matrix<double, 28, 28>;
 using Vec28 = Eigen::Matrix<double, 28, 1>;
 
+/// M(q) and C_q(q), where both full-coordinate formulations start.
+struct MassAndJacobian {
+  Mat16 M;
+  Mat12x16 Cq;
+};
+
+MassAndJacobian mass_and_jacobian(const Model& m, const Vec16& q) {
+  MassAndJacobian r;
+  mass_matrix(m, q, r.M);
+  constraint_jacobian(m, q, r.Cq);
+  return r;
+}
+
 Status augmented(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f, Vec16& qdd,
                  Vec12& lambda) {
-  Mat16 M;
-  mass_matrix(m, q, M);
-  Mat12x16 Cq;
-  constraint_jacobian(m, q, Cq);
+  const auto [M, Cq] = mass_and_jacobian(m, q);
   Mat28 A = Mat28::Zero();
   A.topLeftCorner<16, 16>() = M;
   A.topRightCorner<16, 12>() = Cq.transpose();
@@ -34,10 +44,7 @@ Status augmented(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f
 
 Status null_space_qr(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f, Vec16& qdd,
                      Vec12& lambda) {
-  Mat16 M;
-  mass_matrix(m, q, M);
-  Mat12x16 Cq;
-  constraint_jacobian(m, q, Cq);
+  const auto [M, Cq] = mass_and_jacobian(m, q);
   const Eigen::Matrix<double, 16, 12> CqT = Cq.transpose();
   const Eigen::HouseholderQR<Eigen::Matrix<double, 16, 12>> qr(CqT);
   const Mat16 Q = qr.householderQ();

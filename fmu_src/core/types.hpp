@@ -13,7 +13,6 @@ namespace pkm {
 constexpr int kLegs = 4;
 constexpr int kN = 16;        // redundant coordinates
 constexpr int kM = 12;        // loop-closure constraints
-constexpr int kDof = 4;       // x, y, z, phi
 constexpr int kPlatform = 12; // index of x in q
 
 /// Index of leg i's first coordinate (rho_i) in q.
@@ -21,7 +20,6 @@ constexpr int leg_offset(int leg) { return 3 * leg; }
 
 using Vec3 = Eigen::Vector3d;
 using Vec4 = Eigen::Matrix<double, 4, 1>;
-using Vec2 = Eigen::Vector2d;
 using Vec8 = Eigen::Matrix<double, 8, 1>;
 using Vec10 = Eigen::Matrix<double, 10, 1>;
 using Vec12 = Eigen::Matrix<double, 12, 1>;

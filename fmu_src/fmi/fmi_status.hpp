@@ -16,7 +16,6 @@ constexpr Status worst(Status a, Status b) { return static_cast<int>(a) > static
 
 enum class Interface : std::uint8_t { ModelExchange, CoSimulation };
 
-const char* status_text(Status s);
 const char* interface_name(Interface i);
 
 }  // namespace pkm_fmi

@@ -64,19 +64,8 @@ void Logger::vlog(Status status, LogCategory c, const char* fmt, va_list args) {
 PKM_FMI_LOG_AS(error, Status::Error, LogCategory::StatusError)
 PKM_FMI_LOG_AS(warning, Status::Warning, LogCategory::StatusWarning)
 PKM_FMI_LOG_AS(discard, Status::Discard, LogCategory::StatusDiscard)
-PKM_FMI_LOG_AS(fatal, Status::Fatal, LogCategory::StatusFatal)
 PKM_FMI_LOG_AS(event, Status::OK, LogCategory::Events)
 PKM_FMI_LOG_AS(call, Status::OK, LogCategory::Calls)
 #undef PKM_FMI_LOG_AS
-
-void Logger::status(Status s, const char* fmt, ...) {
-  static constexpr LogCategory kCategory[] = {LogCategory::Events, LogCategory::StatusWarning,
-                                              LogCategory::StatusDiscard, LogCategory::StatusError,
-                                              LogCategory::StatusFatal};
-  va_list args;
-  va_start(args, fmt);
-  vlog(s, kCategory[static_cast<int>(s)], fmt, args);
-  va_end(args);
-}
 
 }  // namespace pkm_fmi

@@ -75,11 +75,8 @@ class Logger {
   void error(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);
   void warning(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);
   void discard(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);
-  void fatal(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);
   void event(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);
   void call(const char* fmt, ...) PKM_FMI_PRINTF(2, 3);  // logCalls
-  /// A message with the status's own category.
-  void status(Status s, const char* fmt, ...) PKM_FMI_PRINTF(3, 4);
 
   const std::string& instance_name() const { return name_; }
 

@@ -10,17 +10,6 @@
 
 namespace pkm_fmi {
 
-const char* status_text(Status s) {
-  switch (s) {
-    case Status::OK: return "OK";
-    case Status::Warning: return "Warning";
-    case Status::Discard: return "Discard";
-    case Status::Error: return "Error";
-    case Status::Fatal: return "Fatal";
-  }
-  return "?";
-}
-
 const char* interface_name(Interface i) { return i == Interface::ModelExchange ? "Model Exchange" : "Co-Simulation"; }
 
 const char* xml_name(Causality c) {

@@ -43,6 +43,7 @@ from .fmu import Fmu, inverse_forces, run
 from .interface import ACC, F, POSE, START_P0, VEL
 from .motions import p
 from .spec import STEP as H, T_MOVE
+from .plots import save_figure
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -242,9 +243,7 @@ def plot_errors(runs, path):
         ax.axhline(tol, color="k", lw=0.8, ls=":", label=f"test bound {tol:g} {unit}")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7, ncol=3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def plot_pose(runs, path, case=POSE_PLOT_CASE):

@@ -1,6 +1,9 @@
 """What the command-line programs share (the examples and `python -m
-pkm4puu.autotest`): progress on stderr, the --build/--out arguments, and
-finding the FMUs with a message that says how to build them."""
+pkm4puu.autotest`): progress on stderr, the --build/--out arguments,
+finding the FMUs with a message that says how to build them, and writing
+the output files."""
+import os
+import platform
 import sys
 import time
 from pathlib import Path
@@ -19,6 +22,19 @@ class Log:
         print(f"{self.prog} [{time.perf_counter() - self.t0:6.1f} s]: {msg}", file=sys.stderr, flush=True)
 
 
+def machine_description():
+    """"Linux x86_64, <CPU model>, <n> cores": the machine a benchmark ran on."""
+    cpu = "unknown"
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{platform.system()} {platform.machine()}, {cpu}, {os.cpu_count()} cores"
+
+
 def add_common_args(ap):
     ap.add_argument("--build", type=Path, default=REPO / "build",
                     help="directory holding PKM4PUU.fmu and PKM4PUU_Inverse.fmu (default: %(default)s)")
@@ -34,3 +50,24 @@ def find_fmus(build, log, models=("PKM4PUU", "PKM4PUU_Inverse")):
     except FileNotFoundError as e:
         log(f"error: {e}, or pass --build DIR")
         return None
+
+
+def start(ap, argv, models=("PKM4PUU", "PKM4PUU_Inverse")):
+    """Parses argv with ap, starts a Log named after the program and finds the
+    FMUs: (args, log, fmus), fmus None when they are missing (logged)."""
+    args = ap.parse_args(argv)
+    log = Log(ap.prog)
+    return args, log, find_fmus(args.build, log, models)
+
+
+def write_outputs(out, log, writers):
+    """Calls writer(path) for each {file name: writer} into the directory out
+    (created if missing), logs each path written, and returns the paths."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for name, write in writers.items():
+        write(out / name)
+        log(f"wrote {out / name}")
+        paths.append(out / name)
+    return paths

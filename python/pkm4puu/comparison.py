@@ -36,6 +36,7 @@ from .fmu import Fmu, run
 from .interface import F, POSE, START_P0, arr
 from .motions import comparison_forces
 from .spec import CMP_AMPLITUDE, CMP_DURATION, L as L_ROD, M_PLATFORM, M_ROD, M_SLIDER, STEP
+from .plots import save_figure
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -182,10 +183,8 @@ def write_results(runs, out_dir):
         ax.set_xlabel("time (s)")
     fig.suptitle("Comparison test through the plant FMU: platform pose (CVODE, 1 ms step)\n"
                  "g = 0, F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s), F2 = F3 = 0", fontsize=11)
-    fig.tight_layout()
     pose_png = out_dir / "comparison_pose.png"
-    fig.savefig(pose_png, dpi=120)
-    plt.close(fig)
+    save_figure(fig, pose_png)
 
     fig, ax = plt.subplots(figsize=(8, 4))
     ax.plot(t, 1e3 * d_rho1)
@@ -193,10 +192,8 @@ def write_results(runs, out_dir):
     ax.set_ylabel("delta rho1 (mm)")
     ax.set_title("Comparison test through the plant FMU: displacement of actuator 1 (CVODE)")
     ax.grid(True, alpha=0.3)
-    fig.tight_layout()
     rho_png = out_dir / "comparison_delta_rho1.png"
-    fig.savefig(rho_png, dpi=120)
-    plt.close(fig)
+    save_figure(fig, rho_png)
     return [csv_path, pose_png, rho_png]
 
 

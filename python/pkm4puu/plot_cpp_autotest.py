@@ -14,7 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .plots import plot_forces, plot_pose  # noqa: E402
+from .plots import plot_forces, plot_pose, save_figure  # noqa: E402
 
 
 def load(path):
@@ -46,9 +46,7 @@ def plot_errors(runs, out):
         ax.axhline(1e-10, color="k", ls=":", lw=1, label="test bound 1e-10")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(loc="best", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+    save_figure(fig, out)
 
 
 def main():

@@ -11,6 +11,13 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
+def save_figure(fig, path, dpi=120):
+    """Lays out, writes and closes a figure."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+
+
 def plot_forces(t, F, F_static, title, path):
     """F1..F4 (columns of F, N) over t and, below, F minus the forces that
     would hold the same pose at rest (mN)."""
@@ -27,9 +34,7 @@ def plot_forces(t, F, F_static, title, path):
     for ax in axes:
         ax.grid(True, alpha=0.3)
         ax.legend(loc="best", ncol=4, fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def plot_pose(t, ref, sim, sim_label, title, path):
@@ -46,6 +51,4 @@ def plot_pose(t, ref, sim, sim_label, title, path):
     for ax in axes[1]:
         ax.set_xlabel("time (s)")
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)

@@ -66,6 +66,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from pkm4puu.fmu import REPO  # noqa: E402
+from pkm4puu.plots import save_figure  # noqa: E402
 
 H = 1e-3  # s, output grid and communication step
 N = round(spec.CMP_DURATION / H)
@@ -646,10 +647,8 @@ def write_results(r, out_dir):
     axes[0, 0].legend(loc="best", fontsize=8)
     fig.suptitle("Comparison test: platform pose, independent engines (solid) and this model (dashed)\n"
                  "g = 0, F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s), F2 = F3 = 0", fontsize=11)
-    fig.tight_layout()
     p = out_dir / "engines_pose.png"
-    fig.savefig(p, dpi=120)
-    plt.close(fig)
+    save_figure(fig, p)
     paths.append(p)
 
     # Fig. 11: delta rho1.
@@ -662,10 +661,8 @@ def write_results(r, out_dir):
     ax.set_title("Comparison test: displacement of actuator 1, engines (solid) and this model (dashed)", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    fig.tight_layout()
     p = out_dir / "engines_delta_rho1.png"
-    fig.savefig(p, dpi=120)
-    plt.close(fig)
+    save_figure(fig, p)
     paths.append(p)
 
     # Differences, and constraint violations. Runs driven by the exact forces

@@ -1,9 +1,8 @@
 // The built FMU binaries (PKM4PUU.so / .dll, PKM4PUU_Inverse.so / .dll)
 // loaded as an importer would (dlopen; LoadLibrary on Windows) and driven
-// through the raw FMI 2.0 functions: shared by the tests/test_fmi_*.cpp and
-// tests/test_hardening_*.cpp suites. Value references come from the models'
-// variable tables (checked against modelDescription.xml by
-// test_fmi_model_description). The helpers that run host programs (capture,
+// through the raw FMI 2.0 functions: shared by the tests of tests/fmi/.
+// Value references come from the models' variable tables (checked against
+// modelDescription.xml by tests/fmi/model_description.cpp). The helpers that run host programs (capture,
 // run_python) exist on POSIX only.
 #pragma once
 

@@ -1,0 +1,593 @@
+// The FMU binaries' state machine, driven through the raw FMI 2.0 functions
+// as an importer would (dlopen): version and platform, instantiation and its
+// checks, calls out of the co-simulation state machine's order before,
+// during and after initialisation and after a failed step, functions this
+// FMU does not provide, NULL and foreign handles, instances of the other
+// model or FMI version, reset, independent instances, status kinds the
+// standard does not define, and the error policy as a table. Each answer is
+// what the standard prescribes, nothing crashes, nothing is written outside
+// the instance (canaries around every output buffer), and an instance that
+// was stepping goes on bit-identically to an untouched twin.
+// Every misuse prints a row of the hardening table ("| tried | answer | kept |").
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fmi2FunctionTypes.h"
+#include "fmi3FunctionTypes.h"
+#include "fmu_fixture.hpp"
+#include "models.hpp"
+
+namespace {
+
+using namespace pkm_test;
+
+class StateMachine : public FmuTest {};
+
+TEST_F(StateMachine, VersionAndPlatform) {
+  EXPECT_STREQ(lib.fmi2GetVersion(), "2.0");
+  EXPECT_STREQ(lib.fmi2GetTypesPlatform(), "default");
+}
+
+TEST_F(StateMachine, InstantiateChecksGuidAndType) {
+  Log log;
+  const fmi2CallbackFunctions f{&pkm_test::collect_log, &std::calloc, &std::free, nullptr, &log};
+  EXPECT_EQ(lib.fmi2Instantiate("x", fmi2CoSimulation, "{not-the-guid}", "", &f, fmi2False, fmi2False), nullptr);
+  EXPECT_EQ(lib.fmi2Instantiate("x", static_cast<fmi2Type>(7), PKM_FMU_PLANT_GUID, "", &f, fmi2False, fmi2False),
+            nullptr);
+  EXPECT_EQ(lib.fmi2Instantiate("x", fmi2CoSimulation, PKM_FMU_INVERSE_GUID, "", &f, fmi2False, fmi2False), nullptr);
+  ASSERT_EQ(log.messages.size(), 3u);
+  for (const auto& m : log.messages) EXPECT_EQ(m.status, fmi2Error);
+  EXPECT_TRUE(log.contains("GUID"));
+  EXPECT_TRUE(log.contains("fmuType = 7"));
+  // Both interfaces of the one binary.
+  for (fmi2Type type : {fmi2ModelExchange, fmi2CoSimulation}) {
+    fmi2Component c = lib.fmi2Instantiate("x", type, PKM_FMU_PLANT_GUID, "", &f, fmi2False, fmi2False);
+    EXPECT_NE(c, nullptr) << log.dump();
+    lib.fmi2FreeInstance(c);
+  }
+}
+
+TEST_F(StateMachine, OutOfOrderCallsAreErrorsWithoutEffect) {
+  PlantFmu p;
+  ASSERT_NE(p.c, nullptr);
+  double value = 0.0;
+  const fmi2ValueReference x = p.vr("x");
+  EXPECT_EQ(lib.fmi2DoStep(p.c, 0.0, 1e-3, fmi2True), fmi2Error);          // before initialisation
+  EXPECT_EQ(lib.fmi2ExitInitializationMode(p.c), fmi2Error);               // not in initialisation mode
+  EXPECT_EQ(lib.fmi2GetReal(p.c, &x, 1, &value), fmi2Error);               // no outputs yet
+  EXPECT_EQ(lib.fmi2Terminate(p.c), fmi2Error);
+  fmi2Status st;
+  EXPECT_EQ(lib.fmi2GetStatus(p.c, fmi2DoStepStatus, &st), fmi2Error);
+  EXPECT_TRUE(p.log.contains("illegal call sequence")) << p.log.dump();
+  // A NULL component is an error, not a crash.
+  EXPECT_EQ(lib.fmi2DoStep(nullptr, 0.0, 1e-3, fmi2True), fmi2Error);
+  EXPECT_EQ(lib.fmi2GetReal(nullptr, &x, 1, &value), fmi2Error);
+  lib.fmi2FreeInstance(nullptr);
+
+  // The instance is still usable: the normal sequence works.
+  ASSERT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK);
+  ASSERT_EQ(lib.fmi2EnterInitializationMode(p.c), fmi2OK);
+  EXPECT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2Error);  // too late
+  EXPECT_EQ(lib.fmi2DoStep(p.c, 0.0, 1e-3, fmi2True), fmi2Error);
+  ASSERT_EQ(lib.fmi2ExitInitializationMode(p.c), fmi2OK);
+  EXPECT_EQ(lib.fmi2EnterInitializationMode(p.c), fmi2Error);
+  // Parameters are fixed after initialisation, outputs never settable.
+  EXPECT_EQ(p.set("l", 0.09), fmi2Error);
+  EXPECT_EQ(p.set("x", 0.01), fmi2Error);
+  EXPECT_EQ(p.set_int("solver", 1), fmi2Error);
+  EXPECT_NEAR(p.get("l"), 0.08, 0.0);
+  // Wrong step arguments.
+  EXPECT_EQ(lib.fmi2DoStep(p.c, 0.5, 1e-3, fmi2True), fmi2Error);  // not the current time
+  EXPECT_EQ(lib.fmi2DoStep(p.c, 0.0, 0.0, fmi2True), fmi2Error);
+  EXPECT_EQ(lib.fmi2DoStep(p.c, 0.0, -1e-3, fmi2True), fmi2Error);
+  EXPECT_EQ(lib.fmi2DoStep(p.c, 0.0, 1e-3, fmi2True), fmi2OK) << p.log.dump();
+  EXPECT_EQ(lib.fmi2GetStatus(p.c, fmi2DoStepStatus, &st), fmi2OK);
+  EXPECT_EQ(st, fmi2OK);
+  EXPECT_EQ(lib.fmi2CancelStep(p.c), fmi2Error);
+  EXPECT_EQ(lib.fmi2GetRealOutputDerivatives(p.c, &x, 1, nullptr, &value), fmi2Error);
+  EXPECT_EQ(lib.fmi2Terminate(p.c), fmi2OK);
+  EXPECT_EQ(lib.fmi2DoStep(p.c, 1e-3, 1e-3, fmi2True), fmi2Error);  // after termination
+  EXPECT_EQ(lib.fmi2Reset(p.c), fmi2OK);
+}
+
+TEST_F(StateMachine, ResetReturnsToTheStartValues) {
+  PlantFmu a;
+  ASSERT_EQ(a.set("z0", 0.06), fmi2OK);
+  a.initialize();
+  ASSERT_EQ(a.set("F[2]", 3.0), fmi2OK);
+  ASSERT_EQ(lib.fmi2DoStep(a.c, 0.0, 1e-2, fmi2True), fmi2OK);
+  ASSERT_EQ(lib.fmi2Reset(a.c), fmi2OK);
+  a.initialize();
+  EXPECT_EQ(a.get("z0"), 0.05);
+  EXPECT_EQ(a.get("F[2]"), kStaticForce);  // its start value (MODEL_SPEC)
+  EXPECT_EQ(a.get("z"), 0.05);
+  PlantFmu b;
+  b.initialize();
+  ASSERT_EQ(lib.fmi2DoStep(a.c, 0.0, 1e-2, fmi2True), fmi2OK);
+  ASSERT_EQ(lib.fmi2DoStep(b.c, 0.0, 1e-2, fmi2True), fmi2OK);
+  EXPECT_TRUE(bit_identical(a.outputs(), b.outputs()));
+}
+
+TEST_F(StateMachine, SeveralInstancesDoNotInterfere) {
+  auto solo = [&](double force, std::vector<double>& trace) {
+    PlantFmu p;
+    ASSERT_EQ(p.set("dy0", force * 1e-3), fmi2OK);
+    p.initialize();
+    for (int k = 0; k < 100; ++k) {
+      ASSERT_EQ(p.set("F[1]", kStaticForce + force), fmi2OK);
+      ASSERT_EQ(lib.fmi2DoStep(p.c, k * 1e-3, 1e-3, fmi2True), fmi2OK);
+      const auto o = p.outputs();
+      trace.insert(trace.end(), o.begin(), o.end());
+    }
+  };
+  std::vector<double> a_solo, b_solo;
+  solo(0.1, a_solo);
+  solo(-0.2, b_solo);
+  PlantFmu a("a", false), b("b", false);
+  ASSERT_EQ(a.set("dy0", 0.1e-3), fmi2OK);
+  ASSERT_EQ(b.set("dy0", -0.2e-3), fmi2OK);
+  a.initialize();
+  b.initialize();
+  std::vector<double> a_trace, b_trace;
+  for (int k = 0; k < 100; ++k) {
+    ASSERT_EQ(b.set("F[1]", kStaticForce - 0.2), fmi2OK);
+    ASSERT_EQ(a.set("F[1]", kStaticForce + 0.1), fmi2OK);
+    ASSERT_EQ(lib.fmi2DoStep(a.c, k * 1e-3, 1e-3, fmi2True), fmi2OK);
+    ASSERT_EQ(lib.fmi2DoStep(b.c, k * 1e-3, 1e-3, fmi2True), fmi2OK);
+    const auto ob = b.outputs();
+    const auto oa = a.outputs();
+    a_trace.insert(a_trace.end(), oa.begin(), oa.end());
+    b_trace.insert(b_trace.end(), ob.begin(), ob.end());
+  }
+  EXPECT_TRUE(bit_identical(a_trace, a_solo));
+  EXPECT_TRUE(bit_identical(b_trace, b_solo));
+}
+
+TEST_F(StateMachine, CallsOutOfOrderBeforeInitialisation) {
+  PlantFmu p;
+  ASSERT_NE(p.c, nullptr);
+  const fmi2ValueReference x = p.vr("x");
+  double buf[3] = {kCanary, kCanary, kCanary};
+  fmi2Status st = fmi2Pending;
+  fmi2Real r = kCanary;
+  fmi2Boolean b = 77;
+  EXPECT_EQ(p.step(0.0, 1e-3), fmi2Error);
+  EXPECT_EQ(p.exit(), fmi2Error);
+  EXPECT_EQ(lib.fmi2GetReal(p.c, &x, 1, &buf[1]), fmi2Error);
+  EXPECT_EQ(lib.fmi2Terminate(p.c), fmi2Error);
+  EXPECT_EQ(lib.fmi2GetStatus(p.c, fmi2DoStepStatus, &st), fmi2Error);
+  EXPECT_EQ(lib.fmi2GetRealStatus(p.c, fmi2LastSuccessfulTime, &r), fmi2Error);
+  EXPECT_EQ(lib.fmi2GetBooleanStatus(p.c, fmi2Terminated, &b), fmi2Error);
+  EXPECT_EQ(lib.fmi2GetRealOutputDerivatives(p.c, &x, 1, nullptr, &buf[1]), fmi2Error);
+  EXPECT_EQ(lib.fmi2CancelStep(p.c), fmi2Error);
+  for (double v : buf) EXPECT_EQ(v, kCanary);
+  EXPECT_EQ(st, fmi2Pending);
+  EXPECT_EQ(r, kCanary);
+  EXPECT_EQ(b, 77);
+  EXPECT_TRUE(p.log.contains("not allowed in state Instantiated (illegal call sequence)")) << p.log.dump();
+  // Then the normal sequence works.
+  p.initialize();
+  EXPECT_EQ(p.step(0.0, 1e-3), fmi2OK);
+  table_row("before initialisation (Instantiated): fmi2DoStep, fmi2ExitInitializationMode, fmi2GetReal(x), "
+            "fmi2Terminate, fmi2GetStatus / GetRealStatus / GetBooleanStatus, fmi2GetRealOutputDerivatives, "
+            "fmi2CancelStep",
+            "fmi2Error each, \"<function>: not allowed in state Instantiated (illegal call sequence); the call has "
+            "no effect\"",
+            "yes: nothing written (guard values intact); setup, initialisation and steps then work");
+}
+
+TEST_F(StateMachine, CallsOutOfOrderDuringInitialisation) {
+  PlantFmu p;
+  ASSERT_EQ(p.setup(), fmi2OK);
+  ASSERT_EQ(p.enter(), fmi2OK);
+  EXPECT_EQ(p.setup(), fmi2Error);
+  EXPECT_EQ(p.enter(), fmi2Error);
+  EXPECT_EQ(p.step(0.0, 1e-3), fmi2Error);
+  EXPECT_EQ(lib.fmi2Terminate(p.c), fmi2Error);
+  fmi2Real r = kCanary;
+  EXPECT_EQ(lib.fmi2GetRealStatus(p.c, fmi2LastSuccessfulTime, &r), fmi2Error);
+  EXPECT_EQ(r, kCanary);
+  ASSERT_EQ(p.exit(), fmi2OK);
+  EXPECT_EQ(p.exit(), fmi2Error);
+  EXPECT_EQ(p.enter(), fmi2Error);
+  EXPECT_EQ(p.setup(), fmi2Error);
+  EXPECT_EQ(p.step(0.0, 1e-3), fmi2OK);
+  table_row("in initialisation mode: fmi2SetupExperiment, fmi2EnterInitializationMode again, fmi2DoStep, "
+            "fmi2Terminate, fmi2GetRealStatus; after it: fmi2ExitInitializationMode, fmi2EnterInitializationMode, "
+            "fmi2SetupExperiment again",
+            "fmi2Error each (illegal call sequence)", "yes: initialisation completes, steps work");
+}
+
+TEST_F(StateMachine, CallsAfterTermination) {
+  PlantFmu p;
+  double t = 0.0;
+  prepare(p, t);
+  ASSERT_EQ(lib.fmi2Terminate(p.c), fmi2OK);
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(t, 1e-3), fmi2Error);
+  EXPECT_EQ(p.set("F[1]", 1.0), fmi2Error);
+  EXPECT_EQ(p.set_derivative("F[1]", 1.0), fmi2Error);
+  EXPECT_EQ(lib.fmi2Terminate(p.c), fmi2Error);
+  EXPECT_EQ(p.enter(), fmi2Error);
+  EXPECT_TRUE(bit_identical(p.all_reals(), before)) << "outputs stay readable and unchanged";
+  EXPECT_EQ(lib.fmi2Reset(p.c), fmi2OK);
+  p.initialize();
+  EXPECT_EQ(p.step(0.0, 1e-3), fmi2OK);
+  table_row("after fmi2Terminate: fmi2DoStep, fmi2SetReal(F[1]), fmi2SetRealInputDerivatives, fmi2Terminate "
+            "again, fmi2EnterInitializationMode",
+            "fmi2Error each (illegal call sequence); fmi2GetReal allowed",
+            "yes: every variable bit-identical; fmi2Reset then works");
+}
+
+TEST_F(StateMachine, CallsInTheStepFailedState) {
+  PlantFmu p;
+  ASSERT_EQ(p.set_int("solver", 1), fmi2OK);
+  p.initialize();
+  ASSERT_EQ(p.set("Fe[1]", 50.0), fmi2OK);
+  double t = 0.0;
+  fmi2Status s = fmi2OK;
+  while (s == fmi2OK && t < 1.0) {
+    s = p.step(t, 1e-3);
+    if (s == fmi2OK) t += 1e-3;
+  }
+  ASSERT_EQ(s, fmi2Discard);
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(t, 1e-3), fmi2Error);
+  EXPECT_EQ(p.set("Fe[1]", 0.0), fmi2Error);
+  EXPECT_EQ(p.set_derivative("Fe[1]", 0.0), fmi2Error);
+  EXPECT_EQ(p.setup(), fmi2Error);
+  fmi2Status st = fmi2Pending;
+  EXPECT_EQ(lib.fmi2GetStatus(p.c, fmi2DoStepStatus, &st), fmi2OK);
+  EXPECT_EQ(st, fmi2OK) << "fmi2DoStep never pends";
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  EXPECT_EQ(p.last_successful_time(), t);
+  EXPECT_TRUE(p.terminated());
+  EXPECT_EQ(lib.fmi2Terminate(p.c), fmi2OK);
+  table_row("after an fmi2Discard (StepFailed): fmi2DoStep again, fmi2SetReal / SetRealInputDerivatives of an "
+            "input, fmi2SetupExperiment",
+            "fmi2Error each (illegal call sequence); fmi2GetReal, fmi2GetStatus, fmi2GetRealStatus, "
+            "fmi2GetBooleanStatus(fmi2Terminated) = true, fmi2Terminate allowed",
+            "yes: every variable bit-identical, fmi2LastSuccessfulTime unchanged");
+}
+
+TEST_F(StateMachine, FunctionsThisFmuDoesNotProvide) {
+  on_stepping_instance(
+      "fmi2CancelStep (fmi2DoStep never returns fmi2Pending), fmi2GetRealOutputDerivatives "
+      "(maxOutputDerivativeOrder = 0)",
+      fmi2Error, "fmi2Error each, with the reason logged (\"not allowed in state StepComplete\", \"not provided\")",
+      [&](PlantFmu& p, double) {
+        const fmi2ValueReference x = p.vr("x");
+        const fmi2Integer order = 1;
+        double buf[3] = {kCanary, kCanary, kCanary};
+        std::vector<fmi2Status> s = {lib.fmi2CancelStep(p.c),
+                                     lib.fmi2GetRealOutputDerivatives(p.c, &x, 1, &order, &buf[1])};
+        for (double v : buf) EXPECT_EQ(v, kCanary);
+        return s;
+      });
+}
+
+TEST_F(StateMachine, NullArgumentsAreErrors) {
+  on_stepping_instance(
+      "NULL arrays with n > 0 in fmi2Get/Set Real/Integer/Boolean/String and fmi2SetRealInputDerivatives; "
+      "NULL FMUstate / size / buffer in the FMU-state functions; NULL value in fmi2GetStatus / GetRealStatus / "
+      "GetBooleanStatus; NULL category list or a NULL category in fmi2SetDebugLogging",
+      fmi2Error, "fmi2Error each, \"<function>: ... is NULL\"", [&](PlantFmu& p, double) {
+        std::vector<fmi2Status> s;
+        const fmi2ValueReference x = p.vr("x"), f = p.vr("F[1]");
+        double v = kCanary;
+        fmi2Integer i = 0;
+        fmi2Boolean b = 0;
+        fmi2String str = nullptr;
+        s.push_back(lib.fmi2GetReal(p.c, nullptr, 1, &v));
+        s.push_back(lib.fmi2GetReal(p.c, &x, 1, nullptr));
+        s.push_back(lib.fmi2SetReal(p.c, nullptr, 1, &v));
+        s.push_back(lib.fmi2SetReal(p.c, &f, 1, nullptr));
+        s.push_back(lib.fmi2GetInteger(p.c, nullptr, 1, &i));
+        s.push_back(lib.fmi2SetInteger(p.c, &x, 1, nullptr));
+        s.push_back(lib.fmi2GetBoolean(p.c, nullptr, 1, &b));
+        s.push_back(lib.fmi2SetBoolean(p.c, &x, 1, nullptr));
+        s.push_back(lib.fmi2GetString(p.c, nullptr, 1, &str));
+        s.push_back(lib.fmi2SetString(p.c, &x, 1, nullptr));
+        const fmi2Integer order = 1;
+        s.push_back(lib.fmi2SetRealInputDerivatives(p.c, nullptr, 1, &order, &v));
+        s.push_back(lib.fmi2SetRealInputDerivatives(p.c, &f, 1, nullptr, &v));
+        s.push_back(lib.fmi2SetRealInputDerivatives(p.c, &f, 1, &order, nullptr));
+        s.push_back(lib.fmi2GetFMUstate(p.c, nullptr));
+        s.push_back(lib.fmi2SetFMUstate(p.c, nullptr));
+        fmi2FMUstate state = nullptr;
+        EXPECT_EQ(lib.fmi2GetFMUstate(p.c, &state), fmi2OK);
+        std::size_t size = 0;
+        s.push_back(lib.fmi2SerializedFMUstateSize(p.c, state, nullptr));
+        s.push_back(lib.fmi2SerializedFMUstateSize(p.c, nullptr, &size));
+        s.push_back(lib.fmi2SerializeFMUstate(p.c, state, nullptr, 1000));
+        s.push_back(lib.fmi2SerializeFMUstate(p.c, nullptr, reinterpret_cast<fmi2Byte*>(&v), sizeof v));
+        fmi2FMUstate out = nullptr;
+        s.push_back(lib.fmi2DeSerializeFMUstate(p.c, nullptr, 100, &out));
+        s.push_back(lib.fmi2DeSerializeFMUstate(p.c, reinterpret_cast<const fmi2Byte*>(&v), sizeof v, nullptr));
+        EXPECT_EQ(out, nullptr);
+        EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, &state), fmi2OK);
+        EXPECT_EQ(lib.fmi2FreeFMUstate(p.c, nullptr), fmi2OK) << "freeing nothing is fine";
+        s.push_back(lib.fmi2GetStatus(p.c, fmi2DoStepStatus, nullptr));
+        s.push_back(lib.fmi2GetRealStatus(p.c, fmi2LastSuccessfulTime, nullptr));
+        s.push_back(lib.fmi2GetBooleanStatus(p.c, fmi2Terminated, nullptr));
+        s.push_back(lib.fmi2SetDebugLogging(p.c, fmi2True, 2, nullptr));
+        const fmi2String with_null[2] = {"logEvents", nullptr};
+        s.push_back(lib.fmi2SetDebugLogging(p.c, fmi2True, 2, with_null));
+        EXPECT_EQ(v, kCanary);
+        // n = 0 with NULL arrays: nothing to do, fine.
+        EXPECT_EQ(lib.fmi2GetReal(p.c, nullptr, 0, nullptr), fmi2OK);
+        EXPECT_EQ(lib.fmi2SetReal(p.c, nullptr, 0, nullptr), fmi2OK);
+        return s;
+      });
+}
+
+TEST_F(StateMachine, NullAndForeignComponentsAreErrorsWithoutACrash) {
+  // Not an instance: NULL, and a pointer to memory that is not one (the tag check).
+  alignas(16) unsigned char not_an_instance[256] = {};
+  for (void* c : {static_cast<void*>(nullptr), static_cast<void*>(not_an_instance)}) {
+    const fmi2ValueReference vr = 10;
+    double v = kCanary;
+    fmi2Integer i = 0;
+    fmi2Boolean b = 0;
+    fmi2String s = nullptr;
+    fmi2FMUstate state = nullptr;
+    std::size_t size = 0;
+    fmi2Status st = fmi2Pending;
+    const fmi2Integer order = 1;
+    EXPECT_EQ(lib.fmi2SetDebugLogging(c, fmi2True, 0, nullptr), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0), fmi2Error);
+    EXPECT_EQ(lib.fmi2EnterInitializationMode(c), fmi2Error);
+    EXPECT_EQ(lib.fmi2ExitInitializationMode(c), fmi2Error);
+    EXPECT_EQ(lib.fmi2Terminate(c), fmi2Error);
+    EXPECT_EQ(lib.fmi2Reset(c), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetReal(c, &vr, 1, &v), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetInteger(c, &vr, 1, &i), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetBoolean(c, &vr, 1, &b), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetString(c, &vr, 1, &s), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetReal(c, &vr, 1, &v), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetInteger(c, &vr, 1, &i), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetBoolean(c, &vr, 1, &b), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetString(c, &vr, 1, &s), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetFMUstate(c, &state), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetFMUstate(c, state), fmi2Error);
+    EXPECT_EQ(lib.fmi2FreeFMUstate(c, &state), fmi2Error);
+    EXPECT_EQ(lib.fmi2SerializedFMUstateSize(c, state, &size), fmi2Error);
+    EXPECT_EQ(lib.fmi2SerializeFMUstate(c, state, nullptr, 0), fmi2Error);
+    EXPECT_EQ(lib.fmi2DeSerializeFMUstate(c, nullptr, 0, &state), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetDirectionalDerivative(c, &vr, 1, &vr, 1, &v, &v), fmi2Error);
+    EXPECT_EQ(lib.fmi2SetRealInputDerivatives(c, &vr, 1, &order, &v), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetRealOutputDerivatives(c, &vr, 1, &order, &v), fmi2Error);
+    EXPECT_EQ(lib.fmi2DoStep(c, 0.0, 1e-3, fmi2True), fmi2Error);
+    EXPECT_EQ(lib.fmi2CancelStep(c), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetStatus(c, fmi2DoStepStatus, &st), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &v), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetIntegerStatus(c, fmi2DoStepStatus, &i), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetBooleanStatus(c, fmi2Terminated, &b), fmi2Error);
+    EXPECT_EQ(lib.fmi2GetStringStatus(c, fmi2PendingStatus, &s), fmi2Error);
+    lib.fmi2FreeInstance(c);
+    EXPECT_EQ(v, kCanary);
+    EXPECT_EQ(st, fmi2Pending);
+    EXPECT_EQ(state, nullptr);
+  }
+  for (unsigned char byte : not_an_instance) EXPECT_EQ(byte, 0) << "the foreign memory was written";
+  table_row("a NULL fmi2Component, or a pointer to memory that is not an instance, passed to every one of the "
+            "32 functions that take one (and fmi2FreeInstance)",
+            "fmi2Error each (nobody to log to); fmi2FreeInstance ignores it",
+            "yes: no crash, the foreign memory untouched");
+}
+
+#ifndef _WIN32  // the FMI 3.0 functions are looked up with dlsym
+// Both libraries are built from the same sources: an instance made by one
+// has the right tag for the other, only its model definition differs. Each
+// library must serve its own model's instances only (issue 17.5), and the
+// FMI 3.0 entry points only instances made by fmi3Instantiate*.
+TEST_F(StateMachine, InstancesOfTheOtherModelOrFmiVersionAreErrors) {
+  FmuLibrary& inverse = inverse_library();
+  InverseFmu inv;
+  PlantFmu plant;
+  ASSERT_NE(inv.c, nullptr);
+  ASSERT_NE(plant.c, nullptr);
+  const fmi2ValueReference vr = 1;
+  for (auto [library, foreign] : {std::pair<FmuLibrary*, fmi2Component>{&lib, inv.c}, {&inverse, plant.c}}) {
+    double v = kCanary;
+    fmi2FMUstate state = nullptr;
+    EXPECT_EQ(library->fmi2SetReal(foreign, &vr, 1, &v), fmi2Error);
+    EXPECT_EQ(library->fmi2GetReal(foreign, &vr, 1, &v), fmi2Error);
+    EXPECT_EQ(v, kCanary);
+    EXPECT_EQ(library->fmi2SetupExperiment(foreign, fmi2False, 0, 0, fmi2False, 0), fmi2Error);
+    EXPECT_EQ(library->fmi2EnterInitializationMode(foreign), fmi2Error);
+    EXPECT_EQ(library->fmi2DoStep(foreign, 0.0, 1e-3, fmi2True), fmi2Error);
+    EXPECT_EQ(library->fmi2GetFMUstate(foreign, &state), fmi2Error);
+    EXPECT_EQ(state, nullptr);
+    EXPECT_EQ(library->fmi2Reset(foreign), fmi2Error);
+    library->fmi2FreeInstance(foreign);  // ignored: not this library's
+  }
+  // An FMI 2.0 instance handed to the same library's FMI 3.0 functions.
+  auto* fmi3_do_step = reinterpret_cast<fmi3DoStepTYPE*>(dlsym(lib.handle, "fmi3DoStep"));
+  auto* fmi3_get = reinterpret_cast<fmi3GetFloat64TYPE*>(dlsym(lib.handle, "fmi3GetFloat64"));
+  auto* fmi3_free = reinterpret_cast<fmi3FreeInstanceTYPE*>(dlsym(lib.handle, "fmi3FreeInstance"));
+  ASSERT_TRUE(fmi3_do_step && fmi3_get && fmi3_free);
+  fmi3Boolean event = fmi3False, terminate = fmi3False, early = fmi3False;
+  fmi3Float64 last = kCanary, v = kCanary;
+  const fmi3ValueReference vr3 = 1;
+  EXPECT_EQ(fmi3_do_step(plant.c, 0.0, 1e-3, fmi3True, &event, &terminate, &early, &last), fmi3Error);
+  EXPECT_EQ(fmi3_get(plant.c, &vr3, 1, &v, 1), fmi3Error);
+  EXPECT_EQ(v, kCanary);
+  fmi3_free(plant.c);  // ignored: an FMI 2.0 instance
+
+  // Both instances survived every call above and still work with their own library.
+  inv.initialize();
+  EXPECT_NEAR(inv.get("F[1]"), kStaticForce, 1e-9) << inv.log.dump();
+  plant.initialize();
+  for (int i = 1; i <= 4; ++i) ASSERT_EQ(plant.set(force_name(i), kStaticForce), fmi2OK);
+  ASSERT_EQ(plant.step(0.0, 1e-3), fmi2OK) << plant.log.dump();
+  EXPECT_NEAR(plant.get("z"), 0.05, 1e-12) << "held at rest by the static forces";
+  table_row("an instance of the inverse FMU passed to the plant library (and the reverse), and an FMI 2.0 instance "
+            "to the FMI 3.0 functions: SetReal, GetReal, SetupExperiment, EnterInitializationMode, DoStep, "
+            "GetFMUstate, Reset, FreeInstance",
+            "fmi2Error / fmi3Error each; FreeInstance ignores it; the instance keeps working with its own library",
+            "yes");
+}
+#endif  // _WIN32
+
+TEST_F(StateMachine, InstantiateWithBadArguments) {
+  Log log;
+  const fmi2CallbackFunctions f{&collect_log, &std::calloc, &std::free, nullptr, &log};
+  EXPECT_EQ(lib.fmi2Instantiate(nullptr, fmi2CoSimulation, PKM_FMU_PLANT_GUID, "", &f, fmi2False, fmi2False), nullptr);
+  EXPECT_EQ(lib.fmi2Instantiate("x", fmi2CoSimulation, nullptr, "", &f, fmi2False, fmi2False), nullptr);
+  EXPECT_EQ(lib.fmi2Instantiate("x", fmi2CoSimulation, "{00000000-0000-0000-0000-000000000000}", "", &f, fmi2False,
+                                fmi2False),
+            nullptr);
+  EXPECT_EQ(lib.fmi2Instantiate("x", static_cast<fmi2Type>(7), PKM_FMU_PLANT_GUID, "", &f, fmi2False, fmi2False),
+            nullptr);
+  EXPECT_EQ(log.messages.size(), 4u) << log.dump();
+  // No callbacks at all, no resource location: a working, silent instance.
+  fmi2Component c = lib.fmi2Instantiate("x", fmi2CoSimulation, PKM_FMU_PLANT_GUID, nullptr, nullptr, fmi2False,
+                                        fmi2True);
+  ASSERT_NE(c, nullptr);
+  EXPECT_EQ(lib.fmi2SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0), fmi2OK);
+  EXPECT_EQ(lib.fmi2EnterInitializationMode(c), fmi2OK);
+  EXPECT_EQ(lib.fmi2ExitInitializationMode(c), fmi2OK);
+  EXPECT_EQ(lib.fmi2DoStep(c, 0.0, -1.0, fmi2True), fmi2Error);  // an error with nobody to tell
+  EXPECT_EQ(lib.fmi2DoStep(c, 0.0, 1e-3, fmi2True), fmi2OK);
+  lib.fmi2FreeInstance(c);
+  table_row("fmi2Instantiate with instanceName NULL, GUID NULL or of another model, fmuType 7; "
+            "with no callback functions at all",
+            "NULL, with the reason logged when there is a logger; without callbacks: a working instance that logs "
+            "nothing",
+            "nothing to lose yet");
+}
+
+// The error policy (README "Error policy", instance.hpp) as a table: each
+// refusal, its status, and what the instance can still do without Reset.
+// Errors found before anything changed leave the instance as it was,
+// wherever they come from (FMI 2.0.4 allows an importer to give up after
+// any fmi2Error; this FMU guarantees more). Discard leaves a valid
+// instance: StepFailed (Co-Simulation) until a saved state is restored or
+// the importer terminates, the inputs' domain for a get.
+TEST_F(StateMachine, TheErrorPolicyAsATable) {
+  struct Row {
+    const char* refusal;
+    fmi2Status expected;
+    std::function<fmi2Status(PlantFmu&, double)> refuse;
+    const char* after;
+    std::function<void(PlantFmu&, double)> usable;
+  };
+  auto steps_on = [](PlantFmu& p, double t) {
+    drive_forces(p, t);
+    ASSERT_EQ(p.step(t, 1e-3), fmi2OK) << p.log.dump();
+  };
+  const Row rows[] = {
+      {"fmi2SetReal(F[1] = NaN)", fmi2Error, [](PlantFmu& p, double) { return p.set("F[1]", std::nan("")); },
+       "unchanged, StepComplete: the next step", steps_on},
+      {"fmi2DoStep(h = -1 ms)", fmi2Error, [](PlantFmu& p, double t) { return p.step(t, -1e-3); },
+       "unchanged, StepComplete: the next step", steps_on},
+      {"fmi2DoStep past stopTime (10 s)", fmi2Error, [](PlantFmu& p, double t) { return p.step(t, 20.0); },
+       "unchanged, StepComplete: the next step", steps_on},
+      {"fmi2SetFMUstate(state with time = NaN, checksum recomputed)", fmi2Error,
+       [&](PlantFmu& p, double) {
+         const std::vector<fmi2Byte> forged = forge(serialized_state(p), 55, std::nan(""));
+         fmi2FMUstate bad = nullptr;
+         EXPECT_EQ(lib.fmi2DeSerializeFMUstate(p.c, forged.data(), forged.size(), &bad), fmi2OK);
+         const fmi2Status s = lib.fmi2SetFMUstate(p.c, bad);
+         lib.fmi2FreeFMUstate(p.c, &bad);
+         return s;
+       },
+       "unchanged, StepComplete: the next step", steps_on},
+      {"fmi2DoStep with F[3] = 1e300 N (the step cannot be completed)", fmi2Discard,
+       [](PlantFmu& p, double t) {
+         EXPECT_EQ(p.set("F[3]", 1e300), fmi2OK);
+         return p.step(t, 1e-3);
+       },
+       "StepFailed, state at fmi2LastSuccessfulTime: gets and status; fmi2DoStep and fmi2SetReal are Errors; a "
+       "saved state restored, the steps go on",
+       [&](PlantFmu& p, double t) {
+         EXPECT_TRUE(p.terminated());
+         EXPECT_EQ(p.last_successful_time(), t);
+         EXPECT_TRUE(all_finite(p.outputs()));
+         EXPECT_EQ(p.step(t, 1e-3), fmi2Error);
+         EXPECT_EQ(p.set("F[3]", kStaticForce), fmi2Error);
+         PlantFmu fresh("fresh");
+         fresh.initialize();
+         fmi2FMUstate home = nullptr;
+         ASSERT_EQ(lib.fmi2GetFMUstate(fresh.c, &home), fmi2OK);
+         ASSERT_EQ(lib.fmi2SetFMUstate(p.c, home), fmi2OK) << p.log.dump();
+         lib.fmi2FreeFMUstate(fresh.c, &home);
+         drive_forces(p, 0.0);
+         EXPECT_EQ(p.step(0.0, 1e-3), fmi2OK) << p.log.dump();
+       }},
+  };
+  for (const Row& r : rows) {
+    SCOPED_TRACE(r.refusal);
+    PlantFmu p("policy");
+    ASSERT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 0.0, fmi2True, 10.0), fmi2OK);  // stopTime 10 s
+    ASSERT_EQ(p.enter(), fmi2OK);
+    ASSERT_EQ(p.exit(), fmi2OK);
+    double t = 0.0;
+    for (int k = 0; k < 3; ++k, t += 1e-3) steps_on(p, t);
+    const std::size_t logged = p.log.messages.size();
+    EXPECT_EQ(r.refuse(p, t), r.expected) << p.log.dump();
+    EXPECT_GT(p.log.messages.size(), logged) << "every refusal comes with its reason";
+    r.usable(p, t);
+    table_row(std::string("error policy: ") + r.refusal,
+              r.expected == fmi2Error ? "fmi2Error, reason logged" : "fmi2Discard, reason logged", r.after);
+  }
+  // Initialisation refused: still in initialization mode, the parameter can be corrected.
+  PlantFmu p("policy");
+  ASSERT_EQ(p.set("l", 0.0), fmi2OK);
+  ASSERT_EQ(p.setup(), fmi2OK);
+  ASSERT_EQ(p.enter(), fmi2OK);
+  EXPECT_EQ(p.exit(), fmi2Error);
+  EXPECT_TRUE(p.log.contains("l = 0 must be positive")) << p.log.dump();
+  ASSERT_EQ(p.set("l", 0.08), fmi2OK) << p.log.dump();
+  ASSERT_EQ(p.exit(), fmi2OK) << p.log.dump();
+  steps_on(p, 0.0);
+  table_row("error policy: fmi2ExitInitializationMode with l = 0", "fmi2Error, reason logged",
+            "InitializationMode: the parameter corrected, fmi2ExitInitializationMode succeeds (no fmi2Reset)");
+  // The inverse FMU: a get beyond a singularity guard.
+  InverseFmu inv;
+  inv.initialize();
+  const std::vector<double> good = inv.outputs();
+  ASSERT_EQ(inv.set("x", 0.0231306807897694 * (1.0 - 1e-9)), fmi2OK);  // leg 2's rod within 3e-5 rad of horizontal
+  const fmi2ValueReference F1 = inv.vr("F[1]");
+  double f = 0.0;
+  EXPECT_EQ(inv.lib.fmi2GetReal(inv.c, &F1, 1, &f), fmi2Discard) << inv.log.dump();
+  EXPECT_EQ(f, good[0]);
+  ASSERT_EQ(inv.set("x", 0.0), fmi2OK);
+  EXPECT_TRUE(bit_identical(inv.outputs(), good));
+  table_row("error policy: inverse fmi2GetReal at a pose beyond a singularity guard", "fmi2Discard, reason logged",
+            "the last good outputs handed out; inputs within the guards: fmi2OK again");
+}
+
+TEST_F(StateMachine, StatusKindsTheStandardDoesNotDefine) {
+  on_stepping_instance(
+      "fmi2GetStatus(fmi2LastSuccessfulTime), fmi2GetRealStatus(fmi2DoStepStatus), fmi2GetIntegerStatus(any), "
+      "fmi2GetBooleanStatus(fmi2DoStepStatus), fmi2GetStringStatus(fmi2PendingStatus) (nothing pending)",
+      fmi2Discard, "fmi2Discard (FMI 2.0: the status is not available), value untouched",
+      [&](PlantFmu& p, double) {
+        fmi2Status st = fmi2Pending;
+        fmi2Real r = kCanary;
+        fmi2Integer i = -5;
+        fmi2Boolean b = -5;
+        fmi2String str = "canary";
+        std::vector<fmi2Status> s = {lib.fmi2GetStatus(p.c, fmi2LastSuccessfulTime, &st),
+                                     lib.fmi2GetRealStatus(p.c, fmi2DoStepStatus, &r),
+                                     lib.fmi2GetIntegerStatus(p.c, fmi2DoStepStatus, &i),
+                                     lib.fmi2GetBooleanStatus(p.c, fmi2DoStepStatus, &b),
+                                     lib.fmi2GetStringStatus(p.c, fmi2PendingStatus, &str)};
+        EXPECT_EQ(st, fmi2Pending);
+        EXPECT_EQ(r, kCanary);
+        EXPECT_EQ(i, -5);
+        EXPECT_EQ(b, -5);
+        EXPECT_STREQ(str, "canary");
+        return s;
+      },
+      /*expect_message=*/false);
+}
+
+}  // namespace

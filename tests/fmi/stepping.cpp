@@ -1,0 +1,370 @@
+// Communication steps of the FMU binaries through the raw FMI 2.0
+// functions: the static forces hold the home pose (CVODE and RK4), a failed
+// step is discarded with the last good state kept, input derivatives are
+// interpolated within a step, the inverse FMU's static forces and its
+// refusal of unreachable poses; bad, overflowing, vanishing, too long and
+// past-stopTime steps, huge finite inputs, and the motion's independence of
+// the start time.
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fmi2FunctionTypes.h"
+#include "fmu_fixture.hpp"
+#include "models.hpp"
+
+namespace {
+
+using namespace pkm_test;
+
+class Stepping : public FmuTest {};
+
+TEST_F(Stepping, HoldsTheHomePoseWithTheStaticForces) {
+  PlantFmu p;
+  ASSERT_NE(p.c, nullptr);
+  p.initialize();
+  for (int i = 1; i <= 4; ++i) ASSERT_EQ(p.set("F[" + std::to_string(i) + "]", kStaticForce), fmi2OK);
+  double t = 0.0;
+  double worst = 0.0;
+  for (int k = 0; k < 2000; ++k) {
+    ASSERT_EQ(lib.fmi2DoStep(p.c, t, 1e-3, fmi2True), fmi2OK) << "step " << k << "\n" << p.log.dump();
+    t = (k + 1) * 1e-3;
+    const double dev[4] = {p.get("x"), p.get("y"), p.get("z") - 0.05, p.get("phi")};
+    for (double d : dev) worst = std::max(worst, std::abs(d));
+  }
+  EXPECT_LE(worst, 1e-9) << "largest deviation from the home pose over 2 s";
+  double last;
+  ASSERT_EQ(lib.fmi2GetRealStatus(p.c, fmi2LastSuccessfulTime, &last), fmi2OK);
+  EXPECT_NEAR(last, 2.0, 1e-12);
+  EXPECT_LT(p.get("constraint_residual"), 1e-12);
+  EXPECT_NEAR(p.get("rho[1]"), 0.0443193423, 1e-10);  // MODEL_SPEC golden pose
+  EXPECT_NEAR(p.get("theta2[2]"), -0.8606121019, 1e-10);
+  EXPECT_TRUE(std::isfinite(p.get("jacobian_condition")));
+  EXPECT_EQ(lib.fmi2Terminate(p.c), fmi2OK);
+  EXPECT_TRUE(p.log.messages.empty()) << p.log.dump();
+}
+
+TEST_F(Stepping, Rk4HoldsTheHomePoseToo) {
+  PlantFmu p;
+  ASSERT_EQ(p.set_int("solver", 1), fmi2OK);
+  p.initialize();
+  for (int i = 1; i <= 4; ++i) ASSERT_EQ(p.set("F[" + std::to_string(i) + "]", kStaticForce), fmi2OK);
+  for (int k = 0; k < 200; ++k) ASSERT_EQ(lib.fmi2DoStep(p.c, k * 1e-2, 1e-2, fmi2True), fmi2OK);
+  EXPECT_NEAR(p.get("z"), 0.05, 1e-9);
+  EXPECT_NEAR(p.get("x"), 0.0, 1e-9);
+}
+
+TEST_F(Stepping, AFailedStepIsDiscardedWithTheLastGoodStateKept) {
+  for (int solver : {0, 1}) {
+    SCOPED_TRACE(solver == 0 ? "CVODE" : "RK4");
+    PlantFmu p;
+    ASSERT_EQ(p.set_int("solver", solver), fmi2OK);
+    p.initialize();
+    // A large horizontal push drives the platform out of the workspace.
+    ASSERT_EQ(p.set("Fe[1]", 50.0), fmi2OK);
+    double t = 0.0;
+    const double h = 0.01;
+    fmi2Status st = fmi2OK;
+    fmi2FMUstate good = nullptr;
+    int k = 0;
+    for (; k < 100; ++k) {
+      ASSERT_EQ(lib.fmi2GetFMUstate(p.c, &good), fmi2OK);
+      st = lib.fmi2DoStep(p.c, t, h, fmi2True);
+      if (st != fmi2OK) break;
+      t += h;
+    }
+    ASSERT_EQ(st, fmi2Discard) << "after " << k << " steps\n" << p.log.dump();
+    EXPECT_TRUE(p.log.contains("failed")) << p.log.dump();  // discards are reported by default
+    EXPECT_EQ(p.log.messages.back().status, fmi2Discard);
+    double last = -1.0;
+    ASSERT_EQ(lib.fmi2GetRealStatus(p.c, fmi2LastSuccessfulTime, &last), fmi2OK);
+    EXPECT_GE(last, t);
+    EXPECT_LT(last, t + h);
+    if (solver == 0) {
+      EXPECT_EQ(last, t) << "CVODE keeps the state of the step start";
+    }
+    fmi2Boolean terminated = fmi2False;
+    ASSERT_EQ(lib.fmi2GetBooleanStatus(p.c, fmi2Terminated, &terminated), fmi2OK);
+    EXPECT_EQ(terminated, fmi2True);
+    // The outputs at the last good point are finite.
+    for (double v : p.outputs()) EXPECT_TRUE(std::isfinite(v));
+    EXPECT_LT(p.get("constraint_residual"), 1e-9);
+    // No further steps; but back to a saved state, the instance can go on.
+    EXPECT_EQ(lib.fmi2DoStep(p.c, last, h, fmi2True), fmi2Error);
+    ASSERT_EQ(lib.fmi2SetFMUstate(p.c, good), fmi2OK) << p.log.dump();
+    ASSERT_EQ(p.set("Fe[1]", 0.0), fmi2OK);
+    EXPECT_EQ(lib.fmi2DoStep(p.c, t, 1e-3, fmi2True), fmi2OK) << p.log.dump();
+    lib.fmi2FreeFMUstate(p.c, &good);
+  }
+}
+
+TEST_F(Stepping, InputDerivativesInterpolateWithinAStep) {
+  // One step of 20 ms with F = F0 + dF (t - t0) against 200 steps of 0.1 ms
+  // with the inputs held at their midpoint values: the same ramp, sampled.
+  // RK4 with 0.1 ms steps in both, so that the only difference is the
+  // sampling, O(1/n^2) relative (CVODE's rtol would hide it).
+  PlantFmu ramp, steps;
+  for (PlantFmu* p : {&ramp, &steps}) {
+    ASSERT_EQ(p->set_int("solver", 1), fmi2OK);
+    ASSERT_EQ(p->set("rk4_step", 1e-4), fmi2OK);
+    p->initialize();
+  }
+  const double F0 = kStaticForce, dF = 0.5, T = 0.02;
+  for (int i = 1; i <= 4; ++i) {
+    const std::string F = "F[" + std::to_string(i) + "]";
+    ASSERT_EQ(ramp.set(F, F0), fmi2OK);
+    ASSERT_EQ(ramp.set_derivative(F, i == 1 ? dF : 0.0), fmi2OK);
+  }
+  ASSERT_EQ(lib.fmi2DoStep(ramp.c, 0.0, T, fmi2True), fmi2OK);
+  const int n = 200;
+  for (int k = 0; k < n; ++k) {
+    const double tm = (k + 0.5) * T / n;
+    for (int i = 1; i <= 4; ++i)
+      ASSERT_EQ(steps.set("F[" + std::to_string(i) + "]", F0 + (i == 1 ? dF * tm : 0.0)), fmi2OK);
+    ASSERT_EQ(lib.fmi2DoStep(steps.c, k * T / n, T / n, fmi2True), fmi2OK);
+  }
+  const double dz = ramp.get("z") - 0.05;
+  EXPECT_GT(std::abs(dz), 1e-8) << "the ramp moved the platform";
+  EXPECT_NEAR(ramp.get("z"), steps.get("z"), 1e-4 * std::abs(dz));
+  EXPECT_NEAR(ramp.get("dz"), steps.get("dz"), 1e-4 * std::abs(ramp.get("dz")));
+  // After the step the input holds its value at the new time ...
+  EXPECT_NEAR(ramp.get("F[1]"), F0 + dF * T, 1e-15);
+  EXPECT_EQ(ramp.get("F[2]"), F0);
+  // ... and setting the value clears the derivative: constant from now on.
+  PlantFmu held;
+  held.initialize();
+  for (int i = 1; i <= 4; ++i) {
+    const std::string F = "F[" + std::to_string(i) + "]";
+    ASSERT_EQ(held.set_derivative(F, 3.0), fmi2OK);
+    ASSERT_EQ(held.set(F, kStaticForce), fmi2OK);
+  }
+  for (int k = 0; k < 10; ++k) ASSERT_EQ(lib.fmi2DoStep(held.c, k * 1e-2, 1e-2, fmi2True), fmi2OK);
+  EXPECT_NEAR(held.get("z"), 0.05, 1e-12);
+  EXPECT_EQ(held.get("F[1]"), kStaticForce);
+  // Higher orders are ignored with a warning; non-inputs are errors.
+  const fmi2ValueReference f1 = ramp.vr("F[1]"), x = ramp.vr("x");
+  const fmi2Integer order2 = 2;
+  const double one = 1.0;
+  EXPECT_EQ(lib.fmi2SetRealInputDerivatives(ramp.c, &f1, 1, &order2, &one), fmi2Warning);
+  EXPECT_EQ(ramp.set_derivative("x", 1.0), fmi2Error);
+  (void)x;
+  // The inverse FMU does not interpolate.
+  InverseFmu inv;
+  EXPECT_EQ(inv.set_derivative("x", 1.0), fmi2Error);
+}
+
+
+TEST_F(Stepping, InverseAtRestAtHomeGivesTheStaticForces) {
+  InverseFmu inv;
+  ASSERT_NE(inv.c, nullptr);
+  inv.initialize();
+  FmuLibrary& ilib = inverse_library();
+  double sum = 0.0;
+  for (int i = 1; i <= 4; ++i) {
+    const double F = inv.get("F[" + std::to_string(i) + "]");
+    EXPECT_NEAR(F, kStaticForce, 1e-9) << "F[" << i << "]";
+    sum += F;
+  }
+  EXPECT_NEAR(sum, 10.622464200, 1e-9);
+  EXPECT_NEAR(inv.get("rho[2]"), 0.0443193423, 1e-10);
+  EXPECT_EQ(inv.get("drho[2]"), 0.0);
+  // Time advances; the outputs follow the inputs at each communication point.
+  ASSERT_EQ(ilib.fmi2DoStep(inv.c, 0.0, 1e-3, fmi2True), fmi2OK);
+  ASSERT_EQ(inv.set("x", 0.005), fmi2OK);
+  ASSERT_EQ(inv.set("y", -0.005), fmi2OK);
+  ASSERT_EQ(inv.set("z", 0.07), fmi2OK);
+  ASSERT_EQ(inv.set("phi", 4.0 * kPi / 180.0), fmi2OK);
+  EXPECT_NEAR(inv.get("rho[1]"), 0.0676488698, 1e-10);  // MODEL_SPEC golden pose
+  EXPECT_NEAR(inv.get("rho[4]"), 0.0792527515, 1e-10);
+  // Gravity off, at rest: no force.
+  InverseFmu zero_g;
+  ASSERT_EQ(zero_g.set("g", 0.0), fmi2OK);
+  zero_g.initialize();
+  for (int i = 1; i <= 4; ++i) EXPECT_NEAR(zero_g.get("F[" + std::to_string(i) + "]"), 0.0, 1e-15);
+}
+
+TEST_F(Stepping, InverseRejectsAnUnreachablePoseWithoutNaN) {
+  InverseFmu inv;
+  inv.initialize();
+  FmuLibrary& ilib = inverse_library();
+  ASSERT_EQ(inv.set("x", 0.2), fmi2OK);
+  const fmi2ValueReference F1 = inv.vr("F[1]");
+  double value = 12345.0;
+  EXPECT_EQ(ilib.fmi2GetReal(inv.c, &F1, 1, &value), fmi2Error);
+  EXPECT_EQ(value, 12345.0) << "nothing written";
+  EXPECT_TRUE(inv.log.contains("unreachable")) << inv.log.dump();
+  // Reachable again: outputs again.
+  ASSERT_EQ(inv.set("x", 0.0), fmi2OK);
+  EXPECT_NEAR(inv.get("F[1]"), kStaticForce, 1e-9);
+}
+
+TEST_F(Stepping, BadCommunicationSteps) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  on_stepping_instance(
+      "fmi2DoStep with communicationStepSize 0, -1e-3, NaN, +Inf, -Inf",
+      fmi2Error, "fmi2Error, \"communicationStepSize = ... must be positive and finite; the call has no effect\"",
+      [&](PlantFmu& p, double t) {
+        return std::vector<fmi2Status>{p.step(t, 0.0), p.step(t, -1e-3), p.step(t, nan), p.step(t, inf),
+                                       p.step(t, -inf)};
+      });
+  on_stepping_instance(
+      "fmi2DoStep whose currentCommunicationPoint is not the FMU's time: t + 1 ms (skipping ahead), t - 1 ms "
+      "(going back), 0, NaN, +Inf",
+      fmi2Error,
+      "fmi2Error, \"currentCommunicationPoint = ... differs from the FMU's time ...; the call has no effect\"",
+      [&](PlantFmu& p, double t) {
+        return std::vector<fmi2Status>{p.step(t + 1e-3, 1e-3), p.step(t - 1e-3, 1e-3), p.step(0.0, 1e-3),
+                                       p.step(nan, 1e-3), p.step(inf, 1e-3)};
+      });
+}
+
+TEST_F(Stepping, AStepWhoseEndOverflowsIsAnError) {
+  PlantFmu p;
+  ASSERT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 1e308, fmi2False, 0.0), fmi2OK);
+  ASSERT_EQ(p.enter(), fmi2OK);
+  ASSERT_EQ(p.exit(), fmi2OK);
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(1e308, 1e308), fmi2Error);
+  EXPECT_TRUE(p.log.contains("is not finite; the call has no effect")) << p.log.dump();
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  EXPECT_EQ(p.last_successful_time(), 1e308);
+  table_row("startTime = 1e308, then fmi2DoStep(1e308, 1e308): the step's end overflows to +Inf",
+            "fmi2Error, \"currentCommunicationPoint + communicationStepSize = inf is not finite; the call has no "
+            "effect\"",
+            "yes: every variable bit-identical, time unchanged");
+}
+
+// Issue 17.7: at t = 1e15 a 1 ms step rounds away (the spacing of doubles
+// there is 0.125 s): answering OK would advance nothing.
+TEST_F(Stepping, AStepThatVanishesInTPlusHIsAnError) {
+  PlantFmu p;
+  ASSERT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 1e15, fmi2False, 0.0), fmi2OK);
+  ASSERT_EQ(p.enter(), fmi2OK);
+  ASSERT_EQ(p.exit(), fmi2OK);
+  ASSERT_EQ(1e15 + 1e-3, 1e15);  // the premise
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(1e15, 1e-3), fmi2Error);
+  EXPECT_TRUE(p.log.contains("vanishes at currentCommunicationPoint")) << p.log.dump();
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  // The instance stays usable: a step that does advance.
+  EXPECT_EQ(p.step(1e15, 1.0), fmi2OK) << p.log.dump();
+  EXPECT_EQ(p.last_successful_time(), 1e15 + 1.0);
+  table_row("startTime = 1e15, then fmi2DoStep(1e15, 1e-3): t + h == t in double precision",
+            "fmi2Error, \"communicationStepSize = 0.001 vanishes at currentCommunicationPoint = 1e+15 ...\"",
+            "yes: every variable bit-identical; a later step of 1 s succeeds");
+}
+
+// Issue 17.7: at startTime 1e9 s, t + 1 ms rounds to a multiple of 0.12 us;
+// the model used to integrate (t + h) - t, 7e-5 s lost over 1 s. It
+// integrates the time since start: the motion is that of a start at 0.
+TEST_F(Stepping, TheMotionDoesNotDependOnTheStartTime) {
+  for (int solver : {0, 1}) {
+    SCOPED_TRACE(solver == 0 ? "CVODE" : "RK4");
+    PlantFmu late("late"), early("early");
+    for (PlantFmu* p : {&late, &early}) {
+      ASSERT_EQ(p->set_int("solver", solver), fmi2OK);
+      const double start = p == &late ? 1e9 : 0.0;
+      ASSERT_EQ(lib.fmi2SetupExperiment(p->c, fmi2False, 0.0, start, fmi2False, 0.0), fmi2OK);
+      ASSERT_EQ(p->enter(), fmi2OK);
+      ASSERT_EQ(p->exit(), fmi2OK);
+      double t = start;
+      for (int k = 0; k < 1000; ++k) {
+        drive_forces(*p, k * 1e-3);  // the same forces at the same time since start
+        ASSERT_EQ(p->step(t, 1e-3), fmi2OK) << p->log.dump();
+        t += 1e-3;  // as a master counts: at 1e9 each addition rounds
+      }
+      EXPECT_EQ(p->get("time"), t) << "the FMU's time is the master's";
+    }
+    EXPECT_TRUE(bit_identical(late.outputs(), early.outputs()))
+        << "x after 1 s: " << late.get("x") << " (start 1e9) vs " << early.get("x") << " (start 0)";
+  }
+  table_row("startTime = 1e9 s, 1000 steps of 1 ms (the master's t += h rounds at every step), CVODE and RK4",
+            "fmi2OK; the model integrates the time since start (the sum of the step sizes)",
+            "yes: every output after 1 s bit-identical to a run started at 0");
+}
+
+TEST_F(Stepping, AStepTooLongForCvodeIsDiscarded) {
+  PlantFmu p;
+  p.initialize();
+  for (int i = 1; i <= 4; ++i) ASSERT_EQ(p.set(force_name(i), kStaticForce + 0.01 * i), fmi2OK);
+  ASSERT_EQ(p.step(0.0, 1e-3), fmi2OK);
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(1e-3, 1e6), fmi2Discard);
+  EXPECT_TRUE(p.log.contains("mxstep")) << p.log.dump();
+  EXPECT_TRUE(p.terminated());
+  EXPECT_EQ(p.last_successful_time(), 1e-3);
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  table_row("CVODE, fmi2DoStep(h = 1e6 s): more than CVODE's 100000 internal steps",
+            "fmi2Discard, fmi2Terminated = true (\"CVODE ... mxstep steps taken before reaching tout\")",
+            "yes: every variable bit-identical at fmi2LastSuccessfulTime = the step start");
+}
+
+TEST_F(Stepping, AStepPastTheStopTimeIsAnError) {
+  PlantFmu p;
+  ASSERT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 0.0, fmi2True, 0.01), fmi2OK);
+  ASSERT_EQ(p.enter(), fmi2OK);
+  ASSERT_EQ(p.exit(), fmi2OK);
+  for (int i = 1; i <= 4; ++i) ASSERT_EQ(p.set(force_name(i), kStaticForce), fmi2OK);
+  for (int k = 0; k < 9; ++k) ASSERT_EQ(p.step(k * 1e-3, 1e-3), fmi2OK);
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(0.009, 2e-3), fmi2Error);
+  EXPECT_TRUE(p.log.contains("would pass stopTime")) << p.log.dump();
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  EXPECT_EQ(p.step(0.009, 1e-3 + 1e-15), fmi2OK) << "rounding of the last step is tolerated\n" << p.log.dump();
+  EXPECT_EQ(p.step(0.01, 1e-3), fmi2Error);
+  table_row("fmi2SetupExperiment(stopTimeDefined, stopTime = 0.01 s), then fmi2DoStep(0.009, 0.002) past it",
+            "fmi2Error (FMI 2.0: computing past a defined stopTime), \"the step to t = 0.011 would pass stopTime "
+            "= 0.01 ...; the call has no effect\"",
+            "yes: every variable bit-identical; the step to exactly stopTime (within 1e-9 relative) succeeds");
+}
+
+TEST_F(Stepping, TooManyRk4StepsAreRefusedBeforeAnyWork) {
+  // The smallest rk4_step its range allows (1e-6 s): a 20 s step needs 2e7
+  // RK4 steps, twice the work budget (1e7, about 25 s of computing).
+  PlantFmu p("refused"), twin("twin");
+  for (PlantFmu* q : {&p, &twin}) {
+    ASSERT_EQ(q->set_int("solver", 1), fmi2OK);
+    ASSERT_EQ(q->set("rk4_step", 1e-6), fmi2OK);
+    q->initialize();
+    drive_forces(*q, 0.0);
+  }
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(0.0, 20.0), fmi2Error);
+  EXPECT_TRUE(p.log.contains("more than the work budget of 1e+07")) << p.log.dump();
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  // Usable as it was (no Reset, no SetFMUstate): the next step is the twin's.
+  ASSERT_EQ(p.step(0.0, 1e-3), fmi2OK) << p.log.dump();
+  ASSERT_EQ(twin.step(0.0, 1e-3), fmi2OK);
+  EXPECT_TRUE(bit_identical(p.outputs(), twin.outputs()));
+  table_row("RK4 with rk4_step = 1e-6 s (the smallest its range allows), then fmi2DoStep(h = 20 s): 2e7 RK4 steps",
+            "fmi2Error at once, \"a communication step of 20 s needs 2e+07 RK4 steps of rk4_step = 1e-06 s, more "
+            "than the work budget of 1e+07 per step ...; the call has no effect\"",
+            "yes: every variable bit-identical; the next step bit-identical to an untouched twin's");
+}
+
+TEST_F(Stepping, HugeFiniteInputsEndTheStepWithADiscard) {
+  for (int solver : {0, 1}) {
+    PlantFmu p;
+    ASSERT_EQ(p.set_int("solver", solver), fmi2OK);
+    p.initialize();
+    const std::vector<double> before = p.outputs();
+    ASSERT_EQ(p.set("F[3]", 1e300), fmi2OK);
+    EXPECT_EQ(p.step(0.0, 1e-3), fmi2Discard) << p.log.dump();
+    EXPECT_TRUE(p.terminated());
+    EXPECT_EQ(p.last_successful_time(), 0.0);
+    const std::vector<double> after = p.outputs();
+    EXPECT_TRUE(all_finite(after));
+    // The state is that of t = 0; only lambda (which depends on the input at t) differs.
+    for (std::size_t k = 0; k < 24; ++k) EXPECT_EQ(after[k], before[k]) << "pose, velocity, rho, drho, theta1, theta2";
+  }
+  table_row("F[3] = 1e300 N (finite, absurd), then fmi2DoStep, CVODE and RK4",
+            "fmi2Discard, fmi2Terminated = true (RK4: \"pose unreachable\"; CVODE: \"the corrector convergence test "
+            "failed repeatedly or with |h| = hmin\" -- before the fixes CVODE 6.4 reported success there, with the "
+            "state unchanged)",
+            "yes: pose and velocity bit-identical at fmi2LastSuccessfulTime = 0, all outputs finite");
+}
+
+}  // namespace
