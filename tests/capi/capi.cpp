@@ -189,7 +189,7 @@ struct MachineHandle {
 // Fourth-order central difference of s -> f(s)[0..3] at s = 0.
 template <class F>
 void d_ds4(F f, double h, double out[4]) {
-  double a[4], b[4], c[4], d[4];
+  double a[4] = {}, b[4] = {}, c[4] = {}, d[4] = {};  // zero if f stops at a failed assertion
   f(-2 * h, a), f(-h, b), f(h, c), f(2 * h, d);
   for (int i = 0; i < 4; ++i) out[i] = (a[i] - 8 * b[i] + 8 * c[i] - d[i]) / (12 * h);
 }
