@@ -35,7 +35,9 @@
  * Prints a Markdown table. Exit status 0, 1 on any failure. */
 #define _GNU_SOURCE
 
+#if defined(__GLIBC__) || defined(__linux__)
 #include <malloc.h>
+#endif
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -273,6 +275,7 @@ int main(int argc, char** argv) {
     printf("\n");
   }
 
+#if defined(__GLIBC__)
   /* Memory per instance (CVODE default: its objects are created at initialisation; RK4 beside it). */
   for (i = 0; i < N_SOLVERS; i += 2) {
     fmi2Component cs[N_MEMORY];
@@ -286,6 +289,10 @@ int main(int argc, char** argv) {
     printf("| memory per instance, %s, initialised (heap in use / %d instances) | %.1f kB | | |\n", solvers[i].name,
            N_MEMORY, (double)(after.uordblks + after.hblkhd - before.uordblks - before.hblkhd) / N_MEMORY / 1024.0);
   }
+
+#else
+  printf("| memory per instance | not measured (needs glibc's mallinfo2) | | |\n");
+#endif
 
   /* Instantiate + initialise, and free. */
   for (i = 0; i < N_SOLVERS; i += 2) {
