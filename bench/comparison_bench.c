@@ -26,6 +26,16 @@
  *                   rk4_step 1 ms)
  *   fmu_cvode       the same with solver = 0 (CVODE, rtol 1e-8, atol 1e-10;
  *                   the FMU restarts it every communication step)
+ *   fmu_rk4_ctrl12  fmu_rk4 reading the 12 controller outputs (x, y, z, phi,
+ *                   their rates, rho[1..4]) instead of the pose: a control
+ *                   tick (issue 16 item 3, against MuJoCo's RK4)
+ *   fmu_cvode_ramp_ctrl12  CVODE at its defaults, the forces as a continuous
+ *                   ramp: each tick fmi2SetReal(F at t_k) and
+ *                   fmi2SetRealInputDerivatives(slope (F(t_k+1) - F(t_k))/h),
+ *                   the piecewise-linear interpolation of the sine through the
+ *                   tick values, so each tick's value continues the last
+ *                   tick's ramp and CVODE keeps its history across ticks;
+ *                   + fmi2GetReal of the 12 controller outputs
  * Timing: a batch is 1 simulated second from rest at P0 (the initial state is
  * set up outside the timed region: pkm_init_pose, or fmi2SetFMUstate to the
  * state saved after initialisation); one untimed warm-up batch, then N timed
@@ -239,12 +249,14 @@ static int value_reference(const char* text, const char* name, fmi2ValueReferenc
 
 typedef struct {
   char guid[128];
-  fmi2ValueReference F[4], pose[4], rho1, residual, solver, rk4_step, g, z0;
+  fmi2ValueReference F[4], pose[4], control[12], rho1, residual, solver, rk4_step, g, z0;
 } Fmi;
 
 static int read_model_description(const char* xml, Fmi* md) {
   static const char* f_names[] = {"F[1]", "F[2]", "F[3]", "F[4]"};
   static const char* pose_names[] = {"x", "y", "z", "phi"};
+  static const char* control_names[12] = {"x",  "y",  "z",      "phi",    "dx",     "dy",
+                                          "dz", "dphi", "rho[1]", "rho[2]", "rho[3]", "rho[4]"};
   char* text = read_text(xml);
   const char *root, *root_end;
   int i, ok = 1;
@@ -260,6 +272,7 @@ static int read_model_description(const char* xml, Fmi* md) {
   }
   for (i = 0; ok && i < 4; ++i)
     ok = value_reference(text, f_names[i], &md->F[i]) && value_reference(text, pose_names[i], &md->pose[i]);
+  for (i = 0; ok && i < 12; ++i) ok = value_reference(text, control_names[i], &md->control[i]);
   ok = ok && value_reference(text, "rho[1]", &md->rho1) &&
        value_reference(text, "constraint_residual", &md->residual) &&
        value_reference(text, "solver", &md->solver) && value_reference(text, "rk4_step", &md->rk4_step) &&
@@ -277,11 +290,30 @@ static int read_model_description(const char* xml, Fmi* md) {
     }                                                                                                \
   } while (0)
 
-static int run_fmu(const Fmu* f, const Fmi* md, int solver, int batches, const char* out_dir, Result* res) {
+/* The forces of tick k (from t = k h to t + h) as a master gives them: held
+ * at the midpoint value, or (ramp) the value at t with the slope to the next
+ * tick's value, so the inputs are continuous from tick to tick. */
+static void tick_forces(int k, int ramp, double F[4], double dF[4]) {
+  const double t = (double)k * STEP;
+  int i;
+  if (!ramp) {
+    forces(t + 0.5 * STEP, F);
+    return;
+  }
+  forces(t, F);
+  forces(t + STEP, dF);
+  for (i = 0; i < 4; ++i) dF[i] = (dF[i] - F[i]) / STEP;
+}
+
+/* n_out: 4 (the pose) or 12 (the controller outputs); ramp: see tick_forces. */
+static int run_fmu(const Fmu* f, const Fmi* md, int solver, int ramp, int n_out, int batches, const char* out_dir,
+                   Result* res) {
   fmi2CallbackFunctions callbacks = {logger, allocate_memory, free, NULL, NULL};
   fmi2FMUstate home = NULL;
   fmi2Component c;
-  double per[MAX_BATCHES], F[4], pose[4];
+  const fmi2Integer order[4] = {1, 1, 1, 1};
+  const fmi2ValueReference* out_vr = n_out == 12 ? md->control : md->pose;
+  double per[MAX_BATCHES], F[4], dF[4], out[12];
   const fmi2Real g = 0.0, z0 = P0[2], rk4_step = STEP;
   const fmi2Integer solver_value = solver;
   int b, k, ok = 1;
@@ -304,11 +336,11 @@ static int run_fmu(const Fmu* f, const Fmi* md, int solver, int batches, const c
     FMI_CHECK(f->fmi2SetFMUstate(c, home));
     t0 = now_seconds();
     for (k = 0; k < STEPS_TIMED; ++k) {
-      const double t = (double)k * STEP;
-      forces(t + 0.5 * STEP, F);
+      tick_forces(k, ramp, F, dF);
       FMI_CHECK(f->fmi2SetReal(c, md->F, 4, F));
-      FMI_CHECK(f->fmi2DoStep(c, t, STEP, fmi2True));
-      FMI_CHECK(f->fmi2GetReal(c, md->pose, 4, pose));
+      if (ramp) FMI_CHECK(f->fmi2SetRealInputDerivatives(c, md->F, 4, order, dF));
+      FMI_CHECK(f->fmi2DoStep(c, (double)k * STEP, STEP, fmi2True));
+      FMI_CHECK(f->fmi2GetReal(c, out_vr, (size_t)n_out, out));
     }
     if (b >= 0) per[b] = now_seconds() - t0;
   }
@@ -319,8 +351,9 @@ static int run_fmu(const Fmu* f, const Fmi* md, int solver, int batches, const c
   for (k = 0; k <= STEPS_TEST; ++k) {
     const double t = (double)k * STEP;
     if (k > 0) {
-      forces(t - 0.5 * STEP, F);
+      tick_forces(k - 1, ramp, F, dF);
       FMI_CHECK(f->fmi2SetReal(c, md->F, 4, F));
+      if (ramp) FMI_CHECK(f->fmi2SetRealInputDerivatives(c, md->F, 4, order, dF));
       FMI_CHECK(f->fmi2DoStep(c, t - STEP, STEP, fmi2True));
     }
     rows[k].v[0] = t;
@@ -348,7 +381,7 @@ int main(int argc, char** argv) {
   const char* xml_arg = NULL;
   char* xml = NULL;
   int batches = 21, i, ok = 1, n = 0;
-  Result results[7];
+  Result results[9];
   Fmu fmu;
   Fmi md;
   pkm_solver_settings rk4, cvode, cvode_tight;
@@ -407,14 +440,18 @@ int main(int argc, char** argv) {
   results[n] = (Result){"capi_cvode_one_call", "C API, CVODE rtol 1e-12, one call", 0, 0, 0};
   ok = ok && run_capi(&cvode_tight, 1, batches, out_dir, &results[n++]);
   results[n] = (Result){"fmu_rk4", "plant FMU, RK4 1 ms, midpoint-held F", 0, 0, 0};
-  ok = ok && run_fmu(&fmu, &md, 1, batches, out_dir, &results[n++]);
+  ok = ok && run_fmu(&fmu, &md, 1, 0, 4, batches, out_dir, &results[n++]);
   results[n] = (Result){"fmu_cvode", "plant FMU, CVODE rtol 1e-8, midpoint-held F", 0, 0, 0};
-  ok = ok && run_fmu(&fmu, &md, 0, batches, out_dir, &results[n++]);
+  ok = ok && run_fmu(&fmu, &md, 0, 0, 4, batches, out_dir, &results[n++]);
+  results[n] = (Result){"fmu_rk4_ctrl12", "plant FMU, RK4 1 ms, held F, 12 outputs", 0, 0, 0};
+  ok = ok && run_fmu(&fmu, &md, 1, 0, 12, batches, out_dir, &results[n++]);
+  results[n] = (Result){"fmu_cvode_ramp_ctrl12", "plant FMU, CVODE 1e-8, F as ramp, 12 outputs", 0, 0, 0};
+  ok = ok && run_fmu(&fmu, &md, 0, 1, 12, batches, out_dir, &results[n++]);
 
   if (ok) {
-    printf("%-18s %-44s %14s %14s %16s\n", "case", "what", "median ms/s", "min ms/s", "max ||C|| (m)");
+    printf("%-22s %-44s %14s %14s %16s\n", "case", "what", "median ms/s", "min ms/s", "max ||C|| (m)");
     for (i = 0; i < n; ++i)
-      printf("%-18s %-44s %14.4f %14.4f %16.2e\n", results[i].name, results[i].what, 1e3 * results[i].median_s,
+      printf("%-22s %-44s %14.4f %14.4f %16.2e\n", results[i].name, results[i].what, 1e3 * results[i].median_s,
              1e3 * results[i].min_s, results[i].max_c);
   }
   if (ok && out_dir) {

@@ -9,7 +9,8 @@ step, through
   MuJoCo         mj_step, RK4, 1 ms, the stiffest connect constraints
                  (pkm4puu.references.mujoco_model), timed in
                  mujoco.rollout (MuJoCo's own C loop) and, for context, in a
-                 Python loop of mj_step;
+                 Python loop of mj_step (its Python overhead per step is
+                 printed);
   Pinocchio      constrained forward dynamics: fixed-step RK4 at 1 ms around
                  pinocchio.constraintDynamics (C++), the loop in Python; and,
                  for context, the 4000 bare constraintDynamics calls alone;
@@ -31,6 +32,13 @@ that a burst of load on a shared machine spreads over all cases; the table
 gives the median of the rounds' medians and the best batch. The C harness
 also runs two one-call C API cases (the simulated second as a single
 pkm_advance_fn: RK4 at 1 ms, and CVODE rtol 1e-12 taking its own steps).
+
+Issue 16 item 3: two control-tick cases of the plant FMU (step + the 12
+controller outputs: RK4 with midpoint-held forces, and CVODE at its default
+tolerances with the forces as a continuous ramp, value and slope each tick)
+are printed against their targets (15x and 10x MuJoCo's mj_step). Both sides
+are C loops (the C harness, mujoco.rollout), so neither pays Python's
+per-call overhead.
 
 usage: .venv/bin/python bench/engines_bench.py [--build DIR] [--rounds R] [--batches B] [--markdown FILE]
 """
@@ -250,6 +258,9 @@ LABELS = {  # harness case: (label, how the forces reach the integrator)
     "capi_cvode_tight": ("this project, C API: CVODE (rtol 1e-12), stop every 1 ms", "at solver times"),
     "fmu_rk4": ("this project, plant FMU (C harness): RK4, 1 ms, + get x, y, z, φ", "midpoint-held"),
     "fmu_cvode": ("this project, plant FMU (C harness): CVODE (rtol 1e-8), + get x, y, z, φ", "midpoint-held"),
+    "fmu_rk4_ctrl12": ("this project, plant FMU (C harness): RK4, 1 ms, + get 12 controller outputs", "midpoint-held"),
+    "fmu_cvode_ramp_ctrl12": ("this project, plant FMU (C harness): CVODE (rtol 1e-8), continued, "
+                              "+ get 12 controller outputs", "ramp: value and slope each tick"),
     "capi_rk4_one_call": ("this project, C API: RK4, 1 ms, one call per second", "at stage times"),
     "capi_cvode_one_call": ("this project, C API: CVODE (rtol 1e-12), own steps, one call", "at solver times"),
 }
@@ -341,6 +352,19 @@ def main(argv=None):
         print(f"target (>= 10x faster than MuJoCo, ||C|| <= 1e-12 m): {LABELS[key][0]}: {ratio:.1f}x "
               f"(best batches: {best['mujoco_rollout'] / best[key]:.1f}x), max ||C|| {c_cases[key]['max_c']:.1e} m: "
               f"{'met' if ok else 'NOT met'}")
+    # Issue 16 item 3: a control tick of the plant FMU (step + the 12 controller outputs) against mj_step, both
+    # timed in a C loop (the C harness; mujoco.rollout), so neither carries Python's per-call overhead.
+    for how, t in (("median", median), ("best batches", best)):
+        per_step_c, per_step_py = t["mujoco_rollout"] / STEPS_TIMED, t["mujoco_loop"] / STEPS_TIMED
+        print(f"mj_step per 1 ms step ({how}): {1e6 * per_step_c:.2f} us in mujoco.rollout (C loop), "
+              f"{1e6 * per_step_py:.2f} us in a Python loop (mj_step + setting ctrl): the Python loop adds "
+              f"{1e6 * (per_step_py - per_step_c):+.2f} us per step")
+    print("the ratios below compare C loop with C loop: the C harness's ticks against mujoco.rollout")
+    for key, target in (("fmu_rk4_ctrl12", 15.0), ("fmu_cvode_ramp_ctrl12", 10.0)):
+        ratio = t_mj / median[key]
+        print(f"target (step + 12-output read >= {target:.0f}x faster than mj_step RK4 1 ms): {LABELS[key][0]} "
+              f"({LABELS[key][1]}): {1e6 * median[key] / STEPS_TIMED:.2f} us per tick, {ratio:.1f}x "
+              f"(best batches: {best['mujoco_rollout'] / best[key]:.1f}x): {'met' if ratio >= target else 'NOT met'}")
     print(f"MuJoCo's own max ||C(q)|| at its stiffest: {mj_run['constraint'].max():.1e} m")
     if args.markdown:
         args.markdown.write_text(table + "\n")

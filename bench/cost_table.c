@@ -1,0 +1,330 @@
+/* pkm_cost_table: the plant FMU's cost in one table (issue 16 item 5),
+ * through the FMU binary (PKM4PUU.so, dlopen + raw FMI 2.0 Co-Simulation, as
+ * a master drives it; plain C, no Python in any timed loop):
+ *
+ *   - wall time per simulated second against the communication step h
+ *     (0.1, 1, 10 ms) and the solver and tolerance (RK4 with rk4_step =
+ *     min(h, 1 ms); CVODE Adams at rtol 1e-6, 1e-8 (the default), 1e-10,
+ *     atol = rtol / 100 as the defaults are), each tick fmi2SetReal(F[1..4])
+ *     + fmi2SetRealInputDerivatives + fmi2DoStep(h) + fmi2GetReal of the 12
+ *     controller outputs (pose, rates, rho[1..4]);
+ *   - memory per instance: the heap in use (glibc mallinfo2) after
+ *     instantiating and initialising 64 instances, over 64;
+ *   - instantiate + initialise: fmi2Instantiate, fmi2SetupExperiment,
+ *     fmi2SetInteger(solver), Enter/ExitInitializationMode (median of 101);
+ *   - batch throughput: one thread per online core, each running its own
+ *     instances one after another (RK4 and CVODE 1e-8, h = 1 ms, 1 simulated
+ *     second each, instantiation included), for about --seconds S of wall
+ *     time: instances x simulated seconds per wall second, all threads
+ *     together, beside one thread alone; with the CPU time the threads got
+ *     (CLOCK_THREAD_CPUTIME_ID) over the wall time, since on a shared
+ *     machine they may get fewer cores than they are (the scheduler's
+ *     autogroup gives a session its share whatever its thread count), and
+ *     the throughput per CPU second, which does not depend on that.
+ *
+ * Scenario: from the home pose, g as declared, F[1..4] = the static holding
+ * force (MODEL_SPEC "A check anyone can derive") plus on F[1] the ramp 0.2 t N
+ * given as value and slope each tick, so the inputs continue and CVODE keeps
+ * its history across ticks (a held input that jumps every tick restarts it:
+ * see the README's continuation table). Timings: --batches B (default 7)
+ * batches of 1 simulated second per cell, the cells interleaved batch by
+ * batch; the median, and the minimum in parentheses.
+ *
+ *   pkm_cost_table [--batches B] [--seconds S] [PKM4PUU.so [modelDescription.xml]]
+ *
+ * Prints a Markdown table. Exit status 0, 1 on any failure. */
+#define _GNU_SOURCE
+
+#if defined(__GLIBC__) || defined(__linux__)
+#include <malloc.h>
+#endif
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "fmi2FunctionTypes.h"
+
+#define PKM_HARNESS_NAME "pkm_cost_table"
+#include "fmu_harness.h"
+
+#ifndef PKM_FMU_PLANT_SO
+#define PKM_FMU_PLANT_SO "PKM4PUU.so"
+#endif
+
+#define STATIC_FORCE 2.655616050 /* N */
+#define SLOPE 0.2                /* N/s on F[1] */
+#define MAX_BATCHES 101
+#define N_STEPS 3
+#define N_SOLVERS 4
+#define N_MEMORY 64
+#define N_INIT 101
+
+static const double steps[N_STEPS] = {1e-4, 1e-3, 1e-2};
+static const struct {
+  const char* name;
+  int solver;
+  double rtol;
+} solvers[N_SOLVERS] = {{"RK4, rk4_step = min(h, 1 ms)", 1, 0.0},
+                        {"CVODE rtol 1e-6", 0, 1e-6},
+                        {"CVODE rtol 1e-8 (default)", 0, 1e-8},
+                        {"CVODE rtol 1e-10", 0, 1e-10}};
+
+typedef struct {
+  fmi2ValueReference F[4], control[12], solver, rtol, atol, rk4_step;
+  char guid[128];
+} Refs;
+
+static Fmu fmu;
+static Refs refs;
+
+static fmi2Component instantiate(const char* name, int solver, double rtol, double h) {
+  static const fmi2CallbackFunctions cb = {logger, allocate_memory, free, NULL, NULL};
+  fmi2Component c = fmu.fmi2Instantiate(name, fmi2CoSimulation, refs.guid, "", &cb, fmi2False, fmi2False);
+  const fmi2Integer s = solver;
+  const fmi2Real step = h < 1e-3 ? h : 1e-3, atol = rtol / 100.0;
+  int ok = c != NULL;
+  ok = ok && fmu.fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) == fmi2OK;
+  ok = ok && fmu.fmi2SetInteger(c, &refs.solver, 1, &s) == fmi2OK;
+  if (solver == 0)
+    ok = ok && fmu.fmi2SetReal(c, &refs.rtol, 1, &rtol) == fmi2OK && fmu.fmi2SetReal(c, &refs.atol, 1, &atol) == fmi2OK;
+  else
+    ok = ok && fmu.fmi2SetReal(c, &refs.rk4_step, 1, &step) == fmi2OK;
+  ok = ok && fmu.fmi2EnterInitializationMode(c) == fmi2OK && fmu.fmi2ExitInitializationMode(c) == fmi2OK;
+  if (!ok && c) {
+    fmu.fmi2FreeInstance(c);
+    c = NULL;
+  }
+  if (!c) fprintf(stderr, "pkm_cost_table: instantiation failed\n");
+  return c;
+}
+
+/* One simulated second from the instance's current state at time t0. */
+static int simulate_second(fmi2Component c, double t0, double h) {
+  const fmi2Integer order[4] = {1, 1, 1, 1};
+  const int n = (int)lround(1.0 / h);
+  double u[4], du[4] = {SLOPE, 0.0, 0.0, 0.0}, y[12];
+  int k;
+  for (k = 0; k < n; ++k) {
+    const double t = t0 + k * h;
+    u[0] = STATIC_FORCE + SLOPE * t, u[1] = u[2] = u[3] = STATIC_FORCE;
+    if (fmu.fmi2SetReal(c, refs.F, 4, u) != fmi2OK || fmu.fmi2SetRealInputDerivatives(c, refs.F, 4, order, du) != fmi2OK ||
+        fmu.fmi2DoStep(c, t, h, fmi2True) != fmi2OK || fmu.fmi2GetReal(c, refs.control, 12, y) != fmi2OK) {
+      fprintf(stderr, "pkm_cost_table: a call failed at t = %g (h = %g)\n", t, h);
+      return 0;
+    }
+  }
+  return 1;
+}
+
+static double median_min(double* v, int n, double* min_out) {
+  qsort(v, (size_t)n, sizeof v[0], compare_double);
+  *min_out = v[0];
+  return v[n / 2];
+}
+
+/* --- batch throughput ----------------------------------------------------------------------------- */
+typedef struct {
+  int solver;
+  double rtol, seconds, sim_seconds, cpu;
+  int ok;
+} Worker;
+
+static double thread_cpu_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void* worker(void* arg) {
+  Worker* w = arg;
+  const double start = now_seconds(), cpu0 = thread_cpu_seconds();
+  w->sim_seconds = 0.0;
+  w->ok = 1;
+  while (now_seconds() - start < w->seconds) {
+    fmi2Component c = instantiate("batch", w->solver, w->rtol, 1e-3);
+    if (!c || !simulate_second(c, 0.0, 1e-3)) {
+      w->ok = 0;
+      return NULL;
+    }
+    fmu.fmi2Terminate(c);
+    fmu.fmi2FreeInstance(c);
+    w->sim_seconds += 1.0;
+  }
+  w->seconds = now_seconds() - start;
+  w->cpu = thread_cpu_seconds() - cpu0;
+  return NULL;
+}
+
+/* instances x simulated seconds per wall second over n_threads threads; *cores: the CPU time the threads
+ * got over the wall time (how many cores they actually had: on a shared machine fewer than n_threads). */
+static double throughput(int n_threads, int solver, double rtol, double seconds, double* cores) {
+  pthread_t th[256];
+  Worker w[256];
+  double sim = 0.0, wall = 0.0, cpu = 0.0;
+  int i;
+  for (i = 0; i < n_threads; ++i) {
+    w[i] = (Worker){solver, rtol, seconds, 0.0, 0.0, 0};
+    if (pthread_create(&th[i], NULL, worker, &w[i]) != 0) return -1.0;
+  }
+  for (i = 0; i < n_threads; ++i) pthread_join(th[i], NULL);
+  for (i = 0; i < n_threads; ++i) {
+    if (!w[i].ok) return -1.0;
+    sim += w[i].sim_seconds;
+    cpu += w[i].cpu;
+    if (w[i].seconds > wall) wall = w[i].seconds;
+  }
+  *cores = cpu / wall;
+  return sim / wall;
+}
+
+static int lookup(const char* text, const char* name, fmi2ValueReference* vr) {
+  const long v = find_value_reference(text, name);
+  if (v < 0) {
+    fprintf(stderr, "pkm_cost_table: no variable %s\n", name);
+    return 0;
+  }
+  *vr = (fmi2ValueReference)v;
+  return 1;
+}
+
+int main(int argc, char** argv) {
+  static const char* control[12] = {"x", "y", "z", "phi", "dx", "dy", "dz", "dphi",
+                                    "rho[1]", "rho[2]", "rho[3]", "rho[4]"};
+  static double per[N_SOLVERS][N_STEPS][MAX_BATCHES];
+  const char *so = PKM_FMU_PLANT_SO, *xml_arg = NULL;
+  char *xml_path = NULL, *text;
+  const char* root;
+  int batches = 7, i, j, b, ok = 1, n_pos = 0;
+  double seconds = 3.0;
+  long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  for (i = 1; i < argc; ++i) {
+    if (strcmp(argv[i], "--batches") == 0 && i + 1 < argc) {
+      batches = atoi(argv[++i]);
+      if (batches < 1 || batches > MAX_BATCHES) return 1;
+    } else if (strcmp(argv[i], "--seconds") == 0 && i + 1 < argc) {
+      seconds = atof(argv[++i]);
+    } else if (n_pos == 0) {
+      so = argv[i], ++n_pos;
+    } else {
+      xml_arg = argv[i], ++n_pos;
+    }
+  }
+  if (cores < 1) cores = 1;
+  if (cores > 256) cores = 256;
+  if (!xml_arg) xml_path = default_xml_path(so);
+  text = read_text(xml_arg ? xml_arg : xml_path);
+  root = text ? strstr(text, "<fmiModelDescription") : NULL;
+  if (!root || !attribute(root, strchr(root, '>'), "guid", refs.guid, sizeof refs.guid)) {
+    fprintf(stderr, "pkm_cost_table: cannot read the model description\n");
+    return 1;
+  }
+  for (i = 0; i < 4; ++i) {
+    char name[8];
+    snprintf(name, sizeof name, "F[%d]", i + 1);
+    ok = ok && lookup(text, name, &refs.F[i]);
+  }
+  for (i = 0; i < 12; ++i) ok = ok && lookup(text, control[i], &refs.control[i]);
+  ok = ok && lookup(text, "solver", &refs.solver) && lookup(text, "rtol", &refs.rtol) &&
+       lookup(text, "atol", &refs.atol) && lookup(text, "rk4_step", &refs.rk4_step);
+  if (!ok || !load_fmu(so, &fmu)) return 1;
+
+  printf("pkm_cost_table: the plant FMU's cost (FMI 2.0 CS through dlopen, plain C)\n");
+  print_machine();
+  printf("fmu:     %s\n", so);
+  printf("online cores: %ld; %d interleaved batches per cell (median, min in parentheses); throughput over %.1f s\n\n",
+         cores, batches, seconds);
+
+  /* Cost per simulated second: one instance per cell, the cells interleaved batch by batch; each batch
+   * restores the state saved after initialisation (untimed), then times one simulated second. */
+  {
+    fmi2Component c[N_SOLVERS][N_STEPS];
+    fmi2FMUstate home[N_SOLVERS][N_STEPS];
+    for (i = 0; i < N_SOLVERS; ++i)
+      for (j = 0; j < N_STEPS; ++j) {
+        c[i][j] = instantiate("cell", solvers[i].solver, solvers[i].rtol, steps[j]);
+        home[i][j] = NULL;
+        if (!c[i][j] || fmu.fmi2GetFMUstate(c[i][j], &home[i][j]) != fmi2OK) return 1;
+      }
+    for (b = -1; b < batches; ++b)
+      for (i = 0; i < N_SOLVERS; ++i)
+        for (j = 0; j < N_STEPS; ++j) {
+          double t0;
+          if (fmu.fmi2SetFMUstate(c[i][j], home[i][j]) != fmi2OK) return 1;
+          t0 = now_seconds();
+          if (!simulate_second(c[i][j], 0.0, steps[j])) return 1;
+          if (b >= 0) per[i][j][b] = now_seconds() - t0;
+        }
+    for (i = 0; i < N_SOLVERS; ++i)
+      for (j = 0; j < N_STEPS; ++j) {
+        fmu.fmi2FreeFMUstate(c[i][j], &home[i][j]);
+        fmu.fmi2Terminate(c[i][j]);
+        fmu.fmi2FreeInstance(c[i][j]);
+      }
+  }
+  printf("| wall time per simulated second (tick: SetReal + SetRealInputDerivatives + DoStep + GetReal of 12) "
+         "| h = 0.1 ms | h = 1 ms | h = 10 ms |\n|---|---|---|---|\n");
+  for (i = 0; i < N_SOLVERS; ++i) {
+    printf("| %s |", solvers[i].name);
+    for (j = 0; j < N_STEPS; ++j) {
+      double mn, md = median_min(per[i][j], batches, &mn);
+      printf(" %.2f ms (%.2f) |", 1e3 * md, 1e3 * mn);
+    }
+    printf("\n");
+  }
+
+#if defined(__GLIBC__)
+  /* Memory per instance (CVODE default: its objects are created at initialisation; RK4 beside it). */
+  for (i = 0; i < N_SOLVERS; i += 2) {
+    fmi2Component cs[N_MEMORY];
+    struct mallinfo2 before, after;
+    malloc_trim(0);
+    before = mallinfo2();
+    for (j = 0; j < N_MEMORY; ++j)
+      if (!(cs[j] = instantiate("memory", solvers[i].solver, solvers[i].rtol, 1e-3))) return 1;
+    after = mallinfo2();
+    for (j = 0; j < N_MEMORY; ++j) fmu.fmi2FreeInstance(cs[j]);
+    printf("| memory per instance, %s, initialised (heap in use / %d instances) | %.1f kB | | |\n", solvers[i].name,
+           N_MEMORY, (double)(after.uordblks + after.hblkhd - before.uordblks - before.hblkhd) / N_MEMORY / 1024.0);
+  }
+
+#else
+  printf("| memory per instance | not measured (needs glibc's mallinfo2) | | |\n");
+#endif
+
+  /* Instantiate + initialise, and free. */
+  for (i = 0; i < N_SOLVERS; i += 2) {
+    double t_init[N_INIT], t_free[N_INIT], mn_i, mn_f, md_i, md_f;
+    for (j = 0; j < N_INIT; ++j) {
+      double t0 = now_seconds(), t1;
+      fmi2Component c = instantiate("init", solvers[i].solver, solvers[i].rtol, 1e-3);
+      t1 = now_seconds();
+      if (!c) return 1;
+      fmu.fmi2Terminate(c);
+      fmu.fmi2FreeInstance(c);
+      t_init[j] = t1 - t0;
+      t_free[j] = now_seconds() - t1;
+    }
+    md_i = median_min(t_init, N_INIT, &mn_i);
+    md_f = median_min(t_free, N_INIT, &mn_f);
+    printf("| instantiate + initialise, %s (median of %d; then terminate + free) | %.1f µs (%.1f); %.1f µs | | |\n",
+           solvers[i].name, N_INIT, 1e6 * md_i, 1e6 * mn_i, 1e6 * md_f);
+  }
+
+  /* Batch throughput on all cores, beside one. */
+  for (i = 0; i < N_SOLVERS; i += 2) {
+    double got_one, got_all;
+    const double one = throughput(1, solvers[i].solver, solvers[i].rtol, seconds, &got_one);
+    const double all = throughput((int)cores, solvers[i].solver, solvers[i].rtol, seconds, &got_all);
+    if (one < 0 || all < 0) return 1;
+    printf("| batch throughput, %s, h = 1 ms, instantiation included: instances × simulated s per wall s | "
+           "%.0f on %ld threads, which got %.2f cores' CPU time (per CPU second: %.0f); 1 thread: %.0f (got %.2f) "
+           "| | |\n",
+           solvers[i].name, all, cores, got_all, all / got_all, one, got_one);
+  }
+  free(text);
+  free(xml_path);
+  return 0;
+}
