@@ -819,11 +819,11 @@ constexpr Variable kVariables[] = {
                     "(Eq. 13), 2 = null space from the leg blocks (Eq. 13, leg-partitioned)",
                     PLANT_SCALAR(formulation), 0, 2),
   PKM_FMI_GUARD_PARAMETERS,
-  real_parameter(148, "stop_stiffness", kDefaultParams.stop_stiffness, "N/m",
+  mechanism_parameter(148, "stop_stiffness", "N/m",
                  "Stiffness k of the compliant end stops: k delta + d delta_dot pushes a slider back past rho_min or rho_max by delta (never pulls)",
-                 PKM_FMI_PARAM(stop_stiffness), 0, 0.0, pkm::kMaxStiffness),
-  real_parameter(149, "stop_damping", kDefaultParams.stop_damping, "N.s/m", "Damping d of the end stops",
-                 PKM_FMI_PARAM(stop_damping), 0, 0.0, pkm::kMaxDamping),
+                 PKM_FMI_PARAM(stop_stiffness), 0),
+  mechanism_parameter(149, "stop_damping", "N.s/m", "Damping d of the end stops",
+                 PKM_FMI_PARAM(stop_damping), 0),
   PKM_FMI_MACHINE_PARAMETERS,
 };
 // clang-format on
