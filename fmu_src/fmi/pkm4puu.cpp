@@ -191,20 +191,6 @@ Status PlantData::configuration(Context& ctx, const char* function, pkm::Model& 
     ctx.log.error("%s: %s", function, why.c_str());
     return Status::Error;
   }
-  if (solver != 0 && solver != 1) {
-    ctx.log.error("%s: parameter solver = %d must be 0 (CVODE) or 1 (RK4)", function, static_cast<int>(solver));
-    return Status::Error;
-  }
-  if (cvode_method != 0 && cvode_method != 1) {
-    ctx.log.error("%s: parameter cvode_method = %d must be 0 (Adams) or 1 (BDF)", function,
-                  static_cast<int>(cvode_method));
-    return Status::Error;
-  }
-  if (formulation < 0 || formulation > 2) {
-    ctx.log.error("%s: parameter formulation = %d must be 0 (Eq. 12), 1 (Eq. 13, QR) or 2 (Eq. 13, leg-partitioned)",
-                  function, static_cast<int>(formulation));
-    return Status::Error;
-  }
   s = pkm::SolverSettings{};
   s.solver = static_cast<pkm::Solver>(solver);
   s.rk4_step = rk4_step;
