@@ -176,6 +176,11 @@ class Instance {
 
   bool allowed(std::uint32_t mask, const char* function);
   bool require(Interface i, const char* function);
+  /// allowed() and require(ModelExchange) for a Model Exchange array get or
+  /// set, then its length (given, of what) against this FMU's and the array
+  /// not NULL; false (logged) refuses the call.
+  bool array_call_allowed(std::uint32_t mask, const char* fn, const char* what, std::size_t given,
+                          std::size_t expected, const void* array);
   Context context() {
     return Context{log_, interface_, mode_ == kInitializationMode, start_time_};
   }
