@@ -302,14 +302,6 @@ const char* pkm_status_string(pkm_status s) { return pkm::status_name(static_cas
 
 pkm_status pkm_set_solver(pkm_model* m, const pkm_solver_settings* c) {
   if (!m || !c) return PKM_ERR_INVALID_ARGUMENT;
-  if (c->cvode_method != 0 && c->cvode_method != 1) {
-    m->error = "cvode_method must be 0 (Adams) or 1 (BDF)";
-    return PKM_ERR_INVALID_ARGUMENT;
-  }
-  if (c->formulation < 0 || c->formulation > 2) {
-    m->error = "formulation must be 0 (Eq. 12), 1 (Eq. 13 QR) or 2 (Eq. 13 leg-partitioned)";
-    return PKM_ERR_INVALID_ARGUMENT;
-  }
   pkm::SolverSettings s;
   s.solver = static_cast<pkm::Solver>(c->solver);
   s.rk4_step = c->rk4_step;

@@ -63,7 +63,22 @@ InputSignal LinearInputs::signal() { return {&eval_linear, this, &eval_linear_ta
 
 std::string validate(const SolverSettings& s) {
   char buf[160];
-  if (s.solver != Solver::Cvode && s.solver != Solver::Rk4) return "solver must be 0 (CVODE) or 1 (RK4)";
+  // The choices first: the FMUs and the C API pass their integers through
+  // unchecked, and this is the one place that words them.
+  if (s.solver != Solver::Cvode && s.solver != Solver::Rk4) {
+    std::snprintf(buf, sizeof buf, "solver = %d must be 0 (CVODE) or 1 (RK4)", static_cast<int>(s.solver));
+    return buf;
+  }
+  if (s.cvode_method != CvodeMethod::Adams && s.cvode_method != CvodeMethod::BDF) {
+    std::snprintf(buf, sizeof buf, "cvode_method = %d must be 0 (Adams) or 1 (BDF)", static_cast<int>(s.cvode_method));
+    return buf;
+  }
+  if (s.formulation != Formulation::Augmented && s.formulation != Formulation::NullSpaceQR &&
+      s.formulation != Formulation::LegPartitioned) {
+    std::snprintf(buf, sizeof buf, "formulation = %d must be 0 (Eq. 12), 1 (Eq. 13, QR) or 2 (Eq. 13, leg-partitioned)",
+                  static_cast<int>(s.formulation));
+    return buf;
+  }
   if (s.solver == Solver::Cvode && !cvode_available())
     return "solver = 0 (CVODE) is not in this build (a source-code FMU compiled without SUNDIALS): set solver = 1 (RK4)";
   if (!(s.rk4_step > 0.0) || !std::isfinite(s.rk4_step)) {
@@ -83,11 +98,6 @@ std::string validate(const SolverSettings& s) {
     std::snprintf(buf, sizeof buf, "atol = %.17g must be positive and at most 1", s.atol);
     return buf;
   }
-  if (s.cvode_method != CvodeMethod::Adams && s.cvode_method != CvodeMethod::BDF)
-    return "cvode_method must be 0 (Adams) or 1 (BDF)";
-  if (s.formulation != Formulation::Augmented && s.formulation != Formulation::NullSpaceQR &&
-      s.formulation != Formulation::LegPartitioned)
-    return "formulation must be 0 (Eq. 12), 1 (Eq. 13, QR) or 2 (Eq. 13, leg-partitioned)";
   return validate(s.limits());
 }
 

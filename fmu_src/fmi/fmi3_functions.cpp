@@ -75,12 +75,17 @@ Instance* instantiate(const char* fn, Interface interface, fmi3String name, fmi3
   }
 }
 
-bool scalar_counts(Instance& i, const char* fn, size_t nvr, size_t n_values) {
-  if (nvr == n_values) return true;
-  i.logger().error("%s: nValues = %llu differs from nValueReferences = %llu (every variable of this FMU is a "
-                   "scalar); the call has no effect",
-                   fn, static_cast<unsigned long long>(n_values), static_cast<unsigned long long>(nvr));
-  return false;
+/// call() for a get or set of scalars: refuses, with no effect, a call whose
+/// nValues differs from nValueReferences (every variable here is a scalar).
+template <class Body>
+fmi3Status scalar_call(fmi3Instance c, const char* fn, size_t nvr, size_t n_values, Body&& body) {
+  return call(c, fn, [&](Instance& i) {
+    if (nvr == n_values) return body(i);
+    i.logger().error("%s: nValues = %llu differs from nValueReferences = %llu (every variable of this FMU is a "
+                     "scalar); the call has no effect",
+                     fn, static_cast<unsigned long long>(n_values), static_cast<unsigned long long>(nvr));
+    return Status::Error;
+  });
 }
 
 }  // namespace
@@ -160,38 +165,23 @@ fmi3Status fmi3Reset(fmi3Instance c) {
 
 // ---------------------------------------------------------------- variables
 
-fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[],
-                          size_t nValues) {
-  return call(c, "fmi3GetFloat64", [&](Instance& i) {
-    return scalar_counts(i, "fmi3GetFloat64", nvr, nValues) ? i.get_real(vr, nvr, values) : Status::Error;
-  });
-}
-
-fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[],
-                          size_t nValues) {
-  return call(c, "fmi3SetFloat64", [&](Instance& i) {
-    return scalar_counts(i, "fmi3SetFloat64", nvr, nValues) ? i.set_real(vr, nvr, values) : Status::Error;
-  });
-}
-
-fmi3Status fmi3GetInt32(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Int32 values[],
-                        size_t nValues) {
-  return call(c, "fmi3GetInt32", [&](Instance& i) {
-    return scalar_counts(i, "fmi3GetInt32", nvr, nValues) ? i.get_integer(vr, nvr, values) : Status::Error;
-  });
-}
-
-fmi3Status fmi3SetInt32(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Int32 values[],
-                        size_t nValues) {
-  return call(c, "fmi3SetInt32", [&](Instance& i) {
-    return scalar_counts(i, "fmi3SetInt32", nvr, nValues) ? i.set_integer(vr, nvr, values) : Status::Error;
-  });
-}
+// Get and set of a type this FMU has variables of (every one a scalar).
+#define PKM_FMI3_GET_SET(Type, CType, get, set)                                                                   \
+  fmi3Status fmi3Get##Type(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, CType values[],             \
+                           size_t nValues) {                                                                     \
+    return scalar_call(c, "fmi3Get" #Type, nvr, nValues, [&](Instance& i) { return i.get(vr, nvr, values); });     \
+  }                                                                                                               \
+  fmi3Status fmi3Set##Type(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const CType values[],       \
+                           size_t nValues) {                                                                     \
+    return scalar_call(c, "fmi3Set" #Type, nvr, nValues, [&](Instance& i) { return i.set(vr, nvr, values); });     \
+  }
+PKM_FMI3_GET_SET(Float64, fmi3Float64, get_real, set_real)
+PKM_FMI3_GET_SET(Int32, fmi3Int32, get_integer, set_integer)
+#undef PKM_FMI3_GET_SET
 
 fmi3Status fmi3GetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean values[],
                           size_t nValues) {
-  return call(c, "fmi3GetBoolean", [&](Instance& i) {
-    if (!scalar_counts(i, "fmi3GetBoolean", nvr, nValues)) return Status::Error;
+  return scalar_call(c, "fmi3GetBoolean", nvr, nValues, [&](Instance& i) {
     Status s = Status::OK;
     for (size_t k = 0; k < nvr && pkm_fmi::succeeded(s); ++k) {
       int v = 0;
@@ -204,8 +194,7 @@ fmi3Status fmi3GetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t 
 
 fmi3Status fmi3SetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Boolean values[],
                           size_t nValues) {
-  return call(c, "fmi3SetBoolean", [&](Instance& i) {
-    if (!scalar_counts(i, "fmi3SetBoolean", nvr, nValues)) return Status::Error;
+  return scalar_call(c, "fmi3SetBoolean", nvr, nValues, [&](Instance& i) {
     Status s = Status::OK;
     for (size_t k = 0; k < nvr && pkm_fmi::succeeded(s); ++k) {
       const int v = values && values[k] ? 1 : 0;

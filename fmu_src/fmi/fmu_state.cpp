@@ -287,14 +287,21 @@ Status Instance::get_fmu_state(void** state) {
   return Status::OK;
 }
 
+SavedState* Instance::state_argument(const char* fn, void* state, const void* out, const char* out_name) {
+  if (!allowed(kMaskFmuState, fn)) return nullptr;
+  SavedState* s = as_state(state);
+  if (!s || (out_name && !out)) {
+    if (out_name && !out) log_.error("%s: %s is NULL", fn, out_name);
+    else log_.error("%s: not an FMU state of this FMU", fn);
+    return nullptr;
+  }
+  return s;
+}
+
 Status Instance::set_fmu_state(void* state) {
   const char* fn = PKM_FN2(fmi2SetFMUstate, fmi3SetFMUState);
-  if (!allowed(kMaskFmuState, fn)) return Status::Error;
-  SavedState* s = as_state(state);
-  if (!s) {
-    log_.error("%s: not an FMU state of this FMU", fn);
-    return Status::Error;
-  }
+  SavedState* s = state_argument(fn, state);
+  if (!s) return Status::Error;
   if (!load(s->bytes.data(), s->bytes.size(), fn, true)) return Status::Error;
   log_.event("%s: state restored at t = %.17g (%s)", fn, time_, mode_name(mode_));
   return Status::OK;
@@ -317,24 +324,16 @@ Status Instance::free_fmu_state(void** state) {
 
 Status Instance::serialized_fmu_state_size(void* state, std::size_t* size) {
   const char* fn = PKM_FN2(fmi2SerializedFMUstateSize, fmi3SerializedFMUStateSize);
-  if (!allowed(kMaskFmuState, fn)) return Status::Error;
-  SavedState* s = as_state(state);
-  if (!s || !size) {
-    log_.error("%s: %s", fn, size ? "not an FMU state of this FMU" : "size is NULL");
-    return Status::Error;
-  }
+  SavedState* s = state_argument(fn, state, size, "size");
+  if (!s) return Status::Error;
   *size = s->bytes.size();
   return Status::OK;
 }
 
 Status Instance::serialize_fmu_state(void* state, unsigned char bytes[], std::size_t size) {
   const char* fn = PKM_FN2(fmi2SerializeFMUstate, fmi3SerializeFMUState);
-  if (!allowed(kMaskFmuState, fn)) return Status::Error;
-  SavedState* s = as_state(state);
-  if (!s || !bytes) {
-    log_.error("%s: %s", fn, bytes ? "not an FMU state of this FMU" : "serializedState is NULL");
-    return Status::Error;
-  }
+  SavedState* s = state_argument(fn, state, bytes, "serializedState");
+  if (!s) return Status::Error;
   if (size < s->bytes.size()) {
     log_.error("%s: buffer of %llu bytes, %llu needed (SerializedFMUStateSize)", fn,
                static_cast<unsigned long long>(size), static_cast<unsigned long long>(s->bytes.size()));

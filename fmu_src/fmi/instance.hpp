@@ -176,6 +176,11 @@ class Instance {
 
   bool allowed(std::uint32_t mask, const char* function);
   bool require(Interface i, const char* function);
+  /// allowed() and require(ModelExchange) for a Model Exchange array get or
+  /// set, then its length (given, of what) against this FMU's and the array
+  /// not NULL; false (logged) refuses the call.
+  bool array_call_allowed(std::uint32_t mask, const char* fn, const char* what, std::size_t given,
+                          std::size_t expected, const void* array);
   Context context() {
     return Context{log_, interface_, mode_ == kInitializationMode, start_time_};
   }
@@ -189,6 +194,11 @@ class Instance {
   const Variable* lookup(const char* function, VarType type, std::uint32_t vr);
 
   SavedState* new_state();
+  /// allowed(kMaskFmuState) and the FMU state argument: the saved state,
+  /// or NULL (logged) to refuse the call, also when the call's output out,
+  /// named out_name, is NULL (out_name NULL: the call has no output).
+  SavedState* state_argument(const char* fn, void* state, const void* out = nullptr,
+                             const char* out_name = nullptr);
   void save(std::vector<unsigned char>& out) const;
   bool check_header(const unsigned char* bytes, std::size_t size, const char* function);
   /// The times of a state being loaded: finite and in order (else logged).

@@ -62,26 +62,24 @@ Status Instance::set_time(double t) {
   return Status::OK;
 }
 
-namespace {
-bool right_count(Logger& log, const char* fn, const char* what, std::size_t given, std::size_t expected,
-                 const void* array) {
+bool Instance::array_call_allowed(std::uint32_t mask, const char* fn, const char* what, std::size_t given,
+                                  std::size_t expected, const void* array) {
+  if (!allowed(mask, fn) || !require(Interface::ModelExchange, fn)) return false;
   if (given != expected) {
-    log.error("%s: %llu %s given, this FMU has %llu; the call has no effect", fn,
-              static_cast<unsigned long long>(given), what, static_cast<unsigned long long>(expected));
+    log_.error("%s: %llu %s given, this FMU has %llu; the call has no effect", fn,
+               static_cast<unsigned long long>(given), what, static_cast<unsigned long long>(expected));
     return false;
   }
   if (!array && given > 0) {
-    log.error("%s: NULL array", fn);
+    log_.error("%s: NULL array", fn);
     return false;
   }
   return true;
 }
-}  // namespace
 
 Status Instance::set_continuous_states(const double x[], std::size_t n) {
   const char* fn = PKM_FN(SetContinuousStates);
-  if (!allowed(kMaskSetStates, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
-  if (!right_count(log_, fn, "states", n, def_.n_states, x)) return Status::Error;
+  if (!array_call_allowed(kMaskSetStates, fn, "states", n, def_.n_states, x)) return Status::Error;
   for (std::size_t k = 0; k < n; ++k) {
     if (!std::isfinite(x[k])) {
       log_.error("%s: state %llu = %g is not finite; the states are unchanged", fn, static_cast<unsigned long long>(k),
@@ -97,32 +95,29 @@ Status Instance::set_continuous_states(const double x[], std::size_t n) {
 
 Status Instance::get_continuous_states(double x[], std::size_t n) {
   const char* fn = PKM_FN(GetContinuousStates);
-  if (!allowed(kMaskGetStates, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
-  if (!right_count(log_, fn, "states", n, def_.n_states, x)) return Status::Error;
+  if (!array_call_allowed(kMaskGetStates, fn, "states", n, def_.n_states, x)) return Status::Error;
   Context ctx = context();
   return data_->get_states(ctx, x);
 }
 
 Status Instance::get_derivatives(double dx[], std::size_t n) {
   const char* fn = PKM_FN2(fmi2GetDerivatives, fmi3GetContinuousStateDerivatives);
-  if (!allowed(kMaskGetStates, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
-  if (!right_count(log_, fn, "derivatives", n, def_.n_states, dx)) return Status::Error;
+  if (!array_call_allowed(kMaskGetStates, fn, "derivatives", n, def_.n_states, dx)) return Status::Error;
   Context ctx = context();
   return data_->get_derivatives(ctx, dx);
 }
 
 Status Instance::get_event_indicators(double z[], std::size_t n) {
   const char* fn = PKM_FN(GetEventIndicators);
-  if (!allowed(kMaskGetStates, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
-  if (!right_count(log_, fn, "event indicators", n, def_.n_event_indicators, z)) return Status::Error;
+  if (!array_call_allowed(kMaskGetStates, fn, "event indicators", n, def_.n_event_indicators, z))
+    return Status::Error;
   Context ctx = context();
   return data_->get_event_indicators(ctx, z);
 }
 
 Status Instance::get_nominals(double x[], std::size_t n) {
   const char* fn = PKM_FN2(fmi2GetNominalsOfContinuousStates, fmi3GetNominalsOfContinuousStates);
-  if (!allowed(kMaskGetStates | kInstantiated, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
-  if (!right_count(log_, fn, "nominals", n, def_.n_states, x)) return Status::Error;
+  if (!array_call_allowed(kMaskGetStates | kInstantiated, fn, "nominals", n, def_.n_states, x)) return Status::Error;
   for (std::size_t k = 0; k < def_.n_variables; ++k)
     if (def_.variables[k].state >= 0) x[def_.variables[k].state] = def_.variables[k].nominal;
   return Status::OK;

@@ -191,20 +191,6 @@ Status PlantData::configuration(Context& ctx, const char* function, pkm::Model& 
     ctx.log.error("%s: %s", function, why.c_str());
     return Status::Error;
   }
-  if (solver != 0 && solver != 1) {
-    ctx.log.error("%s: parameter solver = %d must be 0 (CVODE) or 1 (RK4)", function, static_cast<int>(solver));
-    return Status::Error;
-  }
-  if (cvode_method != 0 && cvode_method != 1) {
-    ctx.log.error("%s: parameter cvode_method = %d must be 0 (Adams) or 1 (BDF)", function,
-                  static_cast<int>(cvode_method));
-    return Status::Error;
-  }
-  if (formulation < 0 || formulation > 2) {
-    ctx.log.error("%s: parameter formulation = %d must be 0 (Eq. 12), 1 (Eq. 13, QR) or 2 (Eq. 13, leg-partitioned)",
-                  function, static_cast<int>(formulation));
-    return Status::Error;
-  }
   s = pkm::SolverSettings{};
   s.solver = static_cast<pkm::Solver>(solver);
   s.rk4_step = rk4_step;
@@ -819,11 +805,11 @@ constexpr Variable kVariables[] = {
                     "(Eq. 13), 2 = null space from the leg blocks (Eq. 13, leg-partitioned)",
                     PLANT_SCALAR(formulation), 0, 2),
   PKM_FMI_GUARD_PARAMETERS,
-  real_parameter(148, "stop_stiffness", kDefaultParams.stop_stiffness, "N/m",
+  mechanism_parameter(148, "stop_stiffness", "N/m",
                  "Stiffness k of the compliant end stops: k delta + d delta_dot pushes a slider back past rho_min or rho_max by delta (never pulls)",
-                 PKM_FMI_PARAM(stop_stiffness), 0, 0.0, pkm::kMaxStiffness),
-  real_parameter(149, "stop_damping", kDefaultParams.stop_damping, "N.s/m", "Damping d of the end stops",
-                 PKM_FMI_PARAM(stop_damping), 0, 0.0, pkm::kMaxDamping),
+                 PKM_FMI_PARAM(stop_stiffness), 0),
+  mechanism_parameter(149, "stop_damping", "N.s/m", "Damping d of the end stops",
+                 PKM_FMI_PARAM(stop_damping), 0),
   PKM_FMI_MACHINE_PARAMETERS,
 };
 // clang-format on
