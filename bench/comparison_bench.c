@@ -230,23 +230,6 @@ static int run_capi(const pkm_solver_settings* settings, int one_call, int batch
 
 
 
-static int value_reference(const char* text, const char* name, fmi2ValueReference* vr) {
-  const char* p = text;
-  while ((p = strstr(p, "<ScalarVariable")) != NULL) {
-    const char* end = strstr(p, "</ScalarVariable>");
-    char buf[128];
-    if (!end) break;
-    if (attribute(p, end, "name", buf, sizeof buf) && strcmp(buf, name) == 0 &&
-        attribute(p, end, "valueReference", buf, sizeof buf)) {
-      *vr = (fmi2ValueReference)strtoul(buf, NULL, 10);
-      return 1;
-    }
-    p = end;
-  }
-  fprintf(stderr, "pkm_comparison_bench: no variable %s in the model description\n", name);
-  return 0;
-}
-
 typedef struct {
   char guid[128];
   fmi2ValueReference F[4], pose[4], control[12], rho1, residual, solver, rk4_step, g, z0;
@@ -255,8 +238,7 @@ typedef struct {
 static int read_model_description(const char* xml, Fmi* md) {
   static const char* f_names[] = {"F[1]", "F[2]", "F[3]", "F[4]"};
   static const char* pose_names[] = {"x", "y", "z", "phi"};
-  static const char* control_names[12] = {"x",  "y",  "z",      "phi",    "dx",     "dy",
-                                          "dz", "dphi", "rho[1]", "rho[2]", "rho[3]", "rho[4]"};
+  static const char* control_names[12] = PKM_CONTROLLER_OUTPUTS;
   char* text = read_text(xml);
   const char *root, *root_end;
   int i, ok = 1;
@@ -271,12 +253,13 @@ static int read_model_description(const char* xml, Fmi* md) {
     ok = 0;
   }
   for (i = 0; ok && i < 4; ++i)
-    ok = value_reference(text, f_names[i], &md->F[i]) && value_reference(text, pose_names[i], &md->pose[i]);
-  for (i = 0; ok && i < 12; ++i) ok = value_reference(text, control_names[i], &md->control[i]);
-  ok = ok && value_reference(text, "rho[1]", &md->rho1) &&
-       value_reference(text, "constraint_residual", &md->residual) &&
-       value_reference(text, "solver", &md->solver) && value_reference(text, "rk4_step", &md->rk4_step) &&
-       value_reference(text, "g", &md->g) && value_reference(text, "z0", &md->z0);
+    ok = lookup_value_reference(text, f_names[i], &md->F[i]) &&
+         lookup_value_reference(text, pose_names[i], &md->pose[i]);
+  for (i = 0; ok && i < 12; ++i) ok = lookup_value_reference(text, control_names[i], &md->control[i]);
+  ok = ok && lookup_value_reference(text, "rho[1]", &md->rho1) &&
+       lookup_value_reference(text, "constraint_residual", &md->residual) &&
+       lookup_value_reference(text, "solver", &md->solver) && lookup_value_reference(text, "rk4_step", &md->rk4_step) &&
+       lookup_value_reference(text, "g", &md->g) && lookup_value_reference(text, "z0", &md->z0);
   free(text);
   return ok;
 }

@@ -180,19 +180,8 @@ static double throughput(int n_threads, int solver, double rtol, double seconds,
   return sim / wall;
 }
 
-static int lookup(const char* text, const char* name, fmi2ValueReference* vr) {
-  const long v = find_value_reference(text, name);
-  if (v < 0) {
-    fprintf(stderr, "pkm_cost_table: no variable %s\n", name);
-    return 0;
-  }
-  *vr = (fmi2ValueReference)v;
-  return 1;
-}
-
 int main(int argc, char** argv) {
-  static const char* control[12] = {"x", "y", "z", "phi", "dx", "dy", "dz", "dphi",
-                                    "rho[1]", "rho[2]", "rho[3]", "rho[4]"};
+  static const char* control[12] = PKM_CONTROLLER_OUTPUTS;
   static double per[N_SOLVERS][N_STEPS][MAX_BATCHES];
   const char *so = PKM_FMU_PLANT_SO, *xml_arg = NULL;
   char *xml_path = NULL, *text;
@@ -224,11 +213,11 @@ int main(int argc, char** argv) {
   for (i = 0; i < 4; ++i) {
     char name[8];
     snprintf(name, sizeof name, "F[%d]", i + 1);
-    ok = ok && lookup(text, name, &refs.F[i]);
+    ok = ok && lookup_value_reference(text, name, &refs.F[i]);
   }
-  for (i = 0; i < 12; ++i) ok = ok && lookup(text, control[i], &refs.control[i]);
-  ok = ok && lookup(text, "solver", &refs.solver) && lookup(text, "rtol", &refs.rtol) &&
-       lookup(text, "atol", &refs.atol) && lookup(text, "rk4_step", &refs.rk4_step);
+  for (i = 0; i < 12; ++i) ok = ok && lookup_value_reference(text, control[i], &refs.control[i]);
+  ok = ok && lookup_value_reference(text, "solver", &refs.solver) && lookup_value_reference(text, "rtol", &refs.rtol) &&
+       lookup_value_reference(text, "atol", &refs.atol) && lookup_value_reference(text, "rk4_step", &refs.rk4_step);
   if (!ok || !load_fmu(so, &fmu)) return 1;
 
   printf("pkm_cost_table: the plant FMU's cost (FMI 2.0 CS through dlopen, plain C)\n");

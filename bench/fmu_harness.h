@@ -1,6 +1,8 @@
-/* What the C benchmark harnesses share (pkm_fmu_bench, pkm_comparison_bench):
+/* What the C harnesses share (pkm_fmu_bench, pkm_comparison_bench,
+ * pkm_fmu_latency_bench, pkm_cost_table):
  * loading a built FMU binary with dlopen, a logger that stays silent unless
- * the FMU reports an error, reading modelDescription.xml's attributes, the
+ * the FMU reports an error, reading modelDescription.xml's attributes and
+ * value references, the controller's output names, the
  * clock and the machine's description. Static functions, one copy per
  * harness (the benchmarks, and the C tests tests/fmu_allocations.c and
  * tests/fmu_alloc_faults.c); define PKM_HARNESS_NAME (the program's name,
@@ -146,6 +148,23 @@ PKM_HARNESS_FN long find_value_reference(const char* text, const char* name) {
   }
   return -1;
 }
+
+/* find_value_reference into *vr; 0, with a message naming the variable, if
+ * there is none. */
+PKM_HARNESS_FN int lookup_value_reference(const char* text, const char* name, fmi2ValueReference* vr) {
+  const long v = find_value_reference(text, name);
+  if (v < 0) {
+    fprintf(stderr, PKM_HARNESS_NAME ": no variable %s in the model description\n", name);
+    return 0;
+  }
+  *vr = (fmi2ValueReference)v;
+  return 1;
+}
+
+/* The 12 outputs a controller reads every tick: the pose, its rates and the
+ * slider positions (an array initialiser). */
+#define PKM_CONTROLLER_OUTPUTS \
+  { "x", "y", "z", "phi", "dx", "dy", "dz", "dphi", "rho[1]", "rho[2]", "rho[3]", "rho[4]" }
 
 PKM_HARNESS_FN double now_seconds(void) {
   struct timespec ts;

@@ -130,19 +130,8 @@ static void report(const char* name, double* ticks) {
          100.0 * (double)slow / (double)n);
 }
 
-static int lookup(const char* text, const char* name, fmi2ValueReference* vr) {
-  const long v = find_value_reference(text, name);
-  if (v < 0) {
-    fprintf(stderr, "pkm_fmu_latency_bench: no variable %s\n", name);
-    return 0;
-  }
-  *vr = (fmi2ValueReference)v;
-  return 1;
-}
-
 int main(int argc, char** argv) {
-  static const char* control[12] = {"x", "y", "z", "phi", "dx", "dy", "dz", "dphi",
-                                    "rho[1]", "rho[2]", "rho[3]", "rho[4]"};
+  static const char* control[12] = PKM_CONTROLLER_OUTPUTS;
   const char* so = argc > 1 ? argv[1] : PKM_FMU_PLANT_SO;
   char* xml_path = argc > 2 ? NULL : default_xml_path(so);
   const char* xml = argc > 2 ? argv[2] : xml_path;
@@ -159,10 +148,10 @@ int main(int argc, char** argv) {
   for (i = 0; i < 4; ++i) {
     char name[8];
     snprintf(name, sizeof name, "F[%d]", i + 1);
-    ok = ok && lookup(text, name, &r.F[i]);
+    ok = ok && lookup_value_reference(text, name, &r.F[i]);
   }
-  for (i = 0; i < 12; ++i) ok = ok && lookup(text, control[i], &r.control[i]);
-  if (!ok || !lookup(text, "solver", &r.solver) || !load_fmu(so, &f)) return 1;
+  for (i = 0; i < 12; ++i) ok = ok && lookup_value_reference(text, control[i], &r.control[i]);
+  if (!ok || !lookup_value_reference(text, "solver", &r.solver) || !load_fmu(so, &f)) return 1;
   printf("pkm_fmu_latency_bench: 10^6 control ticks of the plant FMU (FMI 2.0 CS, 1 ms), each timed\n");
   print_machine();
   printf("tick: SetReal(F[1..4]) [+ SetRealInputDerivatives] + DoStep(1 ms) + GetReal(12 controller outputs)\n");

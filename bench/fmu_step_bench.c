@@ -209,21 +209,10 @@ static int run(const Fmu* f, const ModelDescription* md, const References* r, in
 
 /* ------------------------------------------------------------------ main */
 
-static int lookup(const ModelDescription* md, const char* name, fmi2ValueReference* vr) {
-  const long v = find_value_reference(md->text, name);
-  if (v < 0) {
-    fprintf(stderr, "pkm_fmu_bench: no variable %s in the model description\n", name);
-    return 0;
-  }
-  *vr = (fmi2ValueReference)v;
-  return 1;
-}
-
 int main(int argc, char** argv) {
   static const char* force_names[] = {"F[1]", "F[2]", "F[3]", "F[4]"};
   static const char* pose_names[] = {"x", "y", "z", "phi"};
-  static const char* control_names[] = {"x", "y", "z", "phi", "dx", "dy", "dz", "dphi",
-                                        "rho[1]", "rho[2]", "rho[3]", "rho[4]"};
+  static const char* control_names[] = PKM_CONTROLLER_OUTPUTS;
   static const char* case_names[] = {"(a) SetReal(F) + DoStep", "(b) (a) + GetReal(x,y,z,phi)",
                                      "(c) (a) + GetReal(12 controller outputs)", "(d) (b) + GetReal(all outputs)"};
   const char* so = argc > 1 ? argv[1] : PKM_FMU_PLANT_SO;
@@ -262,10 +251,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (!parse_model_description(text, &md)) return 1;
-  for (i = 0; i < 4; ++i) ok &= lookup(&md, force_names[i], &r.F[i]) & lookup(&md, pose_names[i], &r.pose[i]);
-  for (i = 0; i < 12; ++i) ok &= lookup(&md, control_names[i], &r.control[i]);
-  ok &= lookup(&md, "solver", &r.solver) & lookup(&md, "rk4_step", &r.rk4_step) & lookup(&md, "rtol", &r.rtol) &
-        lookup(&md, "atol", &r.atol);
+  for (i = 0; i < 4; ++i) ok &= lookup_value_reference(md.text, force_names[i], &r.F[i]) & lookup_value_reference(md.text, pose_names[i], &r.pose[i]);
+  for (i = 0; i < 12; ++i) ok &= lookup_value_reference(md.text, control_names[i], &r.control[i]);
+  ok &= lookup_value_reference(md.text, "solver", &r.solver) & lookup_value_reference(md.text, "rk4_step", &r.rk4_step) & lookup_value_reference(md.text, "rtol", &r.rtol) &
+        lookup_value_reference(md.text, "atol", &r.atol);
   if (!ok || !load_fmu(so, &f)) return 1;
 
   printf("pkm_fmu_bench: FMI 2.0 Co-Simulation, one communication step of the plant FMU\n");

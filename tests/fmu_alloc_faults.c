@@ -184,13 +184,6 @@ static int child_case(int solver, int call, long n, const double reference[4]) {
   return 1;
 }
 
-static int lookup(const char* text, const char* name, fmi2ValueReference* vr) {
-  const long v = find_value_reference(text, name);
-  if (v < 0) return 0;
-  *vr = (fmi2ValueReference)v;
-  return 1;
-}
-
 int main(int argc, char** argv) {
   static const char* poses[4] = {"x", "y", "z", "phi"};
   const char* so = argc > 1 ? argv[1] : PKM_FMU_PLANT_SO;
@@ -206,9 +199,9 @@ int main(int argc, char** argv) {
   for (i = 0; i < 4; ++i) {
     char name[8];
     snprintf(name, sizeof name, "F[%d]", i + 1);
-    ok = ok && lookup(text, name, &vr_F[i]) && lookup(text, poses[i], &vr_pose[i]);
+    ok = ok && lookup_value_reference(text, name, &vr_F[i]) && lookup_value_reference(text, poses[i], &vr_pose[i]);
   }
-  if (!ok || !lookup(text, "solver", &vr_solver)) return 1;
+  if (!ok || !lookup_value_reference(text, "solver", &vr_solver)) return 1;
   {
     /* One case in this process, for a debugger: PKM_ALLOC_FAULT="solver call n"
      * (call: the index in the sequence, as printed; the other instance's

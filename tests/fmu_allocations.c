@@ -55,19 +55,8 @@ static void quiet_logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2
   if (status == fmi2Error || status == fmi2Fatal) fprintf(stderr, "FMU: %s\n", message);
 }
 
-static int lookup(const char* text, const char* name, fmi2ValueReference* vr) {
-  const long v = find_value_reference(text, name);
-  if (v < 0) {
-    fprintf(stderr, "fmu_allocations: no variable %s\n", name);
-    return 0;
-  }
-  *vr = (fmi2ValueReference)v;
-  return 1;
-}
-
 static int read_refs(const char* text, Refs* r) {
-  static const char* control[12] = {"x", "y", "z", "phi", "dx", "dy", "dz", "dphi",
-                                    "rho[1]", "rho[2]", "rho[3]", "rho[4]"};
+  static const char* control[12] = PKM_CONTROLLER_OUTPUTS;
   char name[16];
   const char* root = strstr(text, "<fmiModelDescription");
   const char* p = text;
@@ -75,10 +64,10 @@ static int read_refs(const char* text, Refs* r) {
   if (!root || !attribute(root, strchr(root, '>'), "guid", r->guid, sizeof r->guid)) return 0;
   for (i = 0; i < 4; ++i) {
     snprintf(name, sizeof name, "F[%d]", i + 1);
-    ok &= lookup(text, name, &r->F[i]);
+    ok &= lookup_value_reference(text, name, &r->F[i]);
   }
-  for (i = 0; i < 12; ++i) ok &= lookup(text, control[i], &r->control[i]);
-  ok &= lookup(text, "solver", &r->solver);
+  for (i = 0; i < 12; ++i) ok &= lookup_value_reference(text, control[i], &r->control[i]);
+  ok &= lookup_value_reference(text, "solver", &r->solver);
   r->n_outputs = 0;
   while ((p = strstr(p, "<ScalarVariable")) != NULL) {
     const char* end = strstr(p, "</ScalarVariable>");
