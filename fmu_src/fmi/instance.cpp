@@ -78,10 +78,9 @@ Status Instance::internal_error(const char* function, const char* what) {
 void Instance::free(void* handle, const ModelDefinition& def, int fmi_version, const char* function) {
   Instance* inst = from(handle, def, fmi_version);
   if (!inst) return;
+  // Not Busy: its destructor would clear the flag of a deleted instance.
   if (inst->busy_.exchange(true, std::memory_order_acquire)) {
-    inst->log_.error("%s: called while another call on this instance is running (from another thread?): the "
-                     "instance is not freed",
-                     function);
+    inst->concurrent_call(function);  // logged; the instance is not freed
     return;
   }
   delete inst;
