@@ -8,7 +8,8 @@
 # FMUs themselves (dlopen), which are optimised at link time as before.
 #
 #   PKM_LTO  (option, ON) in Release builds; OFF: no LTO anywhere.
-#   pkm_without_lto(<target>...)  links those targets without LTO.
+#   pkm_without_lto(<target>...)  links those targets without LTO;
+#   pkm_directory_without_lto()   every later target of the directory.
 include_guard(GLOBAL)
 option(PKM_LTO "Link-time optimisation in Release builds (inlines the small kinematics helpers across files)" ON)
 set(PKM_LTO_ACTIVE OFF)
@@ -31,11 +32,21 @@ function(pkm_fat_lto_objects)
   endif()
 endfunction()
 
+# The link option that makes gcc link fat objects' machine code (none elsewhere).
+set(PKM_NO_LTO_LINK_OPTION)
+if(PKM_LTO_ACTIVE AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+  set(PKM_NO_LTO_LINK_OPTION -fno-lto)
+endif()
+
 function(pkm_without_lto)
   foreach(_t IN LISTS ARGN)
     set_target_properties(${_t} PROPERTIES INTERPROCEDURAL_OPTIMIZATION OFF)
-    if(PKM_LTO_ACTIVE AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
-      target_link_options(${_t} PRIVATE -fno-lto)
-    endif()
+    target_link_options(${_t} PRIVATE ${PKM_NO_LTO_LINK_OPTION})
   endforeach()
 endfunction()
+
+# Every target defined after it in the calling directory (and below): no LTO.
+macro(pkm_directory_without_lto)
+  set(CMAKE_INTERPROCEDURAL_OPTIMIZATION OFF)
+  add_link_options(${PKM_NO_LTO_LINK_OPTION})
+endmacro()
