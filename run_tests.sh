@@ -3,11 +3,11 @@
 # Python checks (pytest) when python_checks/ holds any test_*.py file.
 #
 # The sanitizer tests (ctest label "sanitized": their own clang build with
-# AddressSanitizer and UndefinedBehaviorSanitizer, then 45 s of fuzzing and
-# the fmpy checks against the instrumented FMUs) are the longest chain, so
-# they start as soon as build/ is configured and run beside everything else
-# at a lower priority: they take the cores the main build leaves idle, then
-# run beside the tests.
+# AddressSanitizer and UndefinedBehaviorSanitizer, then the replay of the
+# fuzzer's seed corpus and the fmpy checks against the instrumented FMUs)
+# are the longest chain, so they start as soon as build/ is configured and
+# run beside everything else at a lower priority: they take the cores the
+# main build leaves idle, then run beside the tests.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")"
 ./scripts/build.sh --configure-only

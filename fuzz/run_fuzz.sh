@@ -5,6 +5,7 @@
 #
 #   fuzz/run_fuzz.sh [--build-dir DIR] [--seconds N | --runs N] [--jobs N] [-- libFuzzer options...]
 #   fuzz/run_fuzz.sh [--build-dir DIR] --build-only
+#   fuzz/run_fuzz.sh [--build-dir DIR] --replay [--jobs N]
 #   fuzz/run_fuzz.sh [--build-dir DIR] --coverage-report
 #
 # Defaults: --build-dir build-fuzz, --seconds 60, one job. The corpus grows in
@@ -13,6 +14,11 @@
 # --build-only builds the harness and, from the same instrumented objects, the
 # FMU archives (DIR/<id>.fmu, DIR/fmi3/<id>.fmu) that
 # scripts/check_sanitized_fmpy.sh drives through fmpy; no fuzzing.
+# --replay runs every input of the seed corpus once (no fuzzing), in N
+# processes of about equal shares: the regression check of the test command
+# (ctest hardening_fuzz_seeds). A fuzzing run first replays its whole corpus
+# too, one input at a time: about 90 s here for the 2,051 seeds, so a
+# 45-second run would never get past them.
 # --coverage-report builds a source-coverage variant in DIR-cov, replays the
 # seed corpus and DIR/corpus through it and prints llvm-cov's region, line
 # and branch coverage of fmu_src/ (no fuzzing).
@@ -28,6 +34,7 @@ runs=""
 jobs=1
 coverage=0
 build_only=0
+replay=0
 extra=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -37,6 +44,7 @@ while [ $# -gt 0 ]; do
     --jobs) jobs="$2"; shift 2 ;;
     --coverage-report) coverage=1; shift ;;
     --build-only) build_only=1; shift ;;
+    --replay) replay=1; shift ;;
     --) shift; extra=("$@"); break ;;
     *) echo "run_fuzz: unknown argument $1" >&2; exit 2 ;;
   esac
@@ -103,6 +111,34 @@ if [ "$build_only" -eq 1 ]; then
 fi
 
 mkdir -p "$build/corpus" "$build/findings"
+if [ "$replay" -eq 1 ]; then
+  seeds_dir="$build/seeds"
+  rm -rf "$seeds_dir" && mkdir -p "$seeds_dir"
+  tar -C "$seeds_dir" -xzf "$root/fuzz/seed_corpus.tar.gz"
+  mapfile -t inputs < <(find "$seeds_dir" -type f | sort)
+  rm -f "$build"/replay-*.log
+  echo "run_fuzz: replaying ${#inputs[@]} seed inputs in $jobs process(es) (logs: $build/replay-*.log)" >&2
+  pids=()
+  for ((j = 0; j < jobs; j++)); do
+    share=()
+    for ((i = j; i < ${#inputs[@]}; i += jobs)); do share+=("${inputs[i]}"); done
+    "$build/fuzz/pkm_fmi_fuzzer" -timeout=30 -rss_limit_mb=2048 -artifact_prefix="$build/findings/" \
+      "${share[@]}" >"$build/replay-$j.log" 2>&1 &
+    pids+=($!)
+  done
+  failed=0
+  for ((j = 0; j < jobs; j++)); do
+    if ! wait "${pids[j]}"; then
+      failed=1
+      echo "run_fuzz: FINDING while replaying share $j; the end of its log:" >&2
+      tail -60 "$build/replay-$j.log" >&2
+    fi
+  done
+  ran=$(cat "$build"/replay-*.log | grep -c '^Executed ' || true)
+  echo "run_fuzz: $ran of ${#inputs[@]} seed inputs ran$([ "$failed" -eq 0 ] && echo ", no finding")" >&2
+  if [ "$failed" -ne 0 ] || [ "$ran" -ne "${#inputs[@]}" ]; then exit 1; fi
+  exit 0
+fi
 # Seeds: fuzz/seed_corpus.tar.gz, the corpus of a 30-minute run merged by
 # libFuzzer (-merge=1), so that a short run starts from deep coverage.
 if [ -z "$(ls -A "$build/corpus")" ] && [ -f "$root/fuzz/seed_corpus.tar.gz" ]; then
