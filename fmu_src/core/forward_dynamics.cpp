@@ -5,6 +5,7 @@
 #include "constraints.hpp"
 #include "lagrangian.hpp"
 #include "reduced_dynamics.hpp"
+#include "small_dense.hpp"
 
 namespace pkm {
 namespace {
@@ -32,11 +33,10 @@ Status augmented(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f
   A.topLeftCorner<16, 16>() = M;
   A.topRightCorner<16, 12>() = Cq.transpose();
   A.bottomLeftCorner<12, 16>() = Cq;
-  Vec28 b;
-  b.head<16>() = f - coriolis(m, q, qd) - gravity(m, q);
-  b.tail<12>() = -constraint_gamma(m, q, qd);
-  const Eigen::PartialPivLU<Mat28> lu(A);
-  const Vec28 x = lu.solve(b);
+  Vec28 x;
+  x.head<16>() = f - coriolis(m, q, qd) - gravity(m, q);
+  x.tail<12>() = -constraint_gamma(m, q, qd);
+  if (!dense::lu_solve_in_place<28>(A, x)) return Status::Singular;
   qdd = x.head<16>();
   lambda = x.tail<12>();
   return x.allFinite() ? Status::Ok : Status::Singular;
@@ -45,24 +45,22 @@ Status augmented(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f
 Status null_space_qr(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& f, Vec16& qdd,
                      Vec12& lambda) {
   const auto [M, Cq] = mass_and_jacobian(m, q);
-  const Eigen::Matrix<double, 16, 12> CqT = Cq.transpose();
-  const Eigen::HouseholderQR<Eigen::Matrix<double, 16, 12>> qr(CqT);
-  const Mat16 Q = qr.householderQ();
-  const auto R = qr.matrixQR().topLeftCorner<12, 12>().triangularView<Eigen::Upper>();
-  for (int k = 0; k < kM; ++k)  // rank check on R's diagonal
-    if (!(std::fabs(qr.matrixQR()(k, k)) > 1e-12)) return Status::Singular;
+  Mat16 Q;
+  Mat12 R;
+  if (!dense::householder_qr<16, 12>(Cq.transpose(), Q, R, 1e-12)) return Status::Singular;  // C_q^T = Q [R; 0]
   const Eigen::Matrix<double, 16, 12> Q1 = Q.leftCols<12>();
   const Eigen::Matrix<double, 16, 4> B = Q.rightCols<4>();
   // Particular solution of C_q qdd = -gamma: C_q = R^T Q1^T, so qdd_p = Q1 R^{-T} (-gamma).
   const Vec12 gamma = constraint_gamma(m, q, qd);
-  const Vec16 qdd_p = Q1 * R.transpose().solve(-gamma);
+  const Vec16 qdd_p = Q1 * dense::upper_transpose_solve<12>(R, -gamma);
   const Vec16 rhs = f - coriolis(m, q, qd) - gravity(m, q);
   // Eq. 13: B^T M B a = B^T (f - V - G - M qdd_p), qdd = qdd_p + B a.
   const Mat4 Mr = B.transpose() * M * B;
-  const Vec4 a = Mr.llt().solve(B.transpose() * (rhs - M * qdd_p));
+  Vec4 a;
+  if (!dense::cholesky_solve<4>(Mr, B.transpose() * (rhs - M * qdd_p), a)) return Status::Singular;
   qdd = qdd_p + B * a;
   // C_q^T lambda = rhs - M qdd: lambda = R^{-1} Q1^T (rhs - M qdd).
-  lambda = R.solve(Q1.transpose() * (rhs - M * qdd));
+  lambda = dense::upper_solve<12>(R, Q1.transpose() * (rhs - M * qdd));
   return (qdd.allFinite() && lambda.allFinite()) ? Status::Ok : Status::Singular;
 }
 
