@@ -2,9 +2,16 @@
 # Installs what is missing (scripts/setup.sh), then configures and builds
 # everything in build/ (Ninja, Release).
 #   scripts/build.sh [--configure-only]
+# PKM_SETUP=for-build installs only what the build needs (setup.sh
+# --for-build); PKM_SETUP=none installs nothing (./run_tests.sh).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
-./scripts/setup.sh
+case "${PKM_SETUP:-all}" in
+  all) ./scripts/setup.sh ;;
+  for-build) ./scripts/setup.sh --for-build ;;
+  none) ;;
+  *) echo "build: PKM_SETUP=${PKM_SETUP} must be all, for-build or none" >&2; exit 2 ;;
+esac
 # A build/ configured earlier with another generator would make cmake fail: reset it.
 if [ -f build/CMakeCache.txt ] && ! grep -q '^CMAKE_GENERATOR:INTERNAL=Ninja$' build/CMakeCache.txt; then
   echo "build: build/ was not configured with Ninja, reconfiguring" >&2

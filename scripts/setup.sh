@@ -3,9 +3,20 @@
 # Debian packages (apt-get) and the Python virtualenv .venv with
 # python_checks/requirements.txt, and this project's package python/pkm4puu.
 # Idempotent and non-interactive (CI-safe).
+#   scripts/setup.sh                everything
+#   scripts/setup.sh --for-build    what configuring and building need: the
+#                                   Debian packages and, in .venv, fmpy (its
+#                                   FMI headers); ./run_tests.sh installs the
+#                                   rest while it builds
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 log() { echo "setup: $*" >&2; }
+for_build=0
+case "${1:-}" in
+  --for-build) for_build=1 ;;
+  "") ;;
+  *) log "unknown argument $1"; exit 2 ;;
+esac
 
 # 1. Debian packages.
 packages=(build-essential cmake ninja-build libeigen3-dev libsundials-dev libgtest-dev
@@ -60,6 +71,16 @@ if [ ! -x .venv/bin/python ]; then
 fi
 req=python_checks/requirements.txt
 stamp=.venv/.requirements.stamp
+if [ "$for_build" -eq 1 ]; then
+  fmpy_pin="$(grep -E '^fmpy==' "$req")"
+  if ! .venv/bin/python -m pip show -q fmpy 2>/dev/null ||
+     [ "$(.venv/bin/python -m pip show fmpy 2>/dev/null | sed -n 's/^Version: //p')" != "${fmpy_pin#fmpy==}" ]; then
+    log "installing $fmpy_pin (the rest of $req comes with scripts/setup.sh)"
+    .venv/bin/pip install --disable-pip-version-check -q "$fmpy_pin"
+  fi
+  log "done (for the build)"
+  exit 0
+fi
 if [ ! -f "$stamp" ] || [ "$req" -nt "$stamp" ]; then
   log "installing Python requirements from $req"
   .venv/bin/pip install --disable-pip-version-check -q -r "$req"
