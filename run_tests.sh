@@ -4,25 +4,46 @@
 #
 # The sanitizer tests (ctest label "sanitized": their own clang build with
 # AddressSanitizer and UndefinedBehaviorSanitizer, then the replay of the
-# fuzzer's seed corpus and the fmpy checks against the instrumented FMUs)
-# are the longest chain, so they start as soon as build/ is configured and
-# run beside everything else at a lower priority: they take the cores the
-# main build leaves idle, then run beside the tests.
+# fuzzer's seed corpus, the fmpy checks and the C++ FMI tests against the
+# instrumented FMUs) are the longest chain, so they start as soon as build/
+# is configured and run beside everything else at a lower priority: they
+# take the cores the main build leaves idle, then run beside the tests.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")"
-./scripts/build.sh --configure-only
+# What the build needs first (Debian packages, fmpy's FMI headers); the rest
+# of the Python requirements (the checks' numpy, SciPy, MuJoCo, Pinocchio,
+# ...) install beside the build, which does not need them.
+PKM_SETUP=for-build ./scripts/build.sh --configure-only
+setup_log=build/setup.log
+./scripts/setup.sh >"$setup_log" 2>&1 &
+setup_pid=$!
 sanitized_log=build/sanitized_tests.log
 # In a process group of its own (setsid), so that a failure before the end
 # stops the whole run (ctest, the script, the compilers) and leaves nothing
 # behind. A new session is also a new scheduling group where the kernel
 # groups sessions (autogroup): its own nice value, not only the processes',
 # must be lowered, or it takes half the machine from the main build.
+# The fmpy checks and the C++ FMI tests against the instrumented binaries
+# need the Python requirements and this build's test programs: they wait
+# for the marker file written when both are there.
+ready=build/.main_build_done
+rm -f "$ready"
 setsid bash -c 'echo 10 >/proc/self/autogroup 2>/dev/null || true
-  exec nice -n 10 ctest --test-dir build --output-on-failure --no-tests=error -j2 -L sanitized' \
-  >"$sanitized_log" 2>&1 &
+  late="hardening_sanitized_fmpy|hardening_sanitized_fmi_tests"
+  nice -n 10 ctest --test-dir build --output-on-failure --no-tests=error -j2 -L sanitized -E "$late" || exit 1
+  while [ ! -f "$0" ]; do sleep 2; done
+  exec nice -n 10 ctest --test-dir build --output-on-failure --no-tests=error -j2 -R "$late"' \
+  "$ready" >"$sanitized_log" 2>&1 &
 sanitized_pid=$!
-trap 'kill -- -"$sanitized_pid" 2>/dev/null || true' EXIT
-./scripts/build.sh
+trap 'kill -- -"$sanitized_pid" 2>/dev/null || true; kill "$setup_pid" 2>/dev/null || true' EXIT
+PKM_SETUP=none ./scripts/build.sh
+if ! wait "$setup_pid"; then
+  cat "$setup_log" >&2
+  echo "run_tests: scripts/setup.sh FAILED (log: $setup_log)" >&2
+  exit 1
+fi
+cat "$setup_log" >&2
+touch "$ready"
 # --no-tests=error: a build that registered no test must fail, not pass silently.
 ctest --test-dir build --output-on-failure -j2 --no-tests=error -LE sanitized
 status=0
@@ -34,7 +55,7 @@ else
 fi
 echo "run_tests: waiting for the sanitizer tests (log: $sanitized_log)" >&2
 if wait "$sanitized_pid"; then
-  grep -E "tests passed|Passed|Skipped|Not Run" "$sanitized_log" || true
+  grep -E "tests passed|Passed|Skipped|Not Run|check_sanitized_fmi_tests" "$sanitized_log" || true
   echo "run_tests: the sanitizer tests passed (log: $sanitized_log)"
 else
   cat "$sanitized_log"

@@ -127,12 +127,23 @@ struct FmuLibrary {
   FmuLibrary& operator=(const FmuLibrary&) = delete;
 };
 
+/// The FMU binary the tests drive: the build's (`built`), or the file of
+/// the same name in the directory PKM_FMU_BINARIES when that is set (the
+/// sanitized build's, scripts/check_sanitized_fmi_tests.sh). The tests of
+/// the binaries as files (tests/fmi/binary.cpp) keep the build's.
+inline std::string fmu_binary(const char* built) {
+  const char* dir = std::getenv("PKM_FMU_BINARIES");
+  if (dir == nullptr || *dir == '\0') return built;
+  const std::string path = built;
+  return std::string(dir) + "/" + path.substr(path.find_last_of("/\\") + 1);
+}
+
 inline FmuLibrary& plant_library() {
-  static FmuLibrary lib(PKM_FMU_PLANT_SO);
+  static FmuLibrary lib(fmu_binary(PKM_FMU_PLANT_SO).c_str());
   return lib;
 }
 inline FmuLibrary& inverse_library() {
-  static FmuLibrary lib(PKM_FMU_INVERSE_SO);
+  static FmuLibrary lib(fmu_binary(PKM_FMU_INVERSE_SO).c_str());
   return lib;
 }
 
