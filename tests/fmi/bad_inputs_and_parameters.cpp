@@ -13,8 +13,7 @@
 
 #include <gtest/gtest.h>
 
-#include "fmu_loader.hpp"
-#include "hardening_table.hpp"
+#include "fmu_fixture.hpp"
 
 namespace {
 
@@ -31,23 +30,11 @@ std::string text(double v) {
   return buf;
 }
 
-/// Deterministic inputs near the static forces.
-void drive(PlantFmu& p, double t) {
-  for (int i = 1; i <= 4; ++i)
-    ASSERT_EQ(p.set(force_name(i), kStaticForce + 0.01 * std::sin(2.0 * kPi * (1.0 + 0.5 * i) * t)), fmi2OK);
-}
-
-/// A plant initialised and stepped 20 times (1 ms), inputs set for the next step.
+/// A plant with `solver`, initialised and stepped 20 times (1 ms), inputs set
+/// for the next step.
 void prepare(PlantFmu& p, int solver, double& t) {
   ASSERT_EQ(p.set_int("solver", solver), fmi2OK);
-  p.initialize();
-  t = 0.0;
-  for (int k = 0; k < 20; ++k) {
-    drive(p, t);
-    ASSERT_EQ(p.step(t, 1e-3), fmi2OK) << p.log.dump();
-    t += 1e-3;
-  }
-  drive(p, t);
+  prepare(p, t, 20);
 }
 
 /// After an error: fmi2Reset, then the default parameters initialise and step.
