@@ -45,7 +45,7 @@ import sys
 import matplotlib
 import numpy as np
 
-from pkm4puu.cli import add_common_args, start, write_outputs
+from pkm4puu.cli import add_common_args, run_program
 from pkm4puu.closed_loop import run_closed_loop
 from pkm4puu.plots import save_figure
 from pkm4puu.drawing import write_run_csv
@@ -238,26 +238,24 @@ def main(argv=None):
     ap.add_argument("--viscous", type=float, default=VISCOUS,
                     help="viscous friction of each joint (N s/m, default %(default)s)")
     ap.add_argument("--t-end", type=float, default=T_END, help="run length (s, default %(default)s)")
-    args, log, fmus = start(ap, argv)
-    if fmus is None:
-        return 1
-    if min(args.payload, args.coulomb, args.viscous) < 0 or args.t_end <= 0:
-        log("error: --payload, --coulomb and --viscous must be >= 0 and --t-end > 0")
-        return 2
-    params = machine(args.payload, args.coulomb, args.viscous)
-    try:
+
+    def compute(args, fmus, log):
+        params = machine(args.payload, args.coulomb, args.viscous)
         runs, ratio = compare(*fmus, plant_machine=params, t_end=args.t_end, log=log)
-    except Exception as exc:  # an FMU error or a diverging loop
-        log(f"error: {exc}")
-        return 1
-    print(summary(runs, ratio, params), flush=True)
-    write_outputs(args.out, log, {"closed_loop.csv": lambda p: write_csv(runs, p),
-                                  "closed_loop_tracking.png": lambda p: plot(runs, ratio, params, p),
-                                  "closed_loop_run.csv": lambda p: write_run_csv(p, runs["ff"].t, runs["ff"].run)})
-    if ratio < MIN_RATIO:
-        log(f"note: friction compensation cut the RMS error by {ratio:.1f}, less than the {MIN_RATIO:g} the test "
-            "requires with the default machine")
-    return 0
+        if ratio < MIN_RATIO:
+            log(f"note: friction compensation cut the RMS error by {ratio:.1f}, less than the {MIN_RATIO:g} the "
+                "test requires with the default machine")
+        return summary(runs, ratio, params), {
+            "closed_loop.csv": lambda p: write_csv(runs, p),
+            "closed_loop_tracking.png": lambda p: plot(runs, ratio, params, p),
+            "closed_loop_run.csv": lambda p: write_run_csv(p, runs["ff"].t, runs["ff"].run)}
+
+    def invalid(args):
+        if min(args.payload, args.coulomb, args.viscous) < 0 or args.t_end <= 0:
+            return "--payload, --coulomb and --viscous must be >= 0 and --t-end > 0"
+        return None
+
+    return run_program(ap, argv, compute, invalid)
 
 
 if __name__ == "__main__":

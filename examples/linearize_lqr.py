@@ -52,7 +52,7 @@ import matplotlib
 import numpy as np
 import scipy.linalg as sla
 
-from pkm4puu.cli import add_common_args, start, write_outputs
+from pkm4puu.cli import add_common_args, run_program
 from pkm4puu.plots import save_figure
 from pkm4puu.closed_loop import run_closed_loop
 from pkm4puu.fmu import Fmu
@@ -405,21 +405,17 @@ def main(argv=None):
     ap.add_argument("--t-end", type=float, default=T_END, help="closed-loop run length (s, default %(default)s)")
     ap.add_argument("--offset", type=float, default=1e3 * OFFSET,
                     help="initial offset from the path (mm, default %(default)s)")
-    args, log, fmus = start(ap, argv)
-    if fmus is None:
-        return 1
-    if args.t_end <= 0 or not 0 <= args.offset <= 5:
-        log("error: --t-end must be > 0 and --offset within [0, 5] mm")
-        return 2
-    try:
+
+    def compute(args, fmus, log):
         s = Study(*fmus, t_end=args.t_end, offset=1e-3 * args.offset, log=log).run()
-    except Exception as exc:  # an FMU error or a diverging loop
-        log(f"error: {exc}")
-        return 1
-    print(summary(s), flush=True)
-    write_outputs(args.out, log, {"linearize_lqr.csv": lambda p: write_csv(s, p),
-                                  "linearize_lqr.png": lambda p: plot(s, p)})
-    return 0
+        return summary(s), {"linearize_lqr.csv": lambda p: write_csv(s, p), "linearize_lqr.png": lambda p: plot(s, p)}
+
+    def invalid(args):
+        if args.t_end <= 0 or not 0 <= args.offset <= 5:
+            return "--t-end must be > 0 and --offset within [0, 5] mm"
+        return None
+
+    return run_program(ap, argv, compute, invalid)
 
 
 if __name__ == "__main__":

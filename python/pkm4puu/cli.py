@@ -1,7 +1,7 @@
 """What the command-line programs share (the examples and `python -m
 pkm4puu.autotest`): progress on stderr, the --build/--out arguments,
-finding the FMUs with a message that says how to build them, and writing
-the output files."""
+finding the FMUs with a message that says how to build them, an example's
+main (run_program) and writing the output files."""
 import os
 import platform
 import sys
@@ -58,6 +58,30 @@ def start(ap, argv, models=("PKM4PUU", "PKM4PUU_Inverse")):
     args = ap.parse_args(argv)
     log = Log(ap.prog)
     return args, log, find_fmus(args.build, log, models)
+
+
+def run_program(ap, argv, compute, invalid=None, models=("PKM4PUU", "PKM4PUU_Inverse")):
+    """An example's main after its arguments are declared: parses argv and
+    finds the FMUs (1 when they are missing); invalid(args), when given,
+    returns what is wrong with the arguments or None (logged, 2);
+    compute(args, fmus, log) returns (the summary to print, {file name:
+    writer(path)} for write_outputs into --out); an exception it raises (an
+    FMU error, a diverging loop) is logged, 1. Returns the exit status."""
+    args, log, fmus = start(ap, argv, models)
+    if fmus is None:
+        return 1
+    wrong = invalid(args) if invalid else None
+    if wrong:
+        log(f"error: {wrong}")
+        return 2
+    try:
+        summary, writers = compute(args, fmus, log)
+    except Exception as exc:
+        log(f"error: {exc}")
+        return 1
+    print(summary, flush=True)
+    write_outputs(args.out, log, writers)
+    return 0
 
 
 def write_outputs(out, log, writers):
