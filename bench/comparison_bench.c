@@ -455,9 +455,5 @@ int main(int argc, char** argv) {
   }
   free(xml);
   dlclose(fmu.handle);
-  if (!ok) {
-    fprintf(stderr, "pkm_comparison_bench: FAILED\n");
-    return 1;
-  }
-  return 0;
+  return exit_status(ok);
 }

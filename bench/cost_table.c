@@ -181,11 +181,9 @@ static double throughput(int n_threads, int solver, double rtol, double seconds,
 }
 
 int main(int argc, char** argv) {
-  static const char* control[12] = PKM_CONTROLLER_OUTPUTS;
   static double per[N_SOLVERS][N_STEPS][MAX_BATCHES];
   const char *so = PKM_FMU_PLANT_SO, *xml_arg = NULL;
   char *xml_path = NULL, *text;
-  const char* root;
   int batches = 7, i, j, b, ok = 1, n_pos = 0;
   double seconds = 3.0;
   long cores = sysconf(_SC_NPROCESSORS_ONLN);
@@ -205,17 +203,7 @@ int main(int argc, char** argv) {
   if (cores > 256) cores = 256;
   if (!xml_arg) xml_path = default_xml_path(so);
   text = read_text(xml_arg ? xml_arg : xml_path);
-  root = text ? strstr(text, "<fmiModelDescription") : NULL;
-  if (!root || !attribute(root, strchr(root, '>'), "guid", refs.guid, sizeof refs.guid)) {
-    fprintf(stderr, "pkm_cost_table: cannot read the model description\n");
-    return 1;
-  }
-  for (i = 0; i < 4; ++i) {
-    char name[8];
-    snprintf(name, sizeof name, "F[%d]", i + 1);
-    ok = ok && lookup_value_reference(text, name, &refs.F[i]);
-  }
-  for (i = 0; i < 12; ++i) ok = ok && lookup_value_reference(text, control[i], &refs.control[i]);
+  ok = read_controller_interface(text, refs.guid, sizeof refs.guid, refs.F, refs.control);
   ok = ok && lookup_value_reference(text, "solver", &refs.solver) && lookup_value_reference(text, "rtol", &refs.rtol) &&
        lookup_value_reference(text, "atol", &refs.atol) && lookup_value_reference(text, "rk4_step", &refs.rk4_step);
   if (!ok || !load_fmu(so, &fmu)) return 1;

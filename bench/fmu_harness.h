@@ -166,6 +166,34 @@ PKM_HARNESS_FN int lookup_value_reference(const char* text, const char* name, fm
 #define PKM_CONTROLLER_OUTPUTS \
   { "x", "y", "z", "phi", "dx", "dy", "dz", "dphi", "rho[1]", "rho[2]", "rho[3]", "rho[4]" }
 
+/* The guid of the model description `text` (its root element's attribute)
+ * and the value references of F[1..4] and of the controller's 12 outputs
+ * (PKM_CONTROLLER_OUTPUTS); 0, with a message, when one is missing. */
+PKM_HARNESS_FN int read_controller_interface(const char* text, char* guid, size_t guid_size, fmi2ValueReference F[4],
+                                             fmi2ValueReference control[12]) {
+  static const char* outputs[12] = PKM_CONTROLLER_OUTPUTS;
+  const char* root = text ? strstr(text, "<fmiModelDescription") : NULL;
+  int i, ok = 1;
+  if (!root || !attribute(root, strchr(root, '>'), "guid", guid, guid_size)) {
+    fprintf(stderr, PKM_HARNESS_NAME ": cannot read the model description\n");
+    return 0;
+  }
+  for (i = 0; i < 4; ++i) {
+    char name[8];
+    snprintf(name, sizeof name, "F[%d]", i + 1);
+    ok = ok && lookup_value_reference(text, name, &F[i]);
+  }
+  for (i = 0; i < 12; ++i) ok = ok && lookup_value_reference(text, outputs[i], &control[i]);
+  return ok;
+}
+
+/* A harness's exit status: 0, or 1 after saying that it failed. */
+PKM_HARNESS_FN int exit_status(int ok) {
+  if (ok) return 0;
+  fprintf(stderr, PKM_HARNESS_NAME ": FAILED\n");
+  return 1;
+}
+
 PKM_HARNESS_FN double now_seconds(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);

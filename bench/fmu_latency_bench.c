@@ -131,27 +131,15 @@ static void report(const char* name, double* ticks) {
 }
 
 int main(int argc, char** argv) {
-  static const char* control[12] = PKM_CONTROLLER_OUTPUTS;
   const char* so = argc > 1 ? argv[1] : PKM_FMU_PLANT_SO;
   char* xml_path = argc > 2 ? NULL : default_xml_path(so);
   const char* xml = argc > 2 ? argv[2] : xml_path;
   char* text = xml ? read_text(xml) : NULL;
-  const char* root = text ? strstr(text, "<fmiModelDescription") : NULL;
   double* ticks = malloc(sizeof(double) * (size_t)BATCHES * TICKS);
   Refs r;
   Fmu f;
-  int i, ok = 1;
-  if (!root || !ticks || !attribute(root, strchr(root, '>'), "guid", r.guid, sizeof r.guid)) {
-    fprintf(stderr, "pkm_fmu_latency_bench: cannot read the model description\n");
-    return 1;
-  }
-  for (i = 0; i < 4; ++i) {
-    char name[8];
-    snprintf(name, sizeof name, "F[%d]", i + 1);
-    ok = ok && lookup_value_reference(text, name, &r.F[i]);
-  }
-  for (i = 0; i < 12; ++i) ok = ok && lookup_value_reference(text, control[i], &r.control[i]);
-  if (!ok || !lookup_value_reference(text, "solver", &r.solver) || !load_fmu(so, &f)) return 1;
+  if (!ticks || !read_controller_interface(text, r.guid, sizeof r.guid, r.F, r.control)) return 1;
+  if (!lookup_value_reference(text, "solver", &r.solver) || !load_fmu(so, &f)) return 1;
   printf("pkm_fmu_latency_bench: 10^6 control ticks of the plant FMU (FMI 2.0 CS, 1 ms), each timed\n");
   print_machine();
   printf("tick: SetReal(F[1..4]) [+ SetRealInputDerivatives] + DoStep(1 ms) + GetReal(12 controller outputs)\n");

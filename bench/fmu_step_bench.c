@@ -293,9 +293,5 @@ int main(int argc, char** argv) {
   free(text);
   free(xml_path);
   dlclose(f.handle);
-  if (!ok) {
-    fprintf(stderr, "pkm_fmu_bench: FAILED\n");
-    return 1;
-  }
-  return 0;
+  return exit_status(ok);
 }

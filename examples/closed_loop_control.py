@@ -41,17 +41,15 @@ import argparse
 import csv
 import math
 import sys
-from dataclasses import dataclass
 
 import matplotlib
 import numpy as np
 
-from pkm4puu.cli import add_common_args, start, write_outputs
+from pkm4puu.cli import add_common_args, run_program
+from pkm4puu.closed_loop import run_closed_loop
 from pkm4puu.plots import save_figure
-from pkm4puu.drawing import RUN_COLUMNS, write_run_csv
-from pkm4puu.fmu import Fmu
-from pkm4puu.interface import ACC, DRHO, F, POSE, RHO, RK4, START_P0, VEL
-from pkm4puu.motions import motion
+from pkm4puu.drawing import write_run_csv
+from pkm4puu.interface import RK4, START_P0
 from pkm4puu.spec import STEP as H, T_MOVE
 
 matplotlib.use("Agg")
@@ -122,54 +120,6 @@ def friction(params, drho):
             + params["friction_coulomb"] * np.tanh(drho / params["friction_velocity"]))
 
 
-@dataclass
-class LoopResult:
-    """One closed-loop run: times t (n,), the desired and measured actuator
-    positions rho_d, rho and rates drho_d, drho (n, 4) (m, m/s), the desired
-    and actual pose and their rates (n, 4), the applied forces F and the feed-forward part
-    F_ff (n, 4) (N; F is the force held over the step starting at t, the last
-    row repeats the one before), and the plant's run (t, RUN_COLUMNS) for
-    render_robot.py."""
-    t: np.ndarray
-    rho_d: np.ndarray
-    rho: np.ndarray
-    drho_d: np.ndarray
-    drho: np.ndarray
-    pose_d: np.ndarray
-    pose: np.ndarray
-    dpose_d: np.ndarray
-    dpose: np.ndarray
-    F: np.ndarray
-    F_ff: np.ndarray
-    run: np.ndarray
-
-    @property
-    def e_rho(self):
-        return self.rho_d - self.rho
-
-    @property
-    def de_rho(self):
-        return self.drho_d - self.drho
-
-    @property
-    def F_pd(self):
-        """The PD's part of the applied force (N)."""
-        return self.F - self.F_ff
-
-    @property
-    def rms(self):
-        """RMS of the actuator position errors over time and the 4 actuators (m)."""
-        return float(np.sqrt(np.mean(self.e_rho ** 2)))
-
-    @property
-    def pos_err(self):
-        return np.linalg.norm(self.pose[:, :3] - self.pose_d[:, :3], axis=1)
-
-    @property
-    def phi_err(self):
-        return np.abs(self.pose[:, 3] - self.pose_d[:, 3])
-
-
 def run_loop(plant_fmu, inverse_fmu, plant_machine=None, model=None, feed_forward=True, kp=KP, kd=KD,
              t_end=T_END, T=T_MOVE, h=H, log=None):
     """One closed-loop run of t_end seconds at period h (see the module's doc).
@@ -179,38 +129,16 @@ def run_loop(plant_fmu, inverse_fmu, plant_machine=None, model=None, feed_forwar
     gives rho_d, drho_d (which do not depend on the masses or the friction)."""
     plant_machine = machine() if plant_machine is None else plant_machine
     model = plant_machine if model is None else model
-    n = round(t_end / h)
-    t = np.arange(n + 1) * h
-    rho_d, rho, drho_d, drho, pose_d, pose, dpose_d, dpose = (np.empty((n + 1, 4)) for _ in range(8))
-    Fs, Ffs = np.zeros((n + 1, 4)), np.zeros((n + 1, 4))
-    run = np.empty((n + 1, len(RUN_COLUMNS)))
-    with Fmu(plant_fmu, start={**START_P0, **RK4, **plant_machine}, instance_name="plant") as plant, \
-            Fmu(inverse_fmu, start=model, instance_name="feed_forward") as inv:
-        vr_sense = plant.vrs(RUN_COLUMNS + DRHO + VEL)  # pose, rho, theta1, theta2, drho, dpose
-        vr_F = plant.vrs(F)
-        vr_motion = inv.vrs(POSE + VEL + ACC)
-        vr_ref = inv.vrs(F + RHO + DRHO)
-        for k in range(n + 1):
-            y = np.array(plant.fmu.getReal(vr_sense))
-            run[k], rho[k], drho[k], dpose[k] = y[:16], y[4:8], y[16:20], y[20:24]
-            pose[k] = y[:4]
-            m = motion(t[k], T)
-            inv.fmu.setReal(vr_motion, m)
-            ref = np.array(inv.fmu.getReal(vr_ref))
-            pose_d[k], dpose_d[k], rho_d[k], drho_d[k] = m[:4], m[4:8], ref[4:8], ref[8:12]
-            if k == n:
-                break
-            Ffs[k] = ref[:4] if feed_forward else 0.0
-            Fs[k] = Ffs[k] + kp * (rho_d[k] - rho[k]) + kd * (drho_d[k] - drho[k])
-            plant.fmu.setReal(vr_F, list(Fs[k]))
-            plant.do_step(t[k], h)
-            if log and (k + 1) % 500 == 0:
-                log(f"  t = {t[k + 1]:.2f} s, |rho_d - rho| = {1e3 * np.abs(rho_d[k] - rho[k]).max():.6f} mm")
-    Fs[n], Ffs[n] = Fs[n - 1], Ffs[n - 1]
-    res = LoopResult(t, rho_d, rho, drho_d, drho, pose_d, pose, dpose_d, dpose, Fs, Ffs, run)
-    if not np.all(np.isfinite(res.rho)):
-        raise RuntimeError("closed loop: the plant's outputs are not finite")
-    return res
+
+    def pd(r, k, F_ref):
+        F_ff = F_ref if feed_forward else 0.0
+        return F_ff, F_ff + kp * (r.rho_d[k] - r.rho[k]) + kd * (r.drho_d[k] - r.drho[k])
+
+    def progress(r, k):
+        return f"|rho_d - rho| = {1e3 * np.abs(r.rho_d[k] - r.rho[k]).max():.6f} mm"
+
+    return run_closed_loop(plant_fmu, inverse_fmu, {**START_P0, **RK4, **plant_machine}, model, pd, progress,
+                           t_end, T, h, log)
 
 
 def compare(plant_fmu, inverse_fmu, plant_machine=None, t_end=T_END, log=None):
@@ -310,26 +238,24 @@ def main(argv=None):
     ap.add_argument("--viscous", type=float, default=VISCOUS,
                     help="viscous friction of each joint (N s/m, default %(default)s)")
     ap.add_argument("--t-end", type=float, default=T_END, help="run length (s, default %(default)s)")
-    args, log, fmus = start(ap, argv)
-    if fmus is None:
-        return 1
-    if min(args.payload, args.coulomb, args.viscous) < 0 or args.t_end <= 0:
-        log("error: --payload, --coulomb and --viscous must be >= 0 and --t-end > 0")
-        return 2
-    params = machine(args.payload, args.coulomb, args.viscous)
-    try:
+
+    def compute(args, fmus, log):
+        params = machine(args.payload, args.coulomb, args.viscous)
         runs, ratio = compare(*fmus, plant_machine=params, t_end=args.t_end, log=log)
-    except Exception as exc:  # an FMU error or a diverging loop
-        log(f"error: {exc}")
-        return 1
-    print(summary(runs, ratio, params), flush=True)
-    write_outputs(args.out, log, {"closed_loop.csv": lambda p: write_csv(runs, p),
-                                  "closed_loop_tracking.png": lambda p: plot(runs, ratio, params, p),
-                                  "closed_loop_run.csv": lambda p: write_run_csv(p, runs["ff"].t, runs["ff"].run)})
-    if ratio < MIN_RATIO:
-        log(f"note: friction compensation cut the RMS error by {ratio:.1f}, less than the {MIN_RATIO:g} the test "
-            "requires with the default machine")
-    return 0
+        if ratio < MIN_RATIO:
+            log(f"note: friction compensation cut the RMS error by {ratio:.1f}, less than the {MIN_RATIO:g} the "
+                "test requires with the default machine")
+        return summary(runs, ratio, params), {
+            "closed_loop.csv": lambda p: write_csv(runs, p),
+            "closed_loop_tracking.png": lambda p: plot(runs, ratio, params, p),
+            "closed_loop_run.csv": lambda p: write_run_csv(p, runs["ff"].t, runs["ff"].run)}
+
+    def invalid(args):
+        if min(args.payload, args.coulomb, args.viscous) < 0 or args.t_end <= 0:
+            return "--payload, --coulomb and --viscous must be >= 0 and --t-end > 0"
+        return None
+
+    return run_program(ap, argv, compute, invalid)
 
 
 if __name__ == "__main__":

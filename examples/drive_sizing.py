@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import matplotlib
 import numpy as np
 
-from pkm4puu.cli import add_common_args, start, write_outputs
+from pkm4puu.cli import add_common_args, run_program
 from pkm4puu.plots import save_figure
 from pkm4puu.fmu import Fmu
 from pkm4puu.interface import ACC, arr, DRHO, F, POSE, RHO, VEL
@@ -208,24 +208,16 @@ def main(argv=None):
     add_common_args(ap)
     ap.add_argument("--durations", type=float, nargs="+", default=list(DURATIONS),
                     help="move times T of the auto-test's path (s, default %(default)s)")
-    args, log, fmus = start(ap, argv)
-    if fmus is None:
-        return 1
-    if min(args.durations) <= 0:
-        log("error: --durations must be > 0")
-        return 2
-    try:
+
+    def compute(args, fmus, log):
         profiles = []
         for T in args.durations:
             log(f"inverse dynamics along the auto-test in {T:g} s")
             profiles.append(drive_profile(fmus[1], T=T))
-    except Exception as exc:  # an FMU error
-        log(f"error: {exc}")
-        return 1
-    print(table(profiles), flush=True)
-    write_outputs(args.out, log, {"drive_sizing.csv": lambda p: write_csv(profiles, p),
-                                  "drive_sizing.png": lambda p: plot(profiles, p)})
-    return 0
+        return table(profiles), {"drive_sizing.csv": lambda p: write_csv(profiles, p),
+                                 "drive_sizing.png": lambda p: plot(profiles, p)}
+
+    return run_program(ap, argv, compute, lambda args: "--durations must be > 0" if min(args.durations) <= 0 else None)
 
 
 if __name__ == "__main__":

@@ -52,13 +52,13 @@ import matplotlib
 import numpy as np
 import scipy.linalg as sla
 
-from pkm4puu.cli import add_common_args, start, write_outputs
+from pkm4puu.cli import add_common_args, run_program
 from pkm4puu.plots import save_figure
-from pkm4puu.drawing import RUN_COLUMNS
+from pkm4puu.closed_loop import run_closed_loop
 from pkm4puu.fmu import Fmu
-from pkm4puu.interface import ACC, DRHO, F, POSE, RHO, RK4, VEL, start_pose
+from pkm4puu.interface import F, POSE, RK4, VEL, start_pose
 from pkm4puu.linearization import INPUTS, ModelExchange
-from pkm4puu.motions import autotest_motion, motion
+from pkm4puu.motions import autotest_motion
 from pkm4puu.references.pinocchio_derivatives import PinocchioReducedDerivatives
 from pkm4puu import spec
 from pkm4puu.spec import STEP as H, T_MOVE
@@ -228,41 +228,18 @@ def offset_start(offset=OFFSET):
 
 def run_lqr(plant_fmu, inverse_fmu, K, plant_machine=None, offset=OFFSET, t_end=T_END, h=H, log=None):
     """The LQR loop, F = F_ff + K (y_d - y) held over each step, from the
-    offset start; a closed_loop_control.LoopResult."""
+    offset start; a pkm4puu.closed_loop.LoopResult."""
     plant_machine = clc.machine() if plant_machine is None else plant_machine
-    n = round(t_end / h)
-    t = np.arange(n + 1) * h
-    rho_d, rho, drho_d, drho, pose_d, pose, dpose_d, dpose = (np.empty((n + 1, 4)) for _ in range(8))
-    Fs, Ffs = np.zeros((n + 1, 4)), np.zeros((n + 1, 4))
-    run = np.empty((n + 1, len(RUN_COLUMNS)))
-    start = {**offset_start(offset), **RK4, **plant_machine}
-    with Fmu(plant_fmu, start=start, instance_name="plant") as plant, \
-            Fmu(inverse_fmu, start=plant_machine, instance_name="feed_forward") as inv:
-        vr_sense = plant.vrs(RUN_COLUMNS + DRHO + VEL)
-        vr_F = plant.vrs(F)
-        vr_motion = inv.vrs(POSE + VEL + ACC)
-        vr_ref = inv.vrs(F + RHO + DRHO)
-        for k in range(n + 1):
-            y = np.array(plant.fmu.getReal(vr_sense))
-            run[k], rho[k], drho[k], dpose[k], pose[k] = y[:16], y[4:8], y[16:20], y[20:24], y[:4]
-            m = motion(t[k], T_MOVE)
-            inv.fmu.setReal(vr_motion, m)
-            ref = np.array(inv.fmu.getReal(vr_ref))
-            pose_d[k], dpose_d[k], rho_d[k], drho_d[k] = m[:4], m[4:8], ref[4:8], ref[8:12]
-            if k == n:
-                break
-            Ffs[k] = ref[:4]
-            e = np.concatenate([pose_d[k] - pose[k], dpose_d[k] - dpose[k]])
-            Fs[k] = Ffs[k] + K @ e
-            plant.fmu.setReal(vr_F, list(Fs[k]))
-            plant.do_step(t[k], h)
-            if log and (k + 1) % 500 == 0:
-                log(f"  LQR: t = {t[k + 1]:.2f} s, |p - p_d| = {1e3 * np.linalg.norm(e[:3]):.6f} mm")
-    Fs[n], Ffs[n] = Fs[n - 1], Ffs[n - 1]
-    res = clc.LoopResult(t, rho_d, rho, drho_d, drho, pose_d, pose, dpose_d, dpose, Fs, Ffs, run)
-    if not np.all(np.isfinite(res.pose)):
-        raise RuntimeError("LQR loop: the plant's outputs are not finite")
-    return res
+
+    def lqr_law(r, k, F_ref):
+        e = np.concatenate([r.pose_d[k] - r.pose[k], r.dpose_d[k] - r.dpose[k]])
+        return F_ref, F_ref + K @ e
+
+    def progress(r, k):
+        return f"|p - p_d| = {1e3 * np.linalg.norm(r.pose_d[k, :3] - r.pose[k, :3]):.6f} mm"
+
+    return run_closed_loop(plant_fmu, inverse_fmu, {**offset_start(offset), **RK4, **plant_machine}, plant_machine,
+                           lqr_law, progress, t_end, T_MOVE, h, log, name="LQR loop")
 
 
 def run_pd(plant_fmu, inverse_fmu, plant_machine=None, offset=OFFSET, t_end=T_END, log=None):
@@ -428,21 +405,17 @@ def main(argv=None):
     ap.add_argument("--t-end", type=float, default=T_END, help="closed-loop run length (s, default %(default)s)")
     ap.add_argument("--offset", type=float, default=1e3 * OFFSET,
                     help="initial offset from the path (mm, default %(default)s)")
-    args, log, fmus = start(ap, argv)
-    if fmus is None:
-        return 1
-    if args.t_end <= 0 or not 0 <= args.offset <= 5:
-        log("error: --t-end must be > 0 and --offset within [0, 5] mm")
-        return 2
-    try:
+
+    def compute(args, fmus, log):
         s = Study(*fmus, t_end=args.t_end, offset=1e-3 * args.offset, log=log).run()
-    except Exception as exc:  # an FMU error or a diverging loop
-        log(f"error: {exc}")
-        return 1
-    print(summary(s), flush=True)
-    write_outputs(args.out, log, {"linearize_lqr.csv": lambda p: write_csv(s, p),
-                                  "linearize_lqr.png": lambda p: plot(s, p)})
-    return 0
+        return summary(s), {"linearize_lqr.csv": lambda p: write_csv(s, p), "linearize_lqr.png": lambda p: plot(s, p)}
+
+    def invalid(args):
+        if args.t_end <= 0 or not 0 <= args.offset <= 5:
+            return "--t-end must be > 0 and --offset within [0, 5] mm"
+        return None
+
+    return run_program(ap, argv, compute, invalid)
 
 
 if __name__ == "__main__":

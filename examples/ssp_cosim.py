@@ -52,6 +52,7 @@ import matplotlib
 import numpy as np
 
 from pkm4puu.cli import add_common_args, start, write_outputs
+from pkm4puu.closed_loop import PoseErrors
 from pkm4puu.plots import save_figure
 from pkm4puu.interface import ACC, F, POSE, START_P0, VEL
 from pkm4puu.motions import motion, p
@@ -106,6 +107,18 @@ def _parameter_binding(name, values):
       </ssd:ParameterBindings>"""
 
 
+def _component(name, fmu, inputs, outputs, binding, values):
+    """An ssd:Component: the FMU resources/<fmu>, its Real connectors and
+    one parameter set `binding` of start values."""
+    connectors = "\n".join([_connector(n, "input") for n in inputs] + [_connector(n, "output") for n in outputs])
+    return f"""      <ssd:Component name="{name}" source="resources/{fmu}">
+        <ssd:Connectors>
+{connectors}
+        </ssd:Connectors>
+{_parameter_binding(binding, values)}
+      </ssd:Component>"""
+
+
 def system_structure(solver="cvode", lead=LEAD, h=H):
     """SystemStructure.ssd as text. The plant starts at rest at P0 with the
     given solver; the inverse FMU's motion inputs start at the motion at
@@ -115,8 +128,6 @@ def system_structure(solver="cvode", lead=LEAD, h=H):
         plant_params["rk4_step"] = float(h)
     inverse_start = dict(zip(MOTION_INPUTS, (float(v) for v in motion((lead - 1.0) * h))))
     xmlns = " ".join(f'xmlns:{k}="{v}"' for k, v in NS.items())
-    connectors_inv = "\n".join([_connector(n, "input") for n in MOTION_INPUTS] + [_connector(n, "output") for n in F])
-    connectors_plant = "\n".join([_connector(n, "input") for n in F] + [_connector(n, "output") for n in POSE])
     connections = "\n".join(
         f'      <ssd:Connection startElement="inverse" startConnector="{n}" endElement="plant" endConnector="{n}"/>'
         for n in F)
@@ -127,18 +138,8 @@ def system_structure(solver="cvode", lead=LEAD, h=H):
 <ssd:SystemStructureDescription {xmlns} name="PKM4PUU_autotest" version="1.0">
   <ssd:System name="autotest" description="4-PUU PKM: computed-force feed-forward driving the plant open loop">
     <ssd:Elements>
-      <ssd:Component name="inverse" source="resources/{INVERSE_FMU}">
-        <ssd:Connectors>
-{connectors_inv}
-        </ssd:Connectors>
-{_parameter_binding("initial motion", inverse_start)}
-      </ssd:Component>
-      <ssd:Component name="plant" source="resources/{PLANT_FMU}">
-        <ssd:Connectors>
-{connectors_plant}
-        </ssd:Connectors>
-{_parameter_binding("plant set-up", plant_params)}
-      </ssd:Component>
+{_component("inverse", INVERSE_FMU, MOTION_INPUTS, F, "initial motion", inverse_start)}
+{_component("plant", PLANT_FMU, F, POSE, "plant set-up", plant_params)}
     </ssd:Elements>
     <ssd:Connections>
 {connections}
@@ -168,20 +169,12 @@ def write_ssp(plant_fmu, inverse_fmu, path, solver="cvode", lead=LEAD):
 
 # --- running it with libcosim ----------------------------------------------------------------
 @dataclass
-class SspRun:
+class SspRun(PoseErrors):
     """Communication times t (s), the plant's pose (x, y, z, phi) there and
-    the prescribed pose; pos_err (m) and phi_err (rad) as in pkm4puu.autotest."""
+    the prescribed pose pose_d; pos_err (m) and phi_err (rad) as in pkm4puu.autotest."""
     t: np.ndarray
     pose: np.ndarray
-    ref: np.ndarray
-
-    @property
-    def pos_err(self):
-        return np.linalg.norm(self.pose[:, :3] - self.ref[:, :3], axis=1)
-
-    @property
-    def phi_err(self):
-        return np.abs(self.pose[:, 3] - self.ref[:, 3])
+    pose_d: np.ndarray
 
 
 def _libcosim():

@@ -22,16 +22,20 @@ def _require_fmu(name: str) -> Path:
     return path
 
 
-@pytest.fixture(scope="session")
-def plant_fmu() -> Path:
-    """PKM4PUU.fmu, the forward-dynamics plant."""
-    return _require_fmu("PKM4PUU.fmu")
+def _built(name: str, what: str):
+    """A session fixture: the path of `name` in the build directory, which
+    must exist (_require_fmu)."""
+    def fixture() -> Path:
+        return _require_fmu(name)
+    fixture.__doc__ = f"{name}, {what}."
+    return pytest.fixture(scope="session")(fixture)
 
 
-@pytest.fixture(scope="session")
-def inverse_fmu() -> Path:
-    """PKM4PUU_Inverse.fmu, the algebraic inverse dynamics."""
-    return _require_fmu("PKM4PUU_Inverse.fmu")
+plant_fmu = _built("PKM4PUU.fmu", "the forward-dynamics plant")
+inverse_fmu = _built("PKM4PUU_Inverse.fmu", "the algebraic inverse dynamics")
+pkm_library = _built("fmu_src/libpkm.so", "the plain C API (pkm.h)")
+plant_fmu3 = _built("fmi3/PKM4PUU.fmu", "the plant as FMI 3.0 (Co-Simulation and Model Exchange)")
+inverse_fmu3 = _built("fmi3/PKM4PUU_Inverse.fmu", "the inverse dynamics as FMI 3.0")
 
 
 @pytest.fixture(scope="session")
@@ -39,24 +43,6 @@ def results_dir() -> Path:
     path = REPO / "results"
     path.mkdir(parents=True, exist_ok=True)
     return path
-
-
-@pytest.fixture(scope="session")
-def pkm_library() -> Path:
-    """fmu_src/libpkm.so, the plain C API (pkm.h)."""
-    return _require_fmu("fmu_src/libpkm.so")
-
-
-@pytest.fixture(scope="session")
-def plant_fmu3() -> Path:
-    """fmi3/PKM4PUU.fmu, the plant as FMI 3.0 (Co-Simulation and Model Exchange)."""
-    return _require_fmu("fmi3/PKM4PUU.fmu")
-
-
-@pytest.fixture(scope="session")
-def inverse_fmu3() -> Path:
-    """fmi3/PKM4PUU_Inverse.fmu, the inverse dynamics as FMI 3.0."""
-    return _require_fmu("fmi3/PKM4PUU_Inverse.fmu")
 
 
 @pytest.fixture(scope="session")

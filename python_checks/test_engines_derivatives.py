@@ -35,6 +35,7 @@ import math
 import numpy as np
 import pytest
 
+from differences import richardson
 from pkm4puu import capi as pkm_capi, motions, spec
 from pkm4puu.linearization import ModelExchange
 from pkm4puu.references.pinocchio_derivatives import PinocchioReducedDerivatives
@@ -86,20 +87,6 @@ def errors(A, B, Ar, Br, g):
     As, Bs = in_consistent_units(A, B, g)
     Ars, Brs = in_consistent_units(Ar, Br, g)
     return column_error(As[4:], Ars[4:]), column_error(Bs[4:], Brs[4:])
-
-
-def richardson(f, h, levels=4):
-    """d/ds f(s) at 0 by central differences at h, h/2, ... and Richardson's
-    table; also the last correction's size (the estimate's own error)."""
-    T = []
-    for k in range(levels):
-        hk = h / 2**k
-        T.append((f(hk) - f(-hk)) / (2 * hk))
-        factor = 4.0
-        for j in range(k - 1, -1, -1):
-            T[j] = (factor * T[j + 1] - T[j]) / (factor - 1.0)
-            factor *= 4.0
-    return T[0], np.abs(T[0] - T[1])
 
 
 def y_of(state):
@@ -179,6 +166,11 @@ def test_pinocchio_assembly_matches_differences_of_its_own_dynamics(pinocchio, c
 
 
 def check_against_pinocchio(results, pinocchio, case, what):
+    """An engine's A, B ({case: {state: (ydot, A, B)}}): the kinematic rows
+    [0 I] and 0 exactly, the acceleration rows against Pinocchio's."""
+    for name in STATES:
+        _, A, B = results[case][name]
+        assert np.array_equal(A[:4], np.hstack([np.zeros((4, 4)), np.eye(4)])) and not B[:4].any(), name
     ref = pinocchio[0][case]
     g = gear(CASES[case])
     worst_a = worst_b = 0.0
@@ -194,26 +186,17 @@ def check_against_pinocchio(results, pinocchio, case, what):
         worst_a, worst_b = max(worst_a, eA), max(worst_b, eB)
         # an analytic identity: nothing depends on z (vertical translation of the whole machine)
         assert np.abs(A[4:, 2]).max() <= 1e-9 * FLOOR * np.abs(A[4:]).max(), f"{what} {case}, {name}: d/dz"
-    return worst_a, worst_b
+    print(f"{what}, {case}: largest column-relative difference from Pinocchio: A {worst_a:.2e}, B {worst_b:.2e}")
 
 
 @pytest.mark.parametrize("case", CASES)
 def test_capi_derivatives_match_pinocchio(capi_derivatives, pinocchio, case):
-    for name in STATES:
-        _, A, B = capi_derivatives[case][name]
-        assert np.array_equal(A[:4], np.hstack([np.zeros((4, 4)), np.eye(4)])) and not B[:4].any(), name
-    worst = check_against_pinocchio(capi_derivatives, pinocchio, case, "C API")
-    print(f"C API, {case}: largest column-relative difference from Pinocchio: A {worst[0]:.2e}, B {worst[1]:.2e}")
+    check_against_pinocchio(capi_derivatives, pinocchio, case, "C API")
 
 
 @pytest.mark.parametrize("case", CASES)
 def test_model_exchange_directional_derivatives_match_pinocchio(fmu_derivatives, pinocchio, case):
-    for name in STATES:
-        _, A, B = fmu_derivatives[case][name]
-        assert np.array_equal(A[:4], np.hstack([np.zeros((4, 4)), np.eye(4)])) and not B[:4].any(), name
-    worst = check_against_pinocchio(fmu_derivatives, pinocchio, case, "Model Exchange FMU")
-    print(f"Model Exchange FMU, {case}: largest column-relative difference from Pinocchio: "
-          f"A {worst[0]:.2e}, B {worst[1]:.2e}")
+    check_against_pinocchio(fmu_derivatives, pinocchio, case, "Model Exchange FMU")
 
 
 @pytest.mark.parametrize("case", CASES)

@@ -1,5 +1,6 @@
-// Shared helpers of the unit tests: random reachable states and finite
-// differences (all derived from the spec, never from the code's outputs).
+// Shared helpers of the unit tests: random reachable states, finite
+// differences and the reference model's Lagrangian terms (all derived from
+// the spec, never from the code's outputs).
 #pragma once
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 
 #include "constraints.hpp"
 #include "model.hpp"
+#include "reference_model.hpp"
 #include "servo_kinematics.hpp"
 
 namespace pkm_test {
@@ -104,6 +106,58 @@ template <class A, class B>
 double rel_diff(const A& a, const B& b, double floor = 1e-300) {
   const double scale = std::max({a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff(), floor});
   return (a - b).cwiseAbs().maxCoeff() / scale;
+}
+
+/// The Lagrangian terms of Eq. 1 from the independent reference model's
+/// energies (reference_model.hpp). M: the Hessian of T in qd by
+/// polarisation, exact for a quadratic form.
+inline Mat16 ref_mass_matrix(const ref::RefParams& r, const Vec16& q) {
+  Mat16 H;
+  const Vec16 zero = Vec16::Zero();
+  for (int i = 0; i < kN; ++i)
+    for (int j = 0; j < kN; ++j) {
+      const Vec16 ei = Vec16::Unit(i), ej = Vec16::Unit(j);
+      H(i, j) = ref::kinetic_energy(r, q, ei + ej) - ref::kinetic_energy(r, q, ei) - ref::kinetic_energy(r, q, ej) +
+                ref::kinetic_energy(r, q, zero);
+    }
+  return H;
+}
+
+/// dT/dqd at (q, qd). T is quadratic in qd, so the central difference with
+/// a unit step is exact: (T(qd+e) - T(qd-e))/2.
+inline Vec16 ref_momentum(const ref::RefParams& r, const Vec16& q, const Vec16& qd) {
+  Vec16 p;
+  for (int k = 0; k < kN; ++k) {
+    Vec16 a = qd, b = qd;
+    a[k] += 1.0;
+    b[k] -= 1.0;
+    p[k] = 0.5 * (ref::kinetic_energy(r, q, a) - ref::kinetic_energy(r, q, b));
+  }
+  return p;
+}
+
+/// d/dq_k of a scalar function of q, every k, by d_ds (step 1e-3).
+template <class F>
+Vec16 ref_gradient(F f, const Vec16& q) {
+  Vec16 g;
+  for (int k = 0; k < kN; ++k)
+    g[k] = d_ds([&](double e) {
+      Vec16 x = q;
+      x[k] += e;
+      return Eigen::Matrix<double, 1, 1>(f(x));
+    }, 1e-3)[0];
+  return g;
+}
+
+/// V = d/dt(dT/dqd) - dT/dq - M qdd = (d/ds dT/dqd(q + s qd, qd)) - dT/dq.
+inline Vec16 ref_coriolis(const ref::RefParams& r, const Vec16& q, const Vec16& qd) {
+  const Vec16 dpdt = d_ds([&](double e) { return ref_momentum(r, Vec16(q + e * qd), qd); }, 1e-3);
+  return dpdt - ref_gradient([&](const Vec16& x) { return ref::kinetic_energy(r, x, qd); }, q);
+}
+
+/// G = dU/dq.
+inline Vec16 ref_gravity(const ref::RefParams& r, const Vec16& q) {
+  return ref_gradient([&](const Vec16& x) { return ref::potential_energy(r, x); }, q);
 }
 
 }  // namespace pkm_test

@@ -7,8 +7,9 @@
 Modules: spec (MODEL_SPEC's numbers and geometry), motions (the test
 motions), interface (variable names), fmu (the wrapper), autotest and
 comparison (the paper's tests through the FMUs; also `python -m`), plots,
-drawing, cli; references.pinocchio_model and references.mujoco_model (the
-independent models, imported on demand: they need pinocchio and mujoco);
+drawing, cli, closed_loop (the sampled loop the control examples share);
+references.pinocchio_model and references.mujoco_model (the independent
+models, imported on demand: they need pinocchio and mujoco);
 capi (a ctypes binding of the C API, pkm.h).
 """
 from .fmu import Fmu, Result, build_dir, find_fmu, inverse_forces, run

@@ -31,14 +31,13 @@ usage: python -m pkm4puu.autotest [--build DIR] [--out DIR]
 import argparse
 import csv
 import sys
-import time
 from pathlib import Path
 
 import matplotlib
 import numpy as np
 
 from . import plots
-from .cli import Log, add_common_args, find_fmus
+from .cli import add_common_args, case_table, finish, run_cases, start
 from .fmu import Fmu, inverse_forces, run
 from .interface import ACC, F, POSE, START_P0, VEL
 from .motions import p
@@ -56,6 +55,7 @@ TOL_PHI = 5e-8  # rad
 SOLVERS = {"CVODE": {"solver": 0}, "RK4": {"solver": 1, "rk4_step": 1e-3}}
 MODES = ("midpoint", "first_order", "zoh")
 BOUNDED_MODES = ("midpoint", "first_order")
+CASES = [(m, s) for m in MODES for s in SOLVERS]  # (input mode, solver), in the table's order
 START = START_P0
 # The case shown in fmu_autotest_pose.png.
 POSE_PLOT_CASE = ("midpoint", "CVODE")
@@ -179,42 +179,22 @@ def run_all(plant_fmu, Fh, log=None, errors=None):
     `errors` is a dict, a case that raises is recorded there as
     (mode, solver) -> exception and left out; otherwise the exception
     propagates."""
-    out = {}
-    for m in MODES:
-        for s in SOLVERS:
-            if log:
-                log(f"case {m}/{s}: running {N} steps of {H * 1e3:g} ms")
-            t0 = time.perf_counter()
-            try:
-                out[(m, s)] = r = run_case(plant_fmu, m, s, Fh)
-            except Exception as exc:
-                if errors is None:
-                    raise
-                errors[(m, s)] = exc
-                if log:
-                    log(f"case {m}/{s}: FAILED: {exc}")
-                continue
-            if log:
-                log(f"case {m}/{s}: done in {time.perf_counter() - t0:.2f} s, max position error "
-                    f"{r.pos_err.max():.3e} m, max phi error {r.phi_err.max():.3e} rad")
-    return out
+    return run_cases(CASES, lambda case: run_case(plant_fmu, *case, Fh), lambda case: "case {}/{}".format(*case),
+                     log, errors, f"running {N} steps of {H * 1e3:g} ms",
+                     lambda r: f", max position error {r.pos_err.max():.3e} m, max phi error {r.phi_err.max():.3e} rad")
 
 
 def format_table(runs, errors=None):
     """The table of max errors, one row per case, with the bound each case is held to."""
-    lines = [f"FMU auto-test (paper section 5.1): inverse FMU -> F1..F4 -> plant FMU, open loop, "
-             f"{H * 1e3:g} ms communication step, {T_MOVE:g} s: max errors",
-             f"{'input mode':<12} {'solver':<6} {'position (m)':>13} {'phi (rad)':>11}  test bound"]
-    for m in MODES:
-        for s in SOLVERS:
-            if (m, s) in runs:
-                r = runs[(m, s)]
-                bound = (f"<= {TOL_POS:g} m, <= {TOL_PHI:g} rad" if m in BOUNDED_MODES
-                         else "above the midpoint hold's (O(h) lag)")
-                lines.append(f"{m:<12} {s:<6} {r.pos_err.max():13.3e} {r.phi_err.max():11.3e}  {bound}")
-            elif errors and (m, s) in errors:
-                lines.append(f"{m:<12} {s:<6} FAILED: {errors[(m, s)]}")
-    return "\n".join(lines)
+    def row(case, r):
+        bound = (f"<= {TOL_POS:g} m, <= {TOL_PHI:g} rad" if case[0] in BOUNDED_MODES
+                 else "above the midpoint hold's (O(h) lag)")
+        return f"{r.pos_err.max():13.3e} {r.phi_err.max():11.3e}  {bound}"
+
+    head = [f"FMU auto-test (paper section 5.1): inverse FMU -> F1..F4 -> plant FMU, open loop, "
+            f"{H * 1e3:g} ms communication step, {T_MOVE:g} s: max errors",
+            f"{'input mode':<12} {'solver':<6} {'position (m)':>13} {'phi (rad)':>11}  test bound"]
+    return "\n".join(case_table(head, CASES, runs, errors, lambda case: "{:<12} {:<6}".format(*case), row))
 
 
 # --- results ------------------------------------------------------------------------------
@@ -284,9 +264,7 @@ def main(argv=None):
                                  description="The paper's auto-test (section 5.1) through the FMUs: inverse FMU "
                                  "-> F1..F4 -> plant FMU, open loop, 1 ms communication step, 2 s.")
     add_common_args(ap)
-    args = ap.parse_args(argv)
-    log = Log("autotest")
-    fmus = find_fmus(args.build, log)
+    args, log, fmus = start(ap, argv, name="autotest")
     if fmus is None:
         return 1
     plant, inverse = fmus
@@ -294,17 +272,9 @@ def main(argv=None):
     Fh = half_step_forces(inverse)
     errors = {}
     runs = run_all(plant, Fh, log=log, errors=errors)
-    bad = sorted(k for k, r in runs.items() if not r.finite())
-
-    print(format_table(runs, errors), flush=True)
-    if errors or bad:
-        for m, s in bad:
-            log(f"case {m}/{s}: non-finite pose")
-        log(f"{len(errors) + len(bad)} of {len(MODES) * len(SOLVERS)} cases failed; nothing written")
-        return 1
-    for path in write_results(runs, Fh, inverse, args.out):
-        log(f"wrote {path}")
-    return 0
+    bad = [f"case {m}/{s}: non-finite pose" for m, s in sorted(k for k, r in runs.items() if not r.finite())]
+    return finish(log, format_table(runs, errors), errors, bad, len(CASES), "cases",
+                  lambda: write_results(runs, Fh, inverse, args.out))
 
 
 if __name__ == "__main__":

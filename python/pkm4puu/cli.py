@@ -1,7 +1,7 @@
 """What the command-line programs share (the examples and `python -m
 pkm4puu.autotest`): progress on stderr, the --build/--out arguments,
-finding the FMUs with a message that says how to build them, and writing
-the output files."""
+finding the FMUs with a message that says how to build them, an example's
+main (run_program) and writing the output files."""
 import os
 import platform
 import sys
@@ -52,12 +52,92 @@ def find_fmus(build, log, models=("PKM4PUU", "PKM4PUU_Inverse")):
         return None
 
 
-def start(ap, argv, models=("PKM4PUU", "PKM4PUU_Inverse")):
-    """Parses argv with ap, starts a Log named after the program and finds the
-    FMUs: (args, log, fmus), fmus None when they are missing (logged)."""
+def start(ap, argv, models=("PKM4PUU", "PKM4PUU_Inverse"), name=None):
+    """Parses argv with ap, starts a Log named `name` (default: the
+    program's) and finds the FMUs: (args, log, fmus), fmus None when they are
+    missing (logged)."""
     args = ap.parse_args(argv)
-    log = Log(ap.prog)
+    log = Log(name or ap.prog)
     return args, log, find_fmus(args.build, log, models)
+
+
+def run_program(ap, argv, compute, invalid=None, models=("PKM4PUU", "PKM4PUU_Inverse")):
+    """An example's main after its arguments are declared: parses argv and
+    finds the FMUs (1 when they are missing); invalid(args), when given,
+    returns what is wrong with the arguments or None (logged, 2);
+    compute(args, fmus, log) returns (the summary to print, {file name:
+    writer(path)} for write_outputs into --out); an exception it raises (an
+    FMU error, a diverging loop) is logged, 1. Returns the exit status."""
+    args, log, fmus = start(ap, argv, models)
+    if fmus is None:
+        return 1
+    wrong = invalid(args) if invalid else None
+    if wrong:
+        log(f"error: {wrong}")
+        return 2
+    try:
+        summary, writers = compute(args, fmus, log)
+    except Exception as exc:
+        log(f"error: {exc}")
+        return 1
+    print(summary, flush=True)
+    write_outputs(args.out, log, writers)
+    return 0
+
+
+def run_cases(cases, run_one, label, log=None, errors=None, running="", result=lambda r: ""):
+    """{case: run_one(case)} for every case. log(message), when given, is
+    told when each starts ("<label(case)>: <running>") and ends (with
+    result(r)). When `errors` is a dict, a case that raises is recorded
+    there (case -> exception) and left out; otherwise the exception
+    propagates."""
+    out = {}
+    for case in cases:
+        name = label(case)
+        if log:
+            log(f"{name}: {running}")
+        t0 = time.perf_counter()
+        try:
+            out[case] = r = run_one(case)
+        except Exception as exc:
+            if errors is None:
+                raise
+            errors[case] = exc
+            if log:
+                log(f"{name}: FAILED: {exc}")
+            continue
+        if log:
+            log(f"{name}: done in {time.perf_counter() - t0:.2f} s{result(r)}")
+    return out
+
+
+def case_table(head, cases, runs, errors, label, row):
+    """The lines of a results table: `head`, then for each case that ran
+    "<label(case)> <row(case, result)>", for each that raised (in `errors`)
+    "<label(case)> FAILED: <exception>"."""
+    lines = list(head)
+    for case in cases:
+        if case in runs:
+            lines.append(f"{label(case)} {row(case, runs[case])}")
+        elif errors and case in errors:
+            lines.append(f"{label(case)} FAILED: {errors[case]}")
+    return lines
+
+
+def finish(log, table, errors, bad, total, kind, write):
+    """The end of a program that runs cases (run_cases): prints `table`;
+    when a case raised (`errors`, logged already) or gave a bad result (`bad`:
+    a message each, logged here) writes nothing and returns 1; otherwise
+    write() writes the results, each path it returns is logged, 0."""
+    print(table, flush=True)
+    if errors or bad:
+        for message in bad:
+            log(message)
+        log(f"{len(errors) + len(bad)} of {total} {kind} failed; nothing written")
+        return 1
+    for path in write():
+        log(f"wrote {path}")
+    return 0
 
 
 def write_outputs(out, log, writers):

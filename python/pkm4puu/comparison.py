@@ -25,13 +25,12 @@ import argparse
 import csv
 import math
 import sys
-import time
 from pathlib import Path
 
 import matplotlib
 import numpy as np
 
-from .cli import Log, add_common_args, find_fmus
+from .cli import add_common_args, case_table, finish, run_cases, start
 from .fmu import Fmu, run
 from .interface import F, POSE, START_P0, arr
 from .motions import comparison_forces
@@ -79,23 +78,8 @@ def run_all(plant_fmu, log=None, errors=None):
     told when each run starts and ends. When `errors` is a dict, a run that
     raises is recorded there (solver -> exception) and left out; otherwise
     the exception propagates."""
-    out = {}
-    for name in SOLVERS:
-        if log:
-            log(f"{name}: running {N} steps of {H * 1e3:g} ms")
-        t0 = time.perf_counter()
-        try:
-            out[name] = run_solver(plant_fmu, name)
-        except Exception as exc:
-            if errors is None:
-                raise
-            errors[name] = exc
-            if log:
-                log(f"{name}: FAILED: {exc}")
-            continue
-        if log:
-            log(f"{name}: done in {time.perf_counter() - t0:.2f} s")
-    return out
+    return run_cases(SOLVERS, lambda name: run_solver(plant_fmu, name), str, log, errors,
+                     f"running {N} steps of {H * 1e3:g} ms")
 
 
 # --- what the checks look at ---------------------------------------------------------------
@@ -137,16 +121,12 @@ def solver_difference(a, b):
 
 def format_table(runs, errors=None):
     """The table of max errors per solver and of CVODE vs RK4, with the bounds."""
-    lines = [f"FMU comparison test (paper section 5.2): plant FMU, g = 0, F1 = -F4 = {CMP_AMPLITUDE:g} N "
-             f"sin(2 pi t / {CMP_DURATION:g} s), F2 = F3 = 0, {H * 1e3:g} ms communication step, {CMP_DURATION:g} s",
-             f"{'solver':<6} {'max ||C(q)|| (m)':>17} {'vertical COM drift (m)':>23} {'max |delta rho1| (m)':>21}"]
-    for name in SOLVERS:
-        if name in runs:
-            r = runs[name]
-            lines.append(f"{name:<6} {max_constraint_residual(r):17.3e} {vertical_com_drift(r):23.3e} "
-                         f"{max_delta_rho1(r):21.4e}")
-        elif errors and name in errors:
-            lines.append(f"{name:<6} FAILED: {errors[name]}")
+    head = [f"FMU comparison test (paper section 5.2): plant FMU, g = 0, F1 = -F4 = {CMP_AMPLITUDE:g} N "
+            f"sin(2 pi t / {CMP_DURATION:g} s), F2 = F3 = 0, {H * 1e3:g} ms communication step, {CMP_DURATION:g} s",
+            f"{'solver':<6} {'max ||C(q)|| (m)':>17} {'vertical COM drift (m)':>23} {'max |delta rho1| (m)':>21}"]
+    lines = case_table(head, SOLVERS, runs, errors, lambda name: f"{name:<6}",
+                       lambda name, r: f"{max_constraint_residual(r):17.3e} {vertical_com_drift(r):23.3e} "
+                                       f"{max_delta_rho1(r):21.4e}")
     lines.append(f"{'bound':<6} {'<= ' + format(TOL_CONSTRAINT, 'g'):>17} {'<= ' + format(TOL_POS, 'g'):>23} "
                  f"{'> ' + format(MIN_DELTA_RHO1, 'g'):>21}")
     if "CVODE" in runs and "RK4" in runs:
@@ -203,25 +183,15 @@ def main(argv=None):
                                  description="The paper's comparison test (section 5.2) through the plant FMU, "
                                  "with CVODE and with RK4.")
     add_common_args(ap)
-    args = ap.parse_args(argv)
-    log = Log("comparison")
-    fmus = find_fmus(args.build, log, models=("PKM4PUU",))
+    args, log, fmus = start(ap, argv, models=("PKM4PUU",), name="comparison")
     if fmus is None:
         return 1
     plant = fmus[0]
     errors = {}
     runs = run_all(plant, log=log, errors=errors)
-    bad = [name for name, r in runs.items() if nonfinite_outputs(r)]
-
-    print(format_table(runs, errors), flush=True)
-    if errors or bad:
-        for name in bad:
-            log(f"{name}: non-finite outputs {nonfinite_outputs(runs[name])}")
-        log(f"{len(errors) + len(bad)} of {len(SOLVERS)} runs failed; nothing written")
-        return 1
-    for path in write_results(runs, args.out):
-        log(f"wrote {path}")
-    return 0
+    bad = [f"{name}: non-finite outputs {nonfinite_outputs(r)}" for name, r in runs.items() if nonfinite_outputs(r)]
+    return finish(log, format_table(runs, errors), errors, bad, len(SOLVERS), "runs",
+                  lambda: write_results(runs, args.out))
 
 
 if __name__ == "__main__":

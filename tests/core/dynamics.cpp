@@ -3,7 +3,6 @@
 // differences of the Lagrangian (Eq. 14), plus the spec's static check.
 #include "inverse_dynamics.hpp"
 #include "lagrangian.hpp"
-#include "reference_model.hpp"
 #include "test_support.hpp"
 
 using namespace pkm_test;
@@ -11,19 +10,6 @@ using namespace pkm_test;
 namespace {
 
 const ref::RefParams kRef{};
-
-// dT/dqd_k at (q, qd) from the reference energy. T is quadratic in qd, so
-// the central difference with a unit step is exact: (T(qd+e) - T(qd-e))/2.
-Vec16 ref_momentum(const Vec16& q, const Vec16& qd) {
-  Vec16 p;
-  for (int k = 0; k < kN; ++k) {
-    Vec16 a = qd, b = qd;
-    a[k] += 1.0;
-    b[k] -= 1.0;
-    p[k] = 0.5 * (ref::kinetic_energy(kRef, q, a) - ref::kinetic_energy(kRef, q, b));
-  }
-  return p;
-}
 
 }  // namespace
 
@@ -37,14 +23,7 @@ TEST(Dynamics, MassMatrixIsSymmetricPositiveDefiniteAndTheHessianOfT) {
     const Eigen::SelfAdjointEigenSolver<Mat16> eig(M);
     EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
     // Hessian of the reference T in qd by polarisation (exact for a quadratic form).
-    Mat16 H;
-    const Vec16 zero = Vec16::Zero();
-    for (int i = 0; i < kN; ++i)
-      for (int j = 0; j < kN; ++j) {
-        const Vec16 ei = Vec16::Unit(i), ej = Vec16::Unit(j);
-        H(i, j) = ref::kinetic_energy(kRef, q, ei + ej) - ref::kinetic_energy(kRef, q, ei) -
-                  ref::kinetic_energy(kRef, q, ej) + ref::kinetic_energy(kRef, q, zero);
-      }
+    const Mat16 H = ref_mass_matrix(kRef, q);
     EXPECT_LT((M - H).cwiseAbs().maxCoeff() / M.cwiseAbs().maxCoeff(), 1e-10) << "seed " << seed;
   }
 }
@@ -66,15 +45,7 @@ TEST(Dynamics, CoriolisTermsMatchFiniteDifferencesOfTheLagrangian) {
   const Model m = default_model();
   for (unsigned seed = 1; seed <= 6; ++seed) {
     const RandomState s = random_state(m, seed);
-    const Vec16 dpdt = d_ds([&](double e) { return ref_momentum(Vec16(s.q + e * s.qd), s.qd); }, 1e-3);
-    Vec16 dTdq;
-    for (int k = 0; k < kN; ++k)
-      dTdq[k] = d_ds([&](double e) {
-        Vec16 x = s.q;
-        x[k] += e;
-        return Eigen::Matrix<double, 1, 1>(ref::kinetic_energy(kRef, x, s.qd));
-      }, 1e-3)[0];
-    const Vec16 V_ref = dpdt - dTdq;
+    const Vec16 V_ref = ref_coriolis(kRef, s.q, s.qd);
     const Vec16 V = coriolis(m, s.q, s.qd);
     EXPECT_LT((V - V_ref).lpNorm<Eigen::Infinity>(), 1e-9 * std::max(1e-6, V.lpNorm<Eigen::Infinity>()) + 1e-12)
         << "seed " << seed << "\nV  = " << V.transpose() << "\nref= " << V_ref.transpose();
@@ -86,14 +57,7 @@ TEST(Dynamics, GravityTermsMatchFiniteDifferencesOfThePotential) {
   const Model m = default_model();
   for (unsigned seed = 1; seed <= 6; ++seed) {
     const Vec16 q = random_state(m, seed).q;
-    Vec16 G_ref;
-    for (int k = 0; k < kN; ++k)
-      G_ref[k] = d_ds([&](double e) {
-        Vec16 x = q;
-        x[k] += e;
-        return Eigen::Matrix<double, 1, 1>(ref::potential_energy(kRef, x));
-      }, 1e-3)[0];
-    EXPECT_LT((gravity(m, q) - G_ref).lpNorm<Eigen::Infinity>(), 1e-12) << "seed " << seed;
+    EXPECT_LT((gravity(m, q) - ref_gravity(kRef, q)).lpNorm<Eigen::Infinity>(), 1e-12) << "seed " << seed;
   }
 }
 

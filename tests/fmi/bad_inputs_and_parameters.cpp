@@ -7,14 +7,15 @@
 // again. Through the built PKM4PUU.so / PKM4PUU_Inverse.so (dlopen).
 // Every case prints a row of the hardening table ("| tried | answer | kept |").
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
-#include "fmu_loader.hpp"
-#include "hardening_table.hpp"
+#include "fmu_fixture.hpp"
 
 namespace {
 
@@ -31,23 +32,11 @@ std::string text(double v) {
   return buf;
 }
 
-/// Deterministic inputs near the static forces.
-void drive(PlantFmu& p, double t) {
-  for (int i = 1; i <= 4; ++i)
-    ASSERT_EQ(p.set(force_name(i), kStaticForce + 0.01 * std::sin(2.0 * kPi * (1.0 + 0.5 * i) * t)), fmi2OK);
-}
-
-/// A plant initialised and stepped 20 times (1 ms), inputs set for the next step.
+/// A plant with `solver`, initialised and stepped 20 times (1 ms), inputs set
+/// for the next step.
 void prepare(PlantFmu& p, int solver, double& t) {
   ASSERT_EQ(p.set_int("solver", solver), fmi2OK);
-  p.initialize();
-  t = 0.0;
-  for (int k = 0; k < 20; ++k) {
-    drive(p, t);
-    ASSERT_EQ(p.step(t, 1e-3), fmi2OK) << p.log.dump();
-    t += 1e-3;
-  }
-  drive(p, t);
+  prepare(p, t, 20);
 }
 
 /// After an error: fmi2Reset, then the default parameters initialise and step.
@@ -159,32 +148,24 @@ TEST(HardeningParameters, NonFiniteParametersAreRejectedBeforeInitialisation) {
 }
 
 struct BadParameter {
-  const char* name;
+  std::string name;
   double value;
-  const char* message;  // expected in the log
+  std::string message;  // expected in the log
   bool integer = false;
 };
 
 TEST(HardeningParameters, OutOfRangeParametersFailInitialisationAndResetRecovers) {
-  const BadParameter cases[] = {
-      {"h", 0.0, "h = 0 must be positive"},
-      {"h", -0.0625, "h = -0.0625 must be positive"},
-      {"l", 0.0, "l = 0 must be positive"},
-      {"l", -0.125, "l = -0.125 must be positive"},
-      {"h_prime", 0.0, "h_prime = 0 must be positive"},
-      {"h_prime", -1.0, "h_prime = -1 must be positive"},
-      {"r_b", 0.0, "r_b = 0 must be positive"},
-      {"r_b", -1.0, "r_b = -1 must be positive"},
-      {"r_Q", 0.0, "r_Q = 0 must be positive"},
-      {"r_Q", -0.5, "r_Q = -0.5 must be positive"},
-      {"m_slider", 0.0, "m_slider = 0 must be positive"},
-      {"m_slider", -0.125, "m_slider = -0.125 must be positive"},
-      {"m_rod", 0.0, "m_rod = 0 must be positive"},
-      {"m_rod", -1.0, "m_rod = -1 must be positive"},
-      {"m_platform", 0.0, "m_platform = 0 must be positive"},
-      {"m_platform", -0.5, "m_platform = -0.5 must be positive"},
-      {"Izz_platform", 0.0, "Izz_platform = 0 must be positive"},
-      {"Izz_platform", -1e-3, "Izz_platform = -0.001 must be positive"},
+  std::vector<BadParameter> cases;
+  // Lengths, masses and the platform's inertia must be positive: zero and a
+  // negative value are refused, "<name> = <value> must be positive".
+  const std::pair<const char*, double> positive[] = {
+      {"h", -0.0625}, {"l", -0.125},       {"h_prime", -1.0},   {"r_b", -1.0},
+      {"r_Q", -0.5},  {"m_slider", -0.125}, {"m_rod", -1.0},     {"m_platform", -0.5},
+      {"Izz_platform", -1e-3}};
+  for (const auto& [name, negative] : positive)
+    for (double value : {0.0, negative})
+      cases.push_back({name, value, std::string(name) + " = " + text(value) + " must be positive"});
+  const BadParameter others[] = {
       {"I_rod[1]", 0.0, "I_rod[1] = 0 must be positive"},
       {"I_rod[2]", -0.25, "I_rod[2] = -0.25 must be positive"},
       {"I_rod[3]", 0.0, "I_rod[3] = 0 must be positive"},
@@ -216,13 +197,15 @@ TEST(HardeningParameters, OutOfRangeParametersFailInitialisationAndResetRecovers
       {"dphi0", -1e5, "dphi0"},
       {"stop_stiffness", 1e12, "stop_stiffness"},
   };
+  cases.insert(cases.end(), std::begin(others), std::end(others));
+  ASSERT_EQ(cases.size(), 47u);
   int refused_when_set = 0;
   for (const BadParameter& c : cases) {
     SCOPED_TRACE(std::string(c.name) + " = " + text(c.value));
     PlantFmu p;
     // Outside the modelDescription's [min, max] (the table's): refused when
     // set, with the range in the message, and the start value kept.
-    const pkm_fmi::Variable* v = p.def.find(c.name);
+    const pkm_fmi::Variable* v = p.def.find(c.name.c_str());
     ASSERT_NE(v, nullptr);
     if (!(c.value >= v->min && c.value <= v->max)) {
       ++refused_when_set;

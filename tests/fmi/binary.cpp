@@ -28,13 +28,11 @@ TEST(FmuBinaries, NeedOnlyTheSystemRuntime) {
   const std::set<std::string> allowed = {"linux-vdso.so.1", "libc.so.6", "libm.so.6", "libstdc++.so.6",
                                          "libgcc_s.so.1", "ld-linux-x86-64.so.2"};
   for (const char* so : {PKM_FMU_PLANT_SO, PKM_FMU_INVERSE_SO}) {
-    int status = 0;
-    const std::string out = capture(std::string("ldd '") + so + "' 2>&1", &status);
-    ASSERT_EQ(status, 0) << out;
-    std::istringstream lines(out);
-    std::string line;
+    std::vector<std::string> lines;
+    std::string out;
+    ASSERT_TRUE(tool_lines("ldd", so, lines, &out)) << out;
     int n = 0;
-    while (std::getline(lines, line)) {
+    for (const std::string& line : lines) {
       std::istringstream words(line);
       std::string lib;
       words >> lib;
@@ -55,13 +53,11 @@ TEST(FmuBinaries, ExportExactlyTheListedFmiFunctions) {
   PKM_FMI3_FUNCTIONS(PKM_TEST_NAME)
 #undef PKM_TEST_NAME
   for (const char* so : {PKM_FMU_PLANT_SO, PKM_FMU_INVERSE_SO}) {
-    int status = 0;
-    const std::string out = capture(std::string("nm -D --defined-only '") + so + "' 2>&1", &status);
-    if (status != 0) GTEST_SKIP() << "nm not available: " << out;
-    std::istringstream lines(out);
-    std::string line;
+    std::vector<std::string> lines;
+    std::string out;
+    if (!tool_lines("nm -D --defined-only", so, lines, &out)) GTEST_SKIP() << "nm not available: " << out;
     std::set<std::string> exported;
-    while (std::getline(lines, line)) exported.insert(line.substr(line.rfind(' ') + 1));
+    for (const std::string& line : lines) exported.insert(line.substr(line.rfind(' ') + 1));
     EXPECT_EQ(exported, listed) << so;  // fmu_src/fmi/fmi_functions.h: 44 of FMI 2.0, 75 of FMI 3.0
     EXPECT_EQ(exported.size(), 119u);
   }

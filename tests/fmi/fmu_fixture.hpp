@@ -64,16 +64,24 @@ inline void drive_forces(FmuInstance& p, double t) {
     ASSERT_EQ(p.set(force_name(i), kStaticForce + 0.01 * std::sin(2.0 * kPi * (1.0 + 0.5 * i) * t)), fmi2OK);
 }
 
-/// Initialised and stepped five times (1 ms), inputs set for the next step.
-inline void prepare(PlantFmu& p, double& t) {
+/// Initialised and stepped `steps` times (1 ms), inputs set for the next step.
+inline void prepare(PlantFmu& p, double& t, int steps = 5) {
   p.initialize();
   t = 0.0;
-  for (int k = 0; k < 5; ++k) {
+  for (int k = 0; k < steps; ++k) {
     drive_forces(p, t);
     ASSERT_EQ(p.step(t, 1e-3), fmi2OK) << p.log.dump();
     t += 1e-3;
   }
   drive_forces(p, t);
+}
+
+/// RK4 at the smallest rk4_step its range allows (1e-6 s), initialised: a
+/// 50 ms step takes 5e4 RK4 steps, about 0.1 s.
+inline void slow_rk4(PlantFmu& p) {
+  ASSERT_EQ(p.set_int("solver", 1), fmi2OK);
+  ASSERT_EQ(p.set("rk4_step", 1e-6), fmi2OK);
+  p.initialize();
 }
 
 /// A misuse on a stepping instance: `misuse` returns the statuses it got;

@@ -22,7 +22,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -224,12 +226,16 @@ class FmuInstance {
     EXPECT_EQ(lib.fmi2GetReal(c, &r, 1, &v), fmi2OK) << name << "\n" << log.dump();
     return v;
   }
-  fmi2Status setup() { return lib.fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0); }
+  /// fmi2SetupExperiment from `start`, with a stopTime when `stop` is finite.
+  fmi2Status setup(double start = 0.0, double stop = std::numeric_limits<double>::infinity()) {
+    const fmi2Boolean stop_defined = std::isfinite(stop) ? fmi2True : fmi2False;
+    return lib.fmi2SetupExperiment(c, fmi2False, 0.0, start, stop_defined, stop_defined ? stop : 0.0);
+  }
   fmi2Status enter() { return lib.fmi2EnterInitializationMode(c); }
   fmi2Status exit() { return lib.fmi2ExitInitializationMode(c); }
-  /// Setup, initialisation mode, exit, at t = 0.
-  void initialize() {
-    ASSERT_EQ(setup(), fmi2OK) << log.dump();
+  /// Setup (as setup(start, stop)), initialisation mode, exit.
+  void initialize(double start = 0.0, double stop = std::numeric_limits<double>::infinity()) {
+    ASSERT_EQ(setup(start, stop), fmi2OK) << log.dump();
     ASSERT_EQ(enter(), fmi2OK) << log.dump();
     ASSERT_EQ(exit(), fmi2OK) << log.dump();
   }
@@ -314,6 +320,17 @@ inline std::string capture(const std::string& command, int* status = nullptr) {
   const int st = pclose(f);
   if (status) *status = st;
   return out;
+}
+
+/// The lines `tool` prints about the shared library `so` (`tool 'so' 2>&1`);
+/// false, with the tool's whole output in *out, when it did not run.
+inline bool tool_lines(const std::string& tool, const char* so, std::vector<std::string>& lines, std::string* out) {
+  int status = 0;
+  *out = capture(tool + " '" + so + "' 2>&1", &status);
+  std::istringstream text(*out);
+  lines.clear();
+  for (std::string line; std::getline(text, line);) lines.push_back(line);
+  return status == 0;
 }
 
 inline bool have_fmpy() {

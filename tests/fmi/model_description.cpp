@@ -6,9 +6,11 @@
 // by perturbing each input and each state of a Model Exchange instance and
 // watching which outputs and derivatives move.
 #include <cmath>
+#include <initializer_list>
 #include <memory>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -135,6 +137,14 @@ struct Harness {
     ASSERT_NE(v, nullptr) << name;
     ASSERT_EQ(inst->set_real(&v->vr, 1, &x), Status::OK) << name;
   }
+  void set(std::initializer_list<std::pair<const char*, double>> values) {
+    for (const auto& [name, x] : values) set(name, x);
+  }
+  /// Initialisation mode and out of it again.
+  void initialize() {
+    ASSERT_EQ(inst->enter_initialization_mode(), Status::OK);
+    ASSERT_EQ(inst->exit_initialization_mode(), Status::OK);
+  }
   std::set<std::uint32_t> declared(std::uint32_t unknown) const {
     const pkm_fmi::Dependencies deps = pkm_fmi::dependencies_of(d, *d.find(unknown));
     return {deps.knowns.begin(), deps.knowns.end()};
@@ -145,32 +155,17 @@ struct Harness {
 // stops (rho_min above every rho of the points below, a soft stop), so that
 // whatever can depend on something does.
 void machine_point(Harness& h) {
-  h.set("rotor_inertia", 2e-6);
-  h.set("friction_viscous", 2.0);
-  h.set("friction_coulomb", 0.1);
-  h.set("payload_mass", 0.2);
-  h.set("payload_com[1]", 0.01);
-  h.set("payload_com[2]", -0.005);
-  h.set("payload_Izz", 1e-4);
-  h.set("rho_min", 0.06);
+  h.set({{"rotor_inertia", 2e-6}, {"friction_viscous", 2.0}, {"friction_coulomb", 0.1}, {"payload_mass", 0.2},
+         {"payload_com[1]", 0.01}, {"payload_com[2]", -0.005}, {"payload_Izz", 1e-4}, {"rho_min", 0.06}});
   if (h.d.find("stop_stiffness")) h.set("stop_stiffness", 1e3);
 }
 
 // A generic point: the platform moving, every input nonzero.
 void plant_point(Harness& h) {
-  h.set("x0", 0.002);
-  h.set("y0", -0.001);
-  h.set("z0", 0.055);
-  h.set("phi0", 0.03);
-  h.set("dx0", 0.01);
-  h.set("dy0", 0.004);
-  h.set("dz0", -0.02);
-  h.set("dphi0", 0.1);
+  h.set({{"x0", 0.002}, {"y0", -0.001}, {"z0", 0.055}, {"phi0", 0.03}, {"dx0", 0.01}, {"dy0", 0.004}, {"dz0", -0.02},
+         {"dphi0", 0.1}});
   for (int i = 1; i <= 4; ++i) h.set(("F[" + std::to_string(i) + "]").c_str(), 2.6 + 0.01 * i);
-  h.set("Fe[1]", 0.05);
-  h.set("Fe[2]", -0.03);
-  h.set("Fe[3]", 0.02);
-  h.set("Me_z", 0.001);
+  h.set({{"Fe[1]", 0.05}, {"Fe[2]", -0.03}, {"Fe[3]", 0.02}, {"Me_z", 0.001}});
   machine_point(h);
   for (int i = 1; i <= 4; ++i) h.set(("tau[" + std::to_string(i) + "]").c_str(), 0.001 * i);
 }
@@ -203,32 +198,18 @@ TEST(ModelStructure, PlantInputDependenciesAreExact) {
   Harness h(pkm_fmi::pkm4puu_definition(), pkm_fmi::Interface::ModelExchange);
   ASSERT_TRUE(h.inst);
   plant_point(h);
-  ASSERT_EQ(h.inst->enter_initialization_mode(), Status::OK);
-  ASSERT_EQ(h.inst->exit_initialization_mode(), Status::OK);
+  h.initialize();
   check_input_dependencies(h);
 }
 
 TEST(ModelStructure, InverseInputDependenciesAreExact) {
   Harness h(pkm_fmi::pkm4puu_inverse_definition(), pkm_fmi::Interface::CoSimulation);
   ASSERT_TRUE(h.inst);
-  h.set("x", 0.003);
-  h.set("y", -0.002);
-  h.set("phi", 0.05);
-  h.set("dx", 0.01);
-  h.set("dy", 0.02);
-  h.set("dz", -0.01);
-  h.set("dphi", -0.2);
-  h.set("ddx", 0.1);
-  h.set("ddy", -0.2);
-  h.set("ddz", 0.3);
-  h.set("ddphi", 0.4);
-  h.set("Fe[1]", 0.1);
-  h.set("Fe[2]", 0.1);
-  h.set("Fe[3]", 0.1);
-  h.set("Me_z", 0.01);
+  h.set({{"x", 0.003}, {"y", -0.002}, {"phi", 0.05}, {"dx", 0.01}, {"dy", 0.02}, {"dz", -0.01}, {"dphi", -0.2},
+         {"ddx", 0.1}, {"ddy", -0.2}, {"ddz", 0.3}, {"ddphi", 0.4}, {"Fe[1]", 0.1}, {"Fe[2]", 0.1}, {"Fe[3]", 0.1},
+         {"Me_z", 0.01}});
   machine_point(h);
-  ASSERT_EQ(h.inst->enter_initialization_mode(), Status::OK);
-  ASSERT_EQ(h.inst->exit_initialization_mode(), Status::OK);
+  h.initialize();
   check_input_dependencies(h);
 }
 
@@ -240,8 +221,7 @@ TEST(ModelStructure, PlantStateDependenciesAreExact) {
   Harness h(pkm_fmi::pkm4puu_definition(), pkm_fmi::Interface::ModelExchange);
   ASSERT_TRUE(h.inst);
   plant_point(h);
-  ASSERT_EQ(h.inst->enter_initialization_mode(), Status::OK);
-  ASSERT_EQ(h.inst->exit_initialization_mode(), Status::OK);
+  h.initialize();
   ASSERT_EQ(h.inst->enter_continuous_time_mode(), Status::OK);
   const int n = static_cast<int>(h.d.n_states);
   std::vector<double> x(n);

@@ -223,9 +223,7 @@ TEST_F(Stepping, BadCommunicationSteps) {
 
 TEST_F(Stepping, AStepWhoseEndOverflowsIsAnError) {
   PlantFmu p;
-  ASSERT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 1e308, fmi2False, 0.0), fmi2OK);
-  ASSERT_EQ(p.enter(), fmi2OK);
-  ASSERT_EQ(p.exit(), fmi2OK);
+  p.initialize(1e308);
   const std::vector<double> before = p.all_reals();
   EXPECT_EQ(p.step(1e308, 1e308), fmi2Error);
   EXPECT_TRUE(p.log.contains("is not finite; the call has no effect")) << p.log.dump();
@@ -241,9 +239,7 @@ TEST_F(Stepping, AStepWhoseEndOverflowsIsAnError) {
 // there is 0.125 s): answering OK would advance nothing.
 TEST_F(Stepping, AStepThatVanishesInTPlusHIsAnError) {
   PlantFmu p;
-  ASSERT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 1e15, fmi2False, 0.0), fmi2OK);
-  ASSERT_EQ(p.enter(), fmi2OK);
-  ASSERT_EQ(p.exit(), fmi2OK);
+  p.initialize(1e15);
   ASSERT_EQ(1e15 + 1e-3, 1e15);  // the premise
   const std::vector<double> before = p.all_reals();
   EXPECT_EQ(p.step(1e15, 1e-3), fmi2Error);
@@ -267,9 +263,7 @@ TEST_F(Stepping, TheMotionDoesNotDependOnTheStartTime) {
     for (PlantFmu* p : {&late, &early}) {
       ASSERT_EQ(p->set_int("solver", solver), fmi2OK);
       const double start = p == &late ? 1e9 : 0.0;
-      ASSERT_EQ(lib.fmi2SetupExperiment(p->c, fmi2False, 0.0, start, fmi2False, 0.0), fmi2OK);
-      ASSERT_EQ(p->enter(), fmi2OK);
-      ASSERT_EQ(p->exit(), fmi2OK);
+      p->initialize(start);
       double t = start;
       for (int k = 0; k < 1000; ++k) {
         drive_forces(*p, k * 1e-3);  // the same forces at the same time since start
@@ -304,9 +298,7 @@ TEST_F(Stepping, AStepTooLongForCvodeIsDiscarded) {
 
 TEST_F(Stepping, AStepPastTheStopTimeIsAnError) {
   PlantFmu p;
-  ASSERT_EQ(lib.fmi2SetupExperiment(p.c, fmi2False, 0.0, 0.0, fmi2True, 0.01), fmi2OK);
-  ASSERT_EQ(p.enter(), fmi2OK);
-  ASSERT_EQ(p.exit(), fmi2OK);
+  p.initialize(0.0, 0.01);
   for (int i = 1; i <= 4; ++i) ASSERT_EQ(p.set(force_name(i), kStaticForce), fmi2OK);
   for (int k = 0; k < 9; ++k) ASSERT_EQ(p.step(k * 1e-3, 1e-3), fmi2OK);
   const std::vector<double> before = p.all_reals();
@@ -326,9 +318,7 @@ TEST_F(Stepping, TooManyRk4StepsAreRefusedBeforeAnyWork) {
   // RK4 steps, twice the work budget (1e7, about 25 s of computing).
   PlantFmu p("refused"), twin("twin");
   for (PlantFmu* q : {&p, &twin}) {
-    ASSERT_EQ(q->set_int("solver", 1), fmi2OK);
-    ASSERT_EQ(q->set("rk4_step", 1e-6), fmi2OK);
-    q->initialize();
+    slow_rk4(*q);
     drive_forces(*q, 0.0);
   }
   const std::vector<double> before = p.all_reals();

@@ -16,8 +16,7 @@
 
 #include <gtest/gtest.h>
 
-#include "fmu_loader.hpp"
-#include "hardening_table.hpp"
+#include "fmu_fixture.hpp"
 
 namespace {
 
@@ -134,13 +133,11 @@ TEST(HardeningThreads, TheBinariesHaveNoMutableStaticDataOfTheirOwn) {
       "Eigen::internal::manage_caching_sizes(Eigen::Action, long*, long*, long*)::m_cacheSizes",
       "guard variable for Eigen::internal::manage_caching_sizes(Eigen::Action, long*, long*, long*)::m_cacheSizes"};
   for (const char* so : {PKM_FMU_PLANT_SO, PKM_FMU_INVERSE_SO}) {
-    int status = 0;
-    const std::string out = capture(std::string("objdump -t -C '") + so + "' 2>&1", &status);
-    if (status != 0) GTEST_SKIP() << "objdump not available: " << out;
-    std::istringstream lines(out);
-    std::string line;
+    std::vector<std::string> lines;
+    std::string out;
+    if (!tool_lines("objdump -t -C", so, lines, &out)) GTEST_SKIP() << "objdump not available: " << out;
     int writable = 0;
-    while (std::getline(lines, line)) {
+    for (const std::string& line : lines) {
       const bool data = line.find(" .data\t") != std::string::npos || line.find(" .bss\t") != std::string::npos ||
                         line.find(" .tdata\t") != std::string::npos || line.find(" .tbss\t") != std::string::npos;
       if (!data || line.find(" O ") == std::string::npos) continue;
@@ -159,32 +156,50 @@ TEST(HardeningThreads, TheBinariesHaveNoMutableStaticDataOfTheirOwn) {
             "instances share nothing mutable");
 }
 
+/// The 50 ms step from t = 0 of `p` (slow_rk4: about 0.1 s) in a thread of
+/// its own, under way (5 ms in) when the constructor returns.
+class StepInAnotherThread {
+ public:
+  explicit StepInAnotherThread(PlantFmu& p)
+      : thread_([this, &p] {
+          started_ = true;
+          status_ = p.step(0.0, 0.05);
+          done = true;
+        }) {
+    while (!started_) std::this_thread::yield();
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ~StepInAnotherThread() {
+    if (thread_.joinable()) thread_.join();
+  }
+  StepInAnotherThread(const StepInAnotherThread&) = delete;
+  StepInAnotherThread& operator=(const StepInAnotherThread&) = delete;
+  /// Waits for the step; its status.
+  fmi2Status join() {
+    thread_.join();
+    return status_;
+  }
+  std::atomic<bool> done{false};
+
+ private:
+  std::atomic<bool> started_{false};
+  fmi2Status status_ = fmi2Fatal;
+  std::thread thread_;  // last: starts when the members above are set
+};
+
 TEST(HardeningThreads, ASecondThreadOnTheSameInstanceIsRefused) {
   // RK4 at 1 us: a 50 ms step takes 5e4 RK4 steps (about 0.1 s), during
   // which another thread reads the instance.
   PlantFmu p("shared"), twin("twin");
-  for (PlantFmu* q : {&p, &twin}) {
-    ASSERT_EQ(q->set_int("solver", 1), fmi2OK);
-    ASSERT_EQ(q->set("rk4_step", 1e-6), fmi2OK);
-    q->initialize();
-  }
-  std::atomic<bool> started{false}, done{false};
-  fmi2Status step_status = fmi2Fatal;
-  std::thread stepper([&] {
-    started = true;
-    step_status = p.step(0.0, 0.05);
-    done = true;
-  });
-  while (!started) std::this_thread::yield();
-  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  for (PlantFmu* q : {&p, &twin}) slow_rk4(*q);
+  StepInAnotherThread stepper(p);
   const fmi2ValueReference x = p.vr("x");
   int refused = 0, answered = 0;
-  while (!done && refused < 1000) {
+  while (!stepper.done && refused < 1000) {
     double v = 0.0;
     (p.lib.fmi2GetReal(p.c, &x, 1, &v) == fmi2Error ? refused : answered) += 1;
   }
-  stepper.join();
-  ASSERT_EQ(step_status, fmi2OK) << p.log.dump();
+  ASSERT_EQ(stepper.join(), fmi2OK) << p.log.dump();
   EXPECT_GT(refused, 0) << answered << " reads answered during the step";
   EXPECT_TRUE(p.log.contains("called while another call on this instance is running")) << p.log.dump();
   // The step itself was not disturbed.
@@ -201,22 +216,10 @@ TEST(HardeningThreads, FreeingAnInstanceWhileAnotherThreadStepsItIsRefused) {
   // As above: a 50 ms step of about 0.1 s, during which another thread frees
   // the instance. Deleting it would pull the memory from under the step.
   PlantFmu p("shared"), twin("twin");
-  for (PlantFmu* q : {&p, &twin}) {
-    ASSERT_EQ(q->set_int("solver", 1), fmi2OK);
-    ASSERT_EQ(q->set("rk4_step", 1e-6), fmi2OK);
-    q->initialize();
-  }
-  std::atomic<bool> started{false};
-  fmi2Status step_status = fmi2Fatal;
-  std::thread stepper([&] {
-    started = true;
-    step_status = p.step(0.0, 0.05);
-  });
-  while (!started) std::this_thread::yield();
-  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  for (PlantFmu* q : {&p, &twin}) slow_rk4(*q);
+  StepInAnotherThread stepper(p);
   p.lib.fmi2FreeInstance(p.c);
-  stepper.join();
-  ASSERT_EQ(step_status, fmi2OK) << p.log.dump();
+  ASSERT_EQ(stepper.join(), fmi2OK) << p.log.dump();
   EXPECT_TRUE(p.log.contains("fmi2FreeInstance: called while another call on this instance is running"))
       << p.log.dump();
   // Still alive and undisturbed: it answers, equal to the twin, and is freed
