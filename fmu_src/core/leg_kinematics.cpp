@@ -76,7 +76,10 @@ Status leg_inverse_kinematics(const Model& m, int leg, const PlatformConfig& pc,
   out.c1 = (qt.x() * A - qt.y() * p.h_prime) / r2;
   out.s1 = (qt.y() * A + qt.x() * p.h_prime) / r2;
   out.c2 = A / p.l;
-  out.s2 = -std::sqrt(std::fmax(0.0, 1.0 - out.c2 * out.c2));  // elbow-down
+  // 0 <= A <= l gives 0 <= c2 <= 1 and c2^2 <= 1 after rounding: the
+  // clamp only guards the sign (a comparison, not a call to fmax).
+  const double s2sq = 1.0 - out.c2 * out.c2;
+  out.s2 = -std::sqrt(s2sq > 0.0 ? s2sq : 0.0);  // elbow-down
   out.rho = qt.z() - p.h - p.l * out.s2;
   if (angles) {
     angles->theta1 = std::atan2(qt.y(), qt.x()) + std::atan2(p.h_prime, A);

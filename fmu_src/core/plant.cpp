@@ -146,6 +146,7 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
   s = prepare_cvode();
   if (s != Status::Ok) return s;
   y_ = y;
+  rho_valid_ = false;
   t_ = t0;
   energy_ = EnergyIntegrals{};
   for (int i = 0; i < kLegs; ++i) theta1_ref_[i] = q[leg_offset(i) + 1];
@@ -196,6 +197,7 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
   if (prepared != Status::Ok) return prepared;
   t_ = t;
   y_ = y;
+  rho_valid_ = false;
   theta1_ref_ = theta1_ref;
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
@@ -216,6 +218,7 @@ Status Plant::set_state(const Vec8& y) {
     return s;
   }
   y_ = y;
+  rho_valid_ = false;
   theta1_stale_ = true;
   return Status::Ok;
 }
@@ -248,13 +251,27 @@ Vec10 Plant::packed() const {
 
 void Plant::unpack(const Vec10& x) {
   y_ = x.head<8>();
+  rho_valid_ = false;
   energy_.actuator_work = x[8];
   energy_.dissipated = x[9];
 }
 
-unsigned Plant::contact_mask(const Vec10& x) const {
-  Vec4 rho;
+Status Plant::slider_positions(Vec4& rho) const {
+  if (!rho_valid_) {
+    const Status s = actuator_positions(model_, y_.head<4>(), rho_);
+    if (s != Status::Ok) return s;
+    rho_valid_ = true;
+  }
+  rho = rho_;
+  return Status::Ok;
+}
+
+unsigned Plant::contact_mask(const Vec10& x, Vec4& rho) const {
   if (actuator_positions(model_, x.head<4>(), rho) != Status::Ok) return ~0u;
+  return contact_mask_at(x, rho);
+}
+
+unsigned Plant::contact_mask_at(const Vec10& x, const Vec4& rho) const {
   unsigned mask = 0;
   for (int i = 0; i < kLegs; ++i) {
     if (rho[i] < model_.p.rho_min) mask |= 1u << i;
@@ -409,7 +426,10 @@ Status Plant::advance_rk4(double t_end) {
     // the set of joints past their stops has changed.
     Vec10 x = packed();
     double t = tk;
-    unsigned mask = contact_mask(x);
+    // rho at x: the previous grid step's end computed it (slider_positions).
+    Vec4 rho_x;
+    unsigned mask = slider_positions(rho_x) == Status::Ok ? contact_mask_at(x, rho_x) : ~0u;
+    bool rho_x_valid = mask != ~0u;
     int events = 0;
     Status s = Status::Ok;
     while (t < t_next && s == Status::Ok) {
@@ -423,7 +443,9 @@ Status Plant::advance_rk4(double t_end) {
       Vec10 trial = x;
       s = rk4_step(f, t, step, trial);
       if (s != Status::Ok) break;
-      unsigned trial_mask = contact_mask(trial);
+      Vec4 rho_trial;
+      unsigned trial_mask = contact_mask(trial, rho_trial);
+      bool rho_trial_valid = trial_mask != ~0u;
       if (trial_mask == ~0u) trial_mask = mask;  // off the workspace: the guard reports it
       if (trial_mask != mask && events < kMaxEventsPerStep) {
         double lo = 0.0, hi = step;
@@ -432,13 +454,16 @@ Status Plant::advance_rk4(double t_end) {
           const double mid = 0.5 * (lo + hi);
           Vec10 xm = x;
           s = rk4_step(f, t, mid, xm);
-          const unsigned mm = contact_mask(xm);
+          Vec4 rho_m;
+          const unsigned mm = contact_mask(xm, rho_m);
           if (mm == mask || mm == ~0u) {
             lo = mid;
           } else {
             hi = mid;
             trial = xm;
             trial_mask = mm;
+            rho_trial = rho_m;
+            rho_trial_valid = true;
           }
         }
         if (s != Status::Ok) break;
@@ -449,6 +474,8 @@ Status Plant::advance_rk4(double t_end) {
       }
       x = trial;
       mask = trial_mask;
+      rho_x = rho_trial;
+      rho_x_valid = rho_trial_valid;
       t = to_end ? t_next : t + step;
     }
     stops_ = kStopsFromState;
@@ -463,6 +490,10 @@ Status Plant::advance_rk4(double t_end) {
     if (s != Status::Ok) return s;
     unpack(x);
     t_ = t_next;
+    if (rho_x_valid) {  // what slider_positions would compute at the new state
+      rho_ = rho_x;
+      rho_valid_ = true;
+    }
   }
   return Status::Ok;
 }
@@ -485,7 +516,8 @@ Status Plant::advance_cvode(double t_end, bool continuous) {
   // The stops held on between roots: those past at the start, then
   // switched by the direction of each root (not by the side of zero on
   // which the located state happens to fall).
-  stops_ = contact_mask(x) & 0xFFu;
+  Vec4 rho;
+  stops_ = (slider_positions(rho) == Status::Ok ? contact_mask_at(x, rho) : ~0u) & 0xFFu;
   int events = 0;
   Status s = Status::Ok;
   for (;;) {

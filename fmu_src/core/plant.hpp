@@ -179,6 +179,11 @@ class Plant {
   /// moves less than pi between reads, which the workspace guarantees.
   const Vec4& theta1_ref() const;
 
+  /// The actuator positions rho_1..4 at the current state
+  /// (actuator_positions, bit for bit; the integrators compute them at the
+  /// end of every step for the end stops, so reading them is a copy).
+  Status slider_positions(Vec4& rho) const;
+
   /// ||C(q)|| at the current state (m).
   double constraint_residual() const;
   /// Condition number of the actuator Jacobian (MODEL_SPEC), +inf if singular.
@@ -203,7 +208,10 @@ class Plant {
   void unpack(const Vec10& x);
   /// Which joints are past a stop at the pose x.head<4>() (bit i: below
   /// rho_min, bit 4 + i: above rho_max); all bits set if unreachable.
-  unsigned contact_mask(const Vec10& x) const;
+  /// rho receives the actuator positions there (valid unless all bits are set).
+  unsigned contact_mask(const Vec10& x, Vec4& rho) const;
+  /// The same with rho, the actuator positions at x, known.
+  unsigned contact_mask_at(const Vec10& x, const Vec4& rho) const;
   /// RK4 substep while a joint is past a stop (resolves the stop's spring).
   double contact_step() const;
   /// Creates CVODE's objects (once, when it is the solver), so that no step
@@ -231,6 +239,9 @@ class Plant {
   EnergyIntegrals energy_;
   long contact_events_ = 0;
   unsigned stops_ = kStopsFromState;  // the stops held on while integrating (machine.hpp)
+  // actuator_positions at y_, when rho_valid_ (every change of y_ clears it).
+  mutable Vec4 rho_ = Vec4::Zero();
+  mutable bool rho_valid_ = false;
   mutable Vec4 theta1_ref_ = Vec4::Zero();
   mutable bool theta1_stale_ = false;
   long rhs_count_ = 0;

@@ -33,7 +33,13 @@ const char* mode_name(std::uint32_t mode) {
 }
 
 Instance::Instance(const ModelDefinition& def, int fmi_version, Interface interface, Logger log)
-    : tag_(tag_of(fmi_version)), def_(def), token_(def.guid()), version_(fmi_version), interface_(interface), log_(std::move(log)) {}
+    : tag_(tag_of(fmi_version)), def_(def), token_(def.guid()), version_(fmi_version), interface_(interface), log_(std::move(log)) {
+  for (std::size_t i = 0; i < def_.n_variables; ++i) {
+    if (!def_.variables[i].derivative) continue;
+    if (derivatives_end_ == 0) derivatives_begin_ = i;
+    derivatives_end_ = i + 1;
+  }
+}
 
 Instance::~Instance() {
   // FreeInstance frees everything the instance allocated, including FMU

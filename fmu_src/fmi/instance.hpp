@@ -231,6 +231,9 @@ class Instance {
   bool terminated_ = false;             // CS: set after a discarded step
   unsigned valid_groups_ = 0;           // output groups (Variable::group) up to date
   bool input_derivatives_set_ = false;  // SetRealInputDerivatives was used (or a state restored)
+  // The table's variables with an input derivative lie in [derivatives_begin_,
+  // derivatives_end_) (do_step checks only these, every step).
+  std::size_t derivatives_begin_ = 0, derivatives_end_ = 0;
   std::unordered_set<SavedState*> states_;  // FMU states this instance created and nobody freed yet
   std::atomic<bool> busy_{false};           // a call is running (Busy)
   // partial_derivative's buffers (kept to reuse their capacity).

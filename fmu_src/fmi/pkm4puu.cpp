@@ -389,7 +389,7 @@ Status PlantData::update_outputs(Context& ctx, unsigned groups) {
   }
   if (groups & kGroupSliders) {
     pkm::Vec4 r;
-    const pkm::Status s = pkm::actuator_positions(plant->model(), plant->state().head<4>(), r);
+    const pkm::Status s = plant->slider_positions(r);
     if (s != pkm::Status::Ok) {
       return cannot_assemble(s);
     }

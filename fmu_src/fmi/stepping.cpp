@@ -85,7 +85,7 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
   }
   // Inputs interpolated with their derivatives must stay finite over the step
   // (only once a derivative was ever set: the loop is not free).
-  for (std::size_t i = 0; input_derivatives_set_ && i < def_.n_variables; ++i) {
+  for (std::size_t i = derivatives_begin_; input_derivatives_set_ && i < derivatives_end_; ++i) {
     const Variable& v = def_.variables[i];
     if (!v.derivative) continue;
     const double u = *static_cast<double*>(v.value(*data_, v.index));
