@@ -2,6 +2,7 @@
 
 #include "constraints.hpp"
 #include "lagrangian.hpp"
+#include "machine.hpp"
 
 namespace pkm {
 
@@ -61,6 +62,79 @@ void ReducedDynamics::add_leg(const Model& m, int leg, const Vec3& qd_leg, doubl
   for (int j = 0; j < 4; ++j)
     for (int k = j; k < 4; ++k) Mr_(j, k) += L.A.col(j).dot(MA.col(k));
   rhs_.noalias() += L.A.transpose() * L.r;
+}
+
+void ReducedDynamics::reset_platform_only(const PlatformConfig& pc, double phid) {
+  Mr_.setZero();
+  rhs_.setZero();
+  cphi_ = pc.cphi;
+  sphi_ = pc.sphi;
+  phid_ = phid;
+}
+
+Status ReducedDynamics::add_leg_platform_only(const Model& m, int leg, const PlatformConfig& pc, const Pose& pd,
+                                              double f_rho, unsigned stops, double& rho, double& rhod) {
+  const Params& p = m.p;
+  LegConfig c;
+  Status s = leg_inverse_kinematics(m, leg, pc, c);
+  if (s != Status::Ok) return s;
+  if (leg_singularity_measure(p, c) < kLegSingularFloor) return Status::Singular;
+  const Vec3 attach = rotated_attachment(m, leg, pc);
+  // prepare_leg_kinematics: J_i^{-1} (its third column is e_0) and
+  // L_i^{-1} = J_i^{-1} Rz(beta_i)^T (third column e_0 too).
+  const double a = -p.l * c.s1 * c.c2 + p.h_prime * c.c1, b = p.l * c.c1 * c.c2 + p.h_prime * c.s1;
+  const double e = -p.l * c.c1 * c.s2, f = -p.l * c.s1 * c.s2, g = p.l * c.c2;
+  const double inv_D = 1.0 / (a * f - b * e);
+  const double j00 = b * g * inv_D, j01 = -a * g * inv_D;
+  const double j10 = f * inv_D, j11 = -e * inv_D;
+  const double j20 = -b * inv_D, j21 = a * inv_D;
+  const double cb = m.cos_beta[leg], sb = m.sin_beta[leg];
+  const double l00 = cb * j00 - sb * j01, l10 = cb * j10 - sb * j11, l20 = cb * j20 - sb * j21;
+  const double l01 = sb * j00 + cb * j01, l11 = sb * j10 + cb * j11, l21 = sb * j20 + cb * j21;
+  // A_i = [L_i^{-1}, L_i^{-1} (e_z x attach)]: rows (l_k0, l_k1, [k == 0], a_k3).
+  const double a03 = l01 * attach.x() - l00 * attach.y();
+  const double a13 = l11 * attach.x() - l10 * attach.y();
+  const double a23 = l21 * attach.x() - l20 * attach.y();
+  // leg_velocity: qd_i = A_i pd.
+  const double phid = pd[3];
+  const double rd0 = l00 * pd[0] + l01 * pd[1] + pd[2] + a03 * phid;
+  const double th1d = l10 * pd[0] + l11 * pd[1] + a13 * phid;
+  const double th2d = l20 * pd[0] + l21 * pd[1] + a23 * phid;
+  // add_leg.
+  const Vec3 gamma = rotate_to_base(m, leg, leg_point_quadratic(p, c, th1d, th2d)) + attach * (phid * phid);
+  const double b0 = -(l00 * gamma[0] + l01 * gamma[1] + gamma[2]);
+  const double b1 = -(l10 * gamma[0] + l11 * gamma[1]);
+  const double b2 = -(l20 * gamma[0] + l21 * gamma[1]);
+  const Mat3 M = leg_mass_matrix(m, c);  // M01 = M12 = 0
+  const double m00 = M(0, 0), m02 = M(0, 2), m11 = M(1, 1), m22 = M(2, 2);
+  const Vec3 V = leg_coriolis(p, c, th1d, th2d, rd0);
+  const Vec3 G = leg_gravity(p, c);
+  const double F = f_rho + passive_joint_force(p, leg, stops, c.rho, rd0);
+  const double r0 = F - V[0] - G[0] - (m00 * b0 + m02 * b2);
+  const double r1 = -V[1] - m11 * b1;
+  const double r2 = -V[2] - G[2] - (m02 * b0 + m22 * b2);
+  // A^T M A, upper triangle; M A's rows, with A's column 2 = e_0.
+  const double A[3][4] = {{l00, l01, 1.0, a03}, {l10, l11, 0.0, a13}, {l20, l21, 0.0, a23}};
+  double MA[3][4];
+  for (int k = 0; k < 4; ++k) {
+    MA[0][k] = m00 * A[0][k] + m02 * A[2][k];
+    MA[1][k] = m11 * A[1][k];
+    MA[2][k] = m02 * A[0][k] + m22 * A[2][k];
+  }
+  for (int j = 0; j < 4; ++j) {
+    if (j == 2) {  // A's column 2 is e_0
+      for (int k = 2; k < 4; ++k) Mr_(2, k) += MA[0][k];
+      continue;
+    }
+    for (int k = j; k < 4; ++k) Mr_(j, k) += A[0][j] * MA[0][k] + A[1][j] * MA[1][k] + A[2][j] * MA[2][k];
+  }
+  rhs_[0] += l00 * r0 + l10 * r1 + l20 * r2;
+  rhs_[1] += l01 * r0 + l11 * r1 + l21 * r2;
+  rhs_[2] += r0;
+  rhs_[3] += a03 * r0 + a13 * r1 + a23 * r2;
+  rho = c.rho;
+  rhod = rd0;
+  return Status::Ok;
 }
 
 void ReducedDynamics::reduced_system(const Model& m, const Wrench& we, Mat4& Mr, Vec4& rhs) const {

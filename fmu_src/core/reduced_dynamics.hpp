@@ -45,6 +45,18 @@ class ReducedDynamics {
   /// for every leg).
   void reduced_system(const Model& m, const Wrench& we, Mat4& Mr, Vec4& rhs) const;
 
+  /// The integrators' hot path, without keeping the legs' terms (solve()
+  /// needs them, solve_platform does not): reset_platform_only, then
+  /// add_leg_platform_only for every leg, then solve_platform. The same
+  /// arithmetic as prepare_leg, leg_velocity and add_leg, with the zeros and
+  /// ones of J_i^{-1}, A_i and M_i written out (bit for bit the same
+  /// result); leg() is not valid afterwards. f_rho is the applied force on
+  /// rho_i, the passive joint force (stops held as `stops`) is added here;
+  /// rho and rhod receive the leg's actuated joint and its rate.
+  void reset_platform_only(const PlatformConfig& pc, double phid);
+  Status add_leg_platform_only(const Model& m, int leg, const PlatformConfig& pc, const Pose& pd, double f_rho,
+                               unsigned stops, double& rho, double& rhod);
+
   struct Leg {
     LegConfig c;
     Vec3 attach;  // Rz(phi) r_Qi

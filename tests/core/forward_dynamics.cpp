@@ -6,6 +6,7 @@
 #include "inverse_dynamics.hpp"
 #include "lagrangian.hpp"
 #include "plant.hpp"
+#include "reduced_dynamics.hpp"
 #include "test_support.hpp"
 
 using namespace pkm_test;
@@ -66,6 +67,43 @@ TEST(ForwardDynamics, StateDerivativeHotPathEqualsFullEvaluation) {
     EXPECT_LT(rel_diff(fast, full), 1e-12);
     EXPECT_LT((ms.q - s.q).lpNorm<Eigen::Infinity>(), 1e-15);
     EXPECT_LT((ms.qd - s.qd).lpNorm<Eigen::Infinity>(), 1e-13);
+  }
+}
+
+TEST(ForwardDynamics, HotPathIsBitIdenticalToTheReducedTermsWithTheLegs) {
+  // state_derivative's hot path (ReducedDynamics::add_leg_platform_only)
+  // writes out the zeros and ones of J_i^-1, A_i and M_i instead of keeping
+  // the legs' terms: the same products summed in the same order as
+  // reduced_terms + solve_platform, so the same bits. With every machine
+  // term acting (rotor, friction, payload) and with the stops held on or off.
+  Params p;
+  p.rotor_inertia = 2e-5;
+  p.friction_viscous = 3.0;
+  p.friction_coulomb = 0.4;
+  p.payload_mass = 0.3;
+  p.payload_com = {0.01, -0.02};
+  const Model m = model_of(p);
+  const unsigned stops[] = {kStopsFromState, 0u, 0x0Fu, 0xF0u, 0x5Au};
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    const RandomState s = random_state(m, seed);
+    Vec8 y;
+    y << s.pose, s.vel;
+    const Vec16 f = generalized_forces(random_vec<4>(700 + seed, 3.0), random_vec<4>(800 + seed, 0.5));
+    for (unsigned st : stops) {
+      Vec8 ydot;
+      JointMotion hot;
+      ASSERT_EQ(state_derivative(m, Formulation::LegPartitioned, y, f, ydot, nullptr, &hot, st), Status::Ok);
+      ReducedDynamics rd;
+      JointMotion legs;
+      ASSERT_EQ(reduced_terms(m, y, f, st, rd, &legs), Status::Ok);
+      Pose pdd;
+      ASSERT_EQ(rd.solve_platform(m, f.segment<4>(kPlatform), pdd), Status::Ok);
+      for (int k = 0; k < 4; ++k) {
+        EXPECT_EQ(ydot[4 + k], pdd[k]) << "seed " << seed << " stops " << st << " k " << k;
+        EXPECT_EQ(hot.rho[k], legs.rho[k]) << "seed " << seed;
+        EXPECT_EQ(hot.rhod[k], legs.rhod[k]) << "seed " << seed;
+      }
+    }
   }
 }
 
