@@ -21,11 +21,7 @@
 set -euo pipefail
 tree="${1:?usage: scripts/check_sanitized_fmi_tests.sh FUZZ_TREE BUILD_DIR}"
 build="${2:?usage: scripts/check_sanitized_fmi_tests.sh FUZZ_TREE BUILD_DIR}"
-runtime="$(clang -print-file-name=libclang_rt.asan-x86_64.so 2>/dev/null || true)"
-if [ ! -f "$runtime" ]; then
-  echo "check_sanitized_fmi_tests: SKIPPED: clang's AddressSanitizer runtime not found (Debian: clang libclang-rt-14-dev)" >&2
-  exit 77
-fi
+source "$(dirname "${BASH_SOURCE[0]}")/sanitizer_env.sh" check_sanitized_fmi_tests
 binaries="$tree/fmu-binaries"
 programs=()
 for exe in "$build"/tests/fmi_*; do
@@ -43,8 +39,7 @@ if PKM_FMU_BINARIES="$binaries" "$build/tests/fmi_state_machine" --gtest_filter=
 fi
 logs="$tree/fmi-tests"
 rm -rf "$logs" && mkdir -p "$logs"
-export LD_PRELOAD="$runtime" PKM_FMU_BINARIES="$binaries"
-export ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+export LD_PRELOAD="$sanitizer_runtime" PKM_FMU_BINARIES="$binaries"
 export GTEST_FILTER='-Stepping.AStepTooLongForCvodeIsDiscarded'
 echo "check_sanitized_fmi_tests: ${#programs[@]} programs against $binaries (logs: $logs)" >&2
 # Two at a time; each program's log is printed if it fails.

@@ -15,11 +15,7 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 tree="${1:?usage: scripts/check_sanitized_fmpy.sh FUZZ_BUILD_DIR}"
-runtime="$(clang -print-file-name=libclang_rt.asan-x86_64.so 2>/dev/null || true)"
-if [ ! -f "$runtime" ]; then
-  echo "check_sanitized_fmpy: SKIPPED: clang's AddressSanitizer runtime not found (Debian: clang libclang-rt-14-dev)" >&2
-  exit 77
-fi
+source scripts/sanitizer_env.sh check_sanitized_fmpy
 for f in PKM4PUU.fmu PKM4PUU_Inverse.fmu fmi3/PKM4PUU.fmu fmi3/PKM4PUU_Inverse.fmu; do
   [ -f "$tree/$f" ] || { echo "check_sanitized_fmpy: $tree/$f missing (fuzz/run_fuzz.sh --build-only builds it)" >&2; exit 1; }
 done
@@ -31,8 +27,7 @@ ctypes.CDLL(os.path.join(d, 'binaries', 'linux64', 'PKM4PUU.so'))" 2>/dev/null; 
   echo "check_sanitized_fmpy: $tree/PKM4PUU.fmu loads without the sanitizer runtime: not an instrumented build" >&2
   exit 1
 fi
-export LD_PRELOAD="$runtime"
-export ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+export LD_PRELOAD="$sanitizer_runtime"
 export PKM_BUILD_DIR="$tree"
 exec .venv/bin/python -m pytest -q -p no:cacheprovider \
   python_checks/test_fmu_autotest.py python_checks/test_fmu_comparison.py python_checks/test_fmu_derivatives.py \
