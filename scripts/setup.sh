@@ -73,8 +73,8 @@ req=python_checks/requirements.txt
 stamp=.venv/.requirements.stamp
 if [ "$for_build" -eq 1 ]; then
   fmpy_pin="$(grep -E '^fmpy==' "$req")"
-  if ! .venv/bin/python -m pip show -q fmpy 2>/dev/null ||
-     [ "$(.venv/bin/python -m pip show fmpy 2>/dev/null | sed -n 's/^Version: //p')" != "${fmpy_pin#fmpy==}" ]; then
+  # pip show prints nothing when fmpy is missing: one comparison covers both.
+  if [ "$(.venv/bin/python -m pip show fmpy 2>/dev/null | sed -n 's/^Version: //p')" != "${fmpy_pin#fmpy==}" ]; then
     log "installing $fmpy_pin (the rest of $req comes with scripts/setup.sh)"
     .venv/bin/pip install --disable-pip-version-check -q "$fmpy_pin"
   fi
