@@ -28,6 +28,11 @@
 # At the end it prints the figures: inputs, FMI calls, coverage.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# The seed corpus (fuzz/seed_corpus.tar.gz), unpacked into a fresh DIR.
+unpack_seeds() {
+  rm -rf "$1" && mkdir -p "$1"
+  tar -C "$1" -xzf "$root/fuzz/seed_corpus.tar.gz"
+}
 build="$root/build-fuzz"
 seconds=60
 runs=""
@@ -82,8 +87,7 @@ if [ "$coverage" -eq 1 ]; then
   cmake --build "$cov" --target pkm_fmi_fuzzer -j"$(nproc)" >"$cov/build.log" 2>&1 || { tail -50 "$cov/build.log" >&2; exit 1; }
   rm -f "$cov"/*.profraw
   dirs=("$cov/seeds")
-  rm -rf "$cov/seeds" && mkdir -p "$cov/seeds"
-  [ -f "$root/fuzz/seed_corpus.tar.gz" ] && tar -C "$cov/seeds" -xzf "$root/fuzz/seed_corpus.tar.gz"
+  unpack_seeds "$cov/seeds"
   [ -d "$build/corpus" ] && dirs+=("$build/corpus")
   LLVM_PROFILE_FILE="$cov/replay.profraw" "$cov/fuzz/pkm_fmi_fuzzer" -runs=0 "${dirs[@]}" >"$cov/replay.log" 2>&1 || {
     tail -30 "$cov/replay.log" >&2; exit 1; }
@@ -113,8 +117,7 @@ fi
 mkdir -p "$build/corpus" "$build/findings"
 if [ "$replay" -eq 1 ]; then
   seeds_dir="$build/seeds"
-  rm -rf "$seeds_dir" && mkdir -p "$seeds_dir"
-  tar -C "$seeds_dir" -xzf "$root/fuzz/seed_corpus.tar.gz"
+  unpack_seeds "$seeds_dir"
   mapfile -t inputs < <(find "$seeds_dir" -type f | sort)
   rm -f "$build"/replay-*.log
   echo "run_fuzz: replaying ${#inputs[@]} seed inputs in $jobs process(es) (logs: $build/replay-*.log)" >&2
@@ -141,9 +144,7 @@ if [ "$replay" -eq 1 ]; then
 fi
 # Seeds: fuzz/seed_corpus.tar.gz, the corpus of a 30-minute run merged by
 # libFuzzer (-merge=1), so that a short run starts from deep coverage.
-if [ -z "$(ls -A "$build/corpus")" ] && [ -f "$root/fuzz/seed_corpus.tar.gz" ]; then
-  tar -C "$build/corpus" -xzf "$root/fuzz/seed_corpus.tar.gz"
-fi
+[ -z "$(ls -A "$build/corpus")" ] && unpack_seeds "$build/corpus"
 seeds=()
 limit=(-max_total_time="$seconds")
 [ -n "$runs" ] && limit=(-runs="$runs")
