@@ -40,8 +40,13 @@
 // Every function here is inlined: GCC's note that a 32-byte vector is
 // passed differently with and without AVX (-Wpsabi) concerns no call. GCC
 // emits it at the end of the translation unit, so it is silenced for the
-// rest of the unit (a push/pop around the header would not reach it).
-#if defined(__GNUC__) && !defined(__clang__)
+// rest of the unit (a push/pop around the header would not reach it);
+// Clang the same.
+#if defined(__clang__)
+#if __has_warning("-Wpsabi")
+#pragma clang diagnostic ignored "-Wpsabi"
+#endif
+#elif defined(__GNUC__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 
