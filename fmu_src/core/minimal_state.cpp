@@ -61,16 +61,10 @@ Status state_derivative(const Model& m, Formulation form, const Vec8& y, const V
   ydot.head<4>() = y.tail<4>();
   if (form == Formulation::LegPartitioned && full == nullptr) {
     // The integrators' hot path: the reduced system without the legs' terms.
-    ReducedDynamics rd;
-    Vec4 rho, rhod;
-    const Status sl = rd.platform_only(m, platform_config(y.head<4>()), y.tail<4>(), f, stops, rho, rhod);
-    if (sl != Status::Ok) return sl;
-    if (joints) {
-      joints->rho = rho;
-      joints->rhod = rhod;
-    }
     Pose pdd;
-    const Status s = rd.solve_platform(m, f.segment<4>(kPlatform), pdd);
+    const Status s = ReducedDynamics::platform_derivative(m, platform_config(y.head<4>()), y.tail<4>(), f, stops,
+                                                          joints ? &joints->rho : nullptr,
+                                                          joints ? &joints->rhod : nullptr, pdd);
     if (s == Status::Ok) ydot.tail<4>() = pdd;
     return s;
   }

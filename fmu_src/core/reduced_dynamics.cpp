@@ -291,6 +291,61 @@ __attribute__((target("avx"))) Status legs_avx(const Model& m, const PlatformCon
 
 using LegsKernel = Status (*)(const Model&, const PlatformConfig&, const Pose&, const Vec16&, unsigned, LegSums&);
 
+LegsKernel best_kernel(const Model& m) {
+#if PKM_LANES_AVX_DISPATCH
+  if (m.avx) return legs_avx;
+#else
+  (void)m;
+#endif
+  return legs_generic;
+}
+
+// The reduced system with the platform, its payload and the external
+// wrench (reduced_system's arithmetic, on the upper triangle only) and its
+// LDL^T solution: solve_platform's and the hot path's one solver. mr: the
+// legs' A^T M A, upper triangle by rows; rhs: the legs' A^T r.
+Status solve_reduced(const Model& m, const Wrench& we, const double mr[10], const double rhs_legs[4], double cphi,
+                     double sphi, double phid, Pose& a) {
+  const PlatformInertia pi = platform_inertia(m, cphi, sphi);
+  double M[4][4] = {{mr[0], mr[1], mr[2], mr[3]},  // the upper triangle
+                    {0.0, mr[4], mr[5], mr[6]},
+                    {0.0, 0.0, mr[7], mr[8]},
+                    {0.0, 0.0, 0.0, mr[9]}};
+  M[0][0] += pi.mass;
+  M[1][1] += pi.mass;
+  M[2][2] += pi.mass;
+  M[3][3] += pi.Izz;
+  M[0][3] -= pi.mwy;
+  M[1][3] += pi.mwx;
+  double rhs[4];
+  for (int j = 0; j < 4; ++j) rhs[j] = rhs_legs[j] + we[j];
+  const double w2 = phid * phid;
+  rhs[0] += pi.mwx * w2;
+  rhs[1] += pi.mwy * w2;
+  rhs[2] -= pi.mass * m.p.g;
+  // LDL^T of the symmetric positive definite 4x4, written out (no square
+  // roots): Mr = U^T D U with unit upper-triangular U, then two substitutions.
+  double d[4], U[4][4];  // U's strictly upper triangle
+  for (int j = 0; j < 4; ++j) {
+    double dj = M[j][j];
+    for (int k = 0; k < j; ++k) dj -= U[k][j] * U[k][j] * d[k];
+    if (!(dj > 0.0)) return Status::Singular;  // also NaN
+    d[j] = dj;
+    for (int i = j + 1; i < 4; ++i) {
+      double u = M[j][i];
+      for (int k = 0; k < j; ++k) u -= U[k][j] * U[k][i] * d[k];
+      U[j][i] = u / dj;
+    }
+  }
+  for (int i = 0; i < 4; ++i)  // U^T z = rhs
+    for (int k = 0; k < i; ++k) rhs[i] -= U[k][i] * rhs[k];
+  for (int i = 0; i < 4; ++i) rhs[i] /= d[i];
+  for (int i = 3; i >= 0; --i)  // U a = z / d
+    for (int k = i + 1; k < 4; ++k) rhs[i] -= U[i][k] * rhs[k];
+  a = Pose(rhs[0], rhs[1], rhs[2], rhs[3]);
+  return a.allFinite() ? Status::Ok : Status::Singular;
+}
+
 }  // namespace
 
 bool ReducedDynamics::lanes_available(LegLanes kernel) {
@@ -302,11 +357,7 @@ Status ReducedDynamics::platform_only(const Model& m, const PlatformConfig& pc, 
                                       unsigned stops, Vec4& rho, Vec4& rhod, LegLanes kernel) {
   LegsKernel run = legs_generic;
   switch (kernel) {
-    case LegLanes::Best:
-#if PKM_LANES_AVX_DISPATCH
-      if (m.avx) run = legs_avx;
-#endif
-      break;
+    case LegLanes::Best: run = best_kernel(m); break;
     case LegLanes::Scalar: run = legs_scalar; break;
     case LegLanes::Generic: run = legs_generic; break;
     case LegLanes::Avx:
@@ -335,6 +386,16 @@ Status ReducedDynamics::platform_only(const Model& m, const PlatformConfig& pc, 
   return Status::Ok;
 }
 
+Status ReducedDynamics::platform_derivative(const Model& m, const PlatformConfig& pc, const Pose& pd,
+                                            const Vec16& f, unsigned stops, Vec4* rho, Vec4* rhod, Pose& pdd) {
+  LegSums sums;
+  const Status s = best_kernel(m)(m, pc, pd, f, stops, sums);
+  if (s != Status::Ok) return s;
+  if (rho) *rho = Vec4(sums.rho[0], sums.rho[1], sums.rho[2], sums.rho[3]);
+  if (rhod) *rhod = Vec4(sums.rhod[0], sums.rhod[1], sums.rhod[2], sums.rhod[3]);
+  return solve_reduced(m, f.segment<4>(kPlatform), sums.mr, sums.rhs, pc.cphi, pc.sphi, pd[3], pdd);
+}
+
 void ReducedDynamics::reduced_system(const Model& m, const Wrench& we, Mat4& Mr, Vec4& rhs) const {
   // The upper triangle of the reduced mass matrix (add_leg fills only it),
   // plus the platform with its payload (lagrangian.hpp): M_p, V_p, G_p.
@@ -352,31 +413,12 @@ void ReducedDynamics::reduced_system(const Model& m, const Wrench& we, Mat4& Mr,
 }
 
 Status ReducedDynamics::solve_platform(const Model& m, const Wrench& we, Pose& a) const {
-  Mat4 Mr;
-  Vec4 rhs;
-  reduced_system(m, we, Mr, rhs);
-  // LDL^T of the symmetric positive definite 4x4, written out (no square
-  // roots): Mr = U^T D U with unit upper-triangular U, then two substitutions.
-  double d[4];
-  Mat4 U = Mat4::Identity();
-  for (int j = 0; j < 4; ++j) {
-    double dj = Mr(j, j);
-    for (int k = 0; k < j; ++k) dj -= U(k, j) * U(k, j) * d[k];
-    if (!(dj > 0.0)) return Status::Singular;  // also NaN
-    d[j] = dj;
-    for (int i = j + 1; i < 4; ++i) {
-      double u = Mr(j, i);
-      for (int k = 0; k < j; ++k) u -= U(k, j) * U(k, i) * d[k];
-      U(j, i) = u / dj;
-    }
-  }
-  for (int i = 0; i < 4; ++i)  // U^T z = rhs
-    for (int k = 0; k < i; ++k) rhs[i] -= U(k, i) * rhs[k];
-  for (int i = 0; i < 4; ++i) rhs[i] /= d[i];
-  for (int i = 3; i >= 0; --i)  // U a = z / d
-    for (int k = i + 1; k < 4; ++k) rhs[i] -= U(i, k) * rhs[k];
-  a = rhs;
-  return a.allFinite() ? Status::Ok : Status::Singular;
+  double mr[10];
+  int n = 0;
+  for (int j = 0; j < 4; ++j)
+    for (int k = j; k < 4; ++k) mr[n++] = Mr_(j, k);
+  const double rhs[4] = {rhs_[0], rhs_[1], rhs_[2], rhs_[3]};
+  return solve_reduced(m, we, mr, rhs, cphi_, sphi_, phid_, a);
 }
 
 Status ReducedDynamics::solve(const Model& m, const Wrench& we, Vec16& qdd, Vec12& lambda) {

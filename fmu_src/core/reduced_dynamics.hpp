@@ -63,6 +63,11 @@ class ReducedDynamics {
     Avx,      // AVX; Status::InvalidArgument where unavailable
   };
   static bool lanes_available(LegLanes kernel);
+  /// platform_only + solve_platform without the object (the integrators'
+  /// hot path, state_derivative): the best lanes, the same solver, the same
+  /// bits. rho and rhod (if given) are written once the legs succeed.
+  static Status platform_derivative(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
+                                    unsigned stops, Vec4* rho, Vec4* rhod, Pose& pdd);
   Status platform_only(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
                        Vec4& rho, Vec4& rhod, LegLanes kernel = LegLanes::Best);
 
