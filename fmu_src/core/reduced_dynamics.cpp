@@ -109,6 +109,14 @@ PKM_LANES_INLINE double passive_force(const Params& p, int first, unsigned stops
 }
 PKM_LANES_INLINE lanes::Pack passive_force(const Params& p, int first, unsigned stops, const lanes::Pack& rho,
                                            const lanes::Pack& rhod) {
+  // Without Coulomb friction and with no stop acting on any leg (all
+  // within their travel, or none held): friction_force's -b rhod plus
+  // stop_contact's 0.0, lane-wise, with no calls to spill around.
+  if (p.friction_coulomb == 0.0 &&
+      (stops == kStopsFromState
+           ? !lanes::any(lanes::either(lanes::lt(rho, p.rho_min), lanes::gt(rho, p.rho_max)))
+           : (stops & ((1u << (2 * kLegs)) - 1u)) == 0u))
+    return -p.friction_viscous * rhod + 0.0;
   double F[lanes::kWidth];
   for (int i = 0; i < lanes::kWidth; ++i)
     F[i] = passive_joint_force(p, first + i, stops, lanes::lane(rho, i), lanes::lane(rhod, i));

@@ -102,51 +102,56 @@ TEST(ForwardDynamics, HotPathIsBitIdenticalToTheReducedTermsWithTheLegs) {
   // the same order as reduced_terms + solve_platform, so the same bits, for
   // every variant of the lanes. With every machine term acting (rotor,
   // friction, payload) and with the stops held on or off, over many states
-  // (some of them fast, for the friction's tanh, and past the stops).
-  Params p;
-  p.rotor_inertia = 2e-5;
-  p.friction_viscous = 3.0;
-  p.friction_coulomb = 0.4;
-  p.payload_mass = 0.3;
-  p.payload_com = {0.01, -0.02};
-  const Model m = model_of(p);
-  const unsigned stops[] = {kStopsFromState, 0u, 0x0Fu, 0xF0u, 0x5Au, 0xA5u};
-  const auto kernels = lane_kernels();
-  int compared = 0;
-  for (unsigned seed = 1; seed <= 300; ++seed) {
-    RandomState s = random_state(m, seed);
-    if (seed % 3 == 0) s.vel *= 20.0;  // the friction's tanh saturated
-    Vec8 y;
-    y << s.pose, s.vel;
-    const Vec16 f = generalized_forces(random_vec<4>(700 + seed, 3.0), random_vec<4>(800 + seed, 0.5));
-    for (unsigned st : stops) {
-      Pose ref;
-      JointMotion legs;
-      ASSERT_EQ(reference_derivative(m, y, f, st, ref, legs), Status::Ok);
-      Vec8 ydot;
-      JointMotion hot;
-      ASSERT_EQ(state_derivative(m, Formulation::LegPartitioned, y, f, ydot, nullptr, &hot, st), Status::Ok);
-      for (int k = 0; k < 4; ++k) {
-        EXPECT_EQ(ydot[4 + k], ref[k]) << "seed " << seed << " stops " << st << " k " << k;
-        EXPECT_EQ(hot.rho[k], legs.rho[k]) << "seed " << seed;
-        EXPECT_EQ(hot.rhod[k], legs.rhod[k]) << "seed " << seed;
-      }
-      for (const auto kernel : kernels) {
-        ReducedDynamics rd;
-        Vec4 rho, rhod;
-        ASSERT_EQ(rd.platform_only(m, platform_config(s.pose), s.vel, f, st, rho, rhod, kernel), Status::Ok);
-        Pose pdd;
-        ASSERT_EQ(rd.solve_platform(m, f.segment<4>(kPlatform), pdd), Status::Ok);
+  // (some of them fast, for the friction's tanh, and past the stops); and
+  // without Coulomb friction, where the lanes take the passive force
+  // lane-wise while no stop acts (stops 0 and, within the travel, from the
+  // state) instead of the scalar function per lane.
+  for (const double coulomb : {0.4, 0.0}) {
+    Params p;
+    p.rotor_inertia = 2e-5;
+    p.friction_viscous = 3.0;
+    p.friction_coulomb = coulomb;
+    p.payload_mass = 0.3;
+    p.payload_com = {0.01, -0.02};
+    const Model m = model_of(p);
+    const unsigned stops[] = {kStopsFromState, 0u, 0x0Fu, 0xF0u, 0x5Au, 0xA5u, 0x100u};
+    const auto kernels = lane_kernels();
+    int compared = 0;
+    for (unsigned seed = 1; seed <= 300; ++seed) {
+      RandomState s = random_state(m, seed);
+      if (seed % 3 == 0) s.vel *= 20.0;  // the friction's tanh saturated
+      Vec8 y;
+      y << s.pose, s.vel;
+      const Vec16 f = generalized_forces(random_vec<4>(700 + seed, 3.0), random_vec<4>(800 + seed, 0.5));
+      for (unsigned st : stops) {
+        Pose ref;
+        JointMotion legs;
+        ASSERT_EQ(reference_derivative(m, y, f, st, ref, legs), Status::Ok);
+        Vec8 ydot;
+        JointMotion hot;
+        ASSERT_EQ(state_derivative(m, Formulation::LegPartitioned, y, f, ydot, nullptr, &hot, st), Status::Ok);
         for (int k = 0; k < 4; ++k) {
-          EXPECT_EQ(pdd[k], ref[k]) << "kernel " << static_cast<int>(kernel) << " seed " << seed << " stops " << st;
-          EXPECT_EQ(rho[k], legs.rho[k]) << "kernel " << static_cast<int>(kernel) << " seed " << seed;
-          EXPECT_EQ(rhod[k], legs.rhod[k]) << "kernel " << static_cast<int>(kernel) << " seed " << seed;
+          EXPECT_EQ(ydot[4 + k], ref[k]) << "seed " << seed << " stops " << st << " k " << k;
+          EXPECT_EQ(hot.rho[k], legs.rho[k]) << "seed " << seed;
+          EXPECT_EQ(hot.rhod[k], legs.rhod[k]) << "seed " << seed;
         }
-        ++compared;
+        for (const auto kernel : kernels) {
+          ReducedDynamics rd;
+          Vec4 rho, rhod;
+          ASSERT_EQ(rd.platform_only(m, platform_config(s.pose), s.vel, f, st, rho, rhod, kernel), Status::Ok);
+          Pose pdd;
+          ASSERT_EQ(rd.solve_platform(m, f.segment<4>(kPlatform), pdd), Status::Ok);
+          for (int k = 0; k < 4; ++k) {
+            EXPECT_EQ(pdd[k], ref[k]) << "kernel " << static_cast<int>(kernel) << " seed " << seed << " stops " << st;
+            EXPECT_EQ(rho[k], legs.rho[k]) << "kernel " << static_cast<int>(kernel) << " seed " << seed;
+            EXPECT_EQ(rhod[k], legs.rhod[k]) << "kernel " << static_cast<int>(kernel) << " seed " << seed;
+          }
+          ++compared;
+        }
       }
     }
+    EXPECT_EQ(compared, 300 * 7 * static_cast<int>(kernels.size()));
   }
-  EXPECT_EQ(compared, 300 * 6 * static_cast<int>(kernels.size()));
 }
 
 TEST(ForwardDynamics, HotPathReportsTheFirstFailingLeg) {
