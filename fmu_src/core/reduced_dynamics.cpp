@@ -6,7 +6,7 @@
 #include "machine.hpp"
 
 // x86-64 with GCC or Clang: an AVX variant of the legs' lanes beside the
-// SSE2 baseline, chosen once at run time. Not on Windows: MinGW-w64's GCC
+// SSE2 baseline, taken where Model::avx (make_model asks CPUID). Not on Windows: MinGW-w64's GCC
 // does not keep 32-byte stack alignment for AVX spills (GCC PR 54412).
 #if PKM_LANES_VECTOR_EXTENSIONS && defined(__x86_64__) && !defined(_WIN32) && !defined(__AVX__)
 #define PKM_LANES_AVX_DISPATCH 1
@@ -103,7 +103,8 @@ struct LegContribution {
 };
 
 // The passive joint force (friction, end stops) per lane: the scalar
-// function itself (its tanh and branches), so the same bits.
+// function itself (its tanh and branches), so the same bits; for the lanes
+// its plain case written lane-wise.
 PKM_LANES_INLINE double passive_force(const Params& p, int first, unsigned stops, double rho, double rhod) {
   return passive_joint_force(p, first, stops, rho, rhod);
 }
