@@ -61,21 +61,10 @@ Status state_derivative(const Model& m, Formulation form, const Vec8& y, const V
   ydot.head<4>() = y.tail<4>();
   if (form == Formulation::LegPartitioned && full == nullptr) {
     // The integrators' hot path: the reduced system without the legs' terms.
-    ReducedDynamics rd;
-    const Pose pd = y.tail<4>();
-    const PlatformConfig pc = platform_config(y.head<4>());
-    rd.reset_platform_only(pc, pd[3]);
-    for (int i = 0; i < kLegs; ++i) {
-      double rho, rhod;
-      const Status s = rd.add_leg_platform_only(m, i, pc, pd, f[leg_offset(i)], stops, rho, rhod);
-      if (s != Status::Ok) return s;
-      if (joints) {
-        joints->rho[i] = rho;
-        joints->rhod[i] = rhod;
-      }
-    }
     Pose pdd;
-    const Status s = rd.solve_platform(m, f.segment<4>(kPlatform), pdd);
+    const Status s = ReducedDynamics::platform_derivative(m, platform_config(y.head<4>()), y.tail<4>(), f, stops,
+                                                          joints ? &joints->rho : nullptr,
+                                                          joints ? &joints->rhod : nullptr, pdd);
     if (s == Status::Ok) ydot.tail<4>() = pdd;
     return s;
   }

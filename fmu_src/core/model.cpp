@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "lanes.hpp"
+
 namespace pkm {
 
 Status make_model(const Params& p, Model& out, std::string* error) {
@@ -26,6 +28,7 @@ Status make_model(const Params& p, Model& out, std::string* error) {
   out.platform_Izz = p.Izz_platform + p.payload_Izz + p.payload_mass * c2;
   out.payload_mx = p.payload_mass * p.payload_com[0];
   out.payload_my = p.payload_mass * p.payload_com[1];
+  out.avx = lanes::cpu_runs_avx();
   return Status::Ok;
 }
 

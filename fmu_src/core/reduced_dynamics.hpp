@@ -46,16 +46,30 @@ class ReducedDynamics {
   void reduced_system(const Model& m, const Wrench& we, Mat4& Mr, Vec4& rhs) const;
 
   /// The integrators' hot path, without keeping the legs' terms (solve()
-  /// needs them, solve_platform does not): reset_platform_only, then
-  /// add_leg_platform_only for every leg, then solve_platform. The same
-  /// arithmetic as prepare_leg, leg_velocity and add_leg, with the zeros and
-  /// ones of J_i^{-1}, A_i and M_i written out (bit for bit the same
-  /// result); leg() is not valid afterwards. f_rho is the applied force on
-  /// rho_i, the passive joint force (stops held as `stops`) is added here;
-  /// rho and rhod receive the leg's actuated joint and its rate.
-  void reset_platform_only(const PlatformConfig& pc, double phid);
-  Status add_leg_platform_only(const Model& m, int leg, const PlatformConfig& pc, const Pose& pd, double f_rho,
-                               unsigned stops, double& rho, double& rhod);
+  /// needs them, solve_platform does not): the reduced system of all four
+  /// legs, then solve_platform. The same arithmetic as prepare_leg,
+  /// leg_velocity and add_leg, with the zeros and ones of J_i^{-1}, A_i and
+  /// M_i written out, computed for the four legs at once as lanes
+  /// (lanes.hpp) and summed in leg order: bit for bit the same result.
+  /// leg() is not valid afterwards. f holds the applied forces (on rho_i at
+  /// leg_offset(i)); the passive joint forces (stops held as `stops`) are
+  /// added here. rho and rhod receive the actuated joints and their rates
+  /// (untouched on failure). On failure the status of the first failing leg
+  /// (Unreachable, Singular), as leg by leg.
+  enum class LegLanes {
+    Best,     // Avx where m.avx (x86-64 GCC/Clang off Windows), else Generic
+    Scalar,   // one leg at a time (the same template for double)
+    Generic,  // the baseline instruction set (SSE2 pairs on x86-64, NEON on aarch64)
+    Avx,      // AVX; Status::InvalidArgument where unavailable
+  };
+  static bool lanes_available(LegLanes kernel);
+  /// platform_only + solve_platform without the object (the integrators'
+  /// hot path, state_derivative): the best lanes, the same solver, the same
+  /// bits. rho and rhod (if given) are written once the legs succeed.
+  static Status platform_derivative(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
+                                    unsigned stops, Vec4* rho, Vec4* rhod, Pose& pdd);
+  Status platform_only(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
+                       Vec4& rho, Vec4& rhod, LegLanes kernel = LegLanes::Best);
 
   struct Leg {
     LegConfig c;

@@ -2,6 +2,7 @@
 // basis, Eq. 13 with the leg-partitioned basis), they invert the inverse
 // dynamics, and energy is conserved when nothing does work.
 #include <cmath>
+#include <vector>
 
 #include "inverse_dynamics.hpp"
 #include "lagrangian.hpp"
@@ -70,41 +71,146 @@ TEST(ForwardDynamics, StateDerivativeHotPathEqualsFullEvaluation) {
   }
 }
 
+namespace {
+
+// The legs' lanes of the hot path (ReducedDynamics::platform_only) that
+// this processor can run: the scalar instance of the same template, the
+// baseline lanes and, where the processor has it, the AVX variant.
+std::vector<ReducedDynamics::LegLanes> lane_kernels() {
+  using K = ReducedDynamics::LegLanes;
+  std::vector<K> k = {K::Best, K::Scalar, K::Generic};
+  if (ReducedDynamics::lanes_available(K::Avx)) k.push_back(K::Avx);
+  return k;
+}
+
+// The reference: reduced_terms (prepare_leg, leg_velocity, add_leg with the
+// legs' terms kept) and solve_platform.
+Status reference_derivative(const Model& m, const Vec8& y, const Vec16& f, unsigned stops, Pose& pdd,
+                            JointMotion& legs) {
+  ReducedDynamics rd;
+  const Status s = reduced_terms(m, y, f, stops, rd, &legs);
+  if (s != Status::Ok) return s;
+  return rd.solve_platform(m, f.segment<4>(kPlatform), pdd);
+}
+
+}  // namespace
+
 TEST(ForwardDynamics, HotPathIsBitIdenticalToTheReducedTermsWithTheLegs) {
-  // state_derivative's hot path (ReducedDynamics::add_leg_platform_only)
-  // writes out the zeros and ones of J_i^-1, A_i and M_i instead of keeping
-  // the legs' terms: the same products summed in the same order as
-  // reduced_terms + solve_platform, so the same bits. With every machine
-  // term acting (rotor, friction, payload) and with the stops held on or off.
-  Params p;
-  p.rotor_inertia = 2e-5;
-  p.friction_viscous = 3.0;
-  p.friction_coulomb = 0.4;
-  p.payload_mass = 0.3;
-  p.payload_com = {0.01, -0.02};
-  const Model m = model_of(p);
-  const unsigned stops[] = {kStopsFromState, 0u, 0x0Fu, 0xF0u, 0x5Au};
-  for (unsigned seed = 1; seed <= 10; ++seed) {
-    const RandomState s = random_state(m, seed);
-    Vec8 y;
-    y << s.pose, s.vel;
-    const Vec16 f = generalized_forces(random_vec<4>(700 + seed, 3.0), random_vec<4>(800 + seed, 0.5));
-    for (unsigned st : stops) {
-      Vec8 ydot;
-      JointMotion hot;
-      ASSERT_EQ(state_derivative(m, Formulation::LegPartitioned, y, f, ydot, nullptr, &hot, st), Status::Ok);
-      ReducedDynamics rd;
-      JointMotion legs;
-      ASSERT_EQ(reduced_terms(m, y, f, st, rd, &legs), Status::Ok);
-      Pose pdd;
-      ASSERT_EQ(rd.solve_platform(m, f.segment<4>(kPlatform), pdd), Status::Ok);
-      for (int k = 0; k < 4; ++k) {
-        EXPECT_EQ(ydot[4 + k], pdd[k]) << "seed " << seed << " stops " << st << " k " << k;
-        EXPECT_EQ(hot.rho[k], legs.rho[k]) << "seed " << seed;
-        EXPECT_EQ(hot.rhod[k], legs.rhod[k]) << "seed " << seed;
+  // state_derivative's hot path (ReducedDynamics::platform_only) writes out
+  // the zeros and ones of J_i^-1, A_i and M_i instead of keeping the legs'
+  // terms and computes the four legs as lanes: the same products summed in
+  // the same order as reduced_terms + solve_platform, so the same bits, for
+  // every variant of the lanes. With every machine term acting (rotor,
+  // friction, payload) and with the stops held on or off, over many states
+  // (some of them fast, for the friction's tanh, and past the stops); and
+  // without Coulomb friction, where the lanes take the passive force
+  // lane-wise while no stop acts (stops 0 and, within the travel, from the
+  // state) instead of the scalar function per lane.
+  for (const double coulomb : {0.4, 0.0}) {
+    Params p;
+    p.rotor_inertia = 2e-5;
+    p.friction_viscous = 3.0;
+    p.friction_coulomb = coulomb;
+    p.payload_mass = 0.3;
+    p.payload_com = {0.01, -0.02};
+    const Model m = model_of(p);
+    const unsigned stops[] = {kStopsFromState, 0u, 0x0Fu, 0xF0u, 0x5Au, 0xA5u, 0x100u};
+    const auto kernels = lane_kernels();
+    int compared = 0;
+    for (unsigned seed = 1; seed <= 300; ++seed) {
+      RandomState s = random_state(m, seed);
+      if (seed % 3 == 0) s.vel *= 20.0;  // the friction's tanh saturated
+      Vec8 y;
+      y << s.pose, s.vel;
+      const Vec16 f = generalized_forces(random_vec<4>(700 + seed, 3.0), random_vec<4>(800 + seed, 0.5));
+      for (unsigned st : stops) {
+        Pose ref;
+        JointMotion legs;
+        ASSERT_EQ(reference_derivative(m, y, f, st, ref, legs), Status::Ok);
+        Vec8 ydot;
+        JointMotion hot;
+        ASSERT_EQ(state_derivative(m, Formulation::LegPartitioned, y, f, ydot, nullptr, &hot, st), Status::Ok);
+        for (int k = 0; k < 4; ++k) {
+          EXPECT_EQ(ydot[4 + k], ref[k]) << "seed " << seed << " stops " << st << " k " << k;
+          EXPECT_EQ(hot.rho[k], legs.rho[k]) << "seed " << seed;
+          EXPECT_EQ(hot.rhod[k], legs.rhod[k]) << "seed " << seed;
+        }
+        for (const auto kernel : kernels) {
+          ReducedDynamics rd;
+          Vec4 rho, rhod;
+          ASSERT_EQ(rd.platform_only(m, platform_config(s.pose), s.vel, f, st, rho, rhod, kernel), Status::Ok);
+          Pose pdd;
+          ASSERT_EQ(rd.solve_platform(m, f.segment<4>(kPlatform), pdd), Status::Ok);
+          for (int k = 0; k < 4; ++k) {
+            EXPECT_EQ(pdd[k], ref[k]) << "kernel " << static_cast<int>(kernel) << " seed " << seed << " stops " << st;
+            EXPECT_EQ(rho[k], legs.rho[k]) << "kernel " << static_cast<int>(kernel) << " seed " << seed;
+            EXPECT_EQ(rhod[k], legs.rhod[k]) << "kernel " << static_cast<int>(kernel) << " seed " << seed;
+          }
+          ++compared;
+        }
       }
     }
+    EXPECT_EQ(compared, 300 * 7 * static_cast<int>(kernels.size()));
   }
+}
+
+TEST(ForwardDynamics, HotPathReportsTheFirstFailingLeg) {
+  // One leg (or two) moved off its reach or onto a singularity, the others
+  // as they are: every variant of the lanes returns the status of the first
+  // failing leg in leg order, as the leg-by-leg reference does. At the pose
+  // (0, 0, z, 0) a leg with beta = 0, r_Q = 0 and B = (-h', 0, .) sees
+  // q~ = (h', 0, .): A = 0, the link vertical (Singular); B = (1, 0, .) is
+  // out of reach.
+  const Model m0 = default_model();
+  ASSERT_GT(m0.p.h_prime, 0.0);
+  const Pose pose(0.0, 0.0, 0.06, 0.0), vel(0.1, -0.05, 0.02, 0.3);
+  Vec8 y;
+  y << pose, vel;
+  const Vec16 f = generalized_forces(Vec4(1.0, 2.0, 3.0, 4.0), Wrench::Zero());
+  enum Fault { None, Far, Singular };
+  auto with = [&](int leg, Fault fault, Model m) {
+    if (fault == None) return m;
+    m.cos_beta[leg] = 1.0;
+    m.sin_beta[leg] = 0.0;
+    m.r_Q[leg] = Vec3::Zero();
+    m.B[leg] = fault == Far ? Vec3(1.0, 0.0, m.B[leg].z()) : Vec3(-m.p.h_prime, 0.0, m.B[leg].z());
+    return m;
+  };
+  struct Case {
+    Fault faults[kLegs];
+    Status expected;
+  };
+  const Case cases[] = {
+      {{None, Far, None, None}, Status::Unreachable},
+      {{None, None, Singular, None}, Status::Singular},
+      {{None, None, None, Far}, Status::Unreachable},
+      {{None, None, None, Singular}, Status::Singular},
+      {{None, Singular, None, Far}, Status::Singular},
+      {{None, None, Far, Singular}, Status::Unreachable},
+      {{Singular, None, None, Far}, Status::Singular},
+      {{Far, Singular, None, None}, Status::Unreachable},
+  };
+  const auto kernels = lane_kernels();
+  for (const Case& c : cases) {
+    Model m = m0;
+    for (int i = 0; i < kLegs; ++i) m = with(i, c.faults[i], m);
+    Pose ref;
+    JointMotion legs;
+    EXPECT_EQ(reference_derivative(m, y, f, kStopsFromState, ref, legs), c.expected);
+    Vec8 ydot;
+    EXPECT_EQ(state_derivative(m, Formulation::LegPartitioned, y, f, ydot), c.expected);
+    for (const auto kernel : kernels) {
+      ReducedDynamics rd;
+      Vec4 rho = Vec4::Constant(7.0), rhod = Vec4::Constant(7.0);
+      EXPECT_EQ(rd.platform_only(m, platform_config(pose), vel, f, kStopsFromState, rho, rhod, kernel), c.expected)
+          << "kernel " << static_cast<int>(kernel);
+      EXPECT_EQ(rho, Vec4::Constant(7.0));  // untouched on failure
+      EXPECT_EQ(rhod, Vec4::Constant(7.0));
+    }
+  }
+  // The unmodified model at that pose: every leg fine.
+  Vec8 ydot;
+  EXPECT_EQ(state_derivative(m0, Formulation::LegPartitioned, y, f, ydot), Status::Ok);
 }
 
 namespace {
