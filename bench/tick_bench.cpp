@@ -115,14 +115,17 @@ std::vector<Pose> run_once(const pkm::Model& model, const pkm::SolverSettings& s
   return traj;
 }
 
-Result measure(const pkm::Model& model, const pkm::SolverSettings& st, Inputs kind, bool cont, const Vec4& F_static,
-               const std::vector<Pose>& reference) {
+/// kRuns runs of run(&result, &seconds) (one simulated second each): the
+/// median time per step, and the largest deviation of the last run's
+/// positions from the reference.
+template <class Run>
+Result measure_runs(Run run, const std::vector<Pose>& reference) {
   Result r;
   std::vector<double> times;
   std::vector<Pose> traj;
   for (int i = 0; i < kRuns && r.ok; ++i) {
     double s = 0;
-    traj = run_once(model, st, kind, cont, F_static, &r, &s);
+    traj = run(&r, &s);
     times.push_back(s);
   }
   if (!r.ok) return r;
@@ -131,6 +134,12 @@ Result measure(const pkm::Model& model, const pkm::SolverSettings& st, Inputs ki
   for (size_t k = 0; k < traj.size() && k < reference.size(); ++k)
     r.max_dev = std::max(r.max_dev, (traj[k] - reference[k]).head<3>().lpNorm<Eigen::Infinity>());
   return r;
+}
+
+Result measure(const pkm::Model& model, const pkm::SolverSettings& st, Inputs kind, bool cont, const Vec4& F_static,
+               const std::vector<Pose>& reference) {
+  return measure_runs([&](Result* r, double* s) { return run_once(model, st, kind, cont, F_static, r, s); },
+                      reference);
 }
 
 #if PKM_TICK_BENCH_ARKODE
@@ -260,20 +269,9 @@ std::vector<Pose> run_arkode(const pkm::Model& model, const pkm::SolverSettings&
 
 Result measure_arkode(const pkm::Model& model, const pkm::SolverSettings& st, ARKODE_ERKTableID table, ArkMode mode,
                       Inputs kind, const Vec4& F_static, const std::vector<Pose>& reference, long* roots) {
-  Result r;
-  std::vector<double> times;
-  std::vector<Pose> traj;
-  for (int i = 0; i < kRuns && r.ok; ++i) {
-    double s = 0;
-    traj = run_arkode(model, st, table, mode, kind, F_static, &r, &s, roots);
-    times.push_back(s);
-  }
-  if (!r.ok) return r;
-  std::sort(times.begin(), times.end());
-  r.median_us = 1e6 * times[times.size() / 2] / kSteps;
-  for (size_t k = 0; k < traj.size() && k < reference.size(); ++k)
-    r.max_dev = std::max(r.max_dev, (traj[k] - reference[k]).head<3>().lpNorm<Eigen::Infinity>());
-  return r;
+  return measure_runs(
+      [&](Result* r, double* s) { return run_arkode(model, st, table, mode, kind, F_static, r, s, roots); },
+      reference);
 }
 
 /// One derivative evaluation alone (machine_rates at the home pose), us:
