@@ -30,13 +30,18 @@ thread_local CvodeIntegrator* t_initializing = nullptr;
 
 void keep_spare(N_Vector) {}
 
-// CVODE's predictor (cvPredict) adds up the Nordsieck array pairwise in every
-// step: q (q + 1) / 2 calls of N_VLinearSum(1, zn[j-1], 1, zn[j], zn[j-1]),
-// 78 at Adams' order 12, each a loop over the 10 components behind SUNDIALS'
-// generic dispatch (a quarter of a continued 1-ms tick, callgrind). Its two
-// axpy cases on this integrator's vectors (length 10, known to the compiler)
-// are done here with the per-component arithmetic of SUNDIALS' Vaxpy_Serial,
-// so bit for bit the same; every other case goes to N_VLinearSum_Serial.
+// CVODE's vector operations on this integrator's vectors (length 10, known
+// to the compiler here) without SUNDIALS' generic loops: its predictor
+// (cvPredict) alone adds up the Nordsieck array pairwise in every step, q (q +
+// 1) / 2 calls of N_VLinearSum(1, zn[j-1], 1, zn[j], zn[j-1]), 78 at Adams'
+// order 12; its corrector, error test and order selection take weighted RMS
+// norms (about 18 per continued 1-ms tick) and scale vectors. Each case below
+// is SUNDIALS 6.4.1's nvector_serial.c (N_VLinearSum_Serial and its
+// Vaxpy/VSum/VDiff/VLin1/VLin2/VScaleSum/VScaleDiff, N_VScale_Serial with
+// VScaleBy/VCopy/VNeg, N_VWrmsNorm_Serial with N_VWSqrSumLocal_Serial): the
+// same cases in its order, the same per-component arithmetic, the norm's sum
+// in its order, so bit for bit the same. Element-wise loops, so z may alias x
+// or y as there. Other lengths go to the serial functions.
 constexpr sunindextype kLength = 10;
 
 void axpy10(realtype a, const realtype* x, realtype* y) {
@@ -49,13 +54,90 @@ void axpy10(realtype a, const realtype* x, realtype* y) {
   }
 }
 
-void linear_sum(realtype a, N_Vector x, realtype b, N_Vector y, N_Vector z) {
-  if (NV_LENGTH_S(x) == kLength) {
-    // N_VLinearSum_Serial's first two cases, in its order.
-    if (b == 1.0 && z == y) return axpy10(a, NV_DATA_S(x), NV_DATA_S(y));
-    if (a == 1.0 && z == x) return axpy10(b, NV_DATA_S(y), NV_DATA_S(x));
+void linear_sum10(realtype a, N_Vector xv, realtype b, N_Vector yv, N_Vector zv) {
+  if (b == 1.0 && zv == yv) return axpy10(a, NV_DATA_S(xv), NV_DATA_S(yv));
+  if (a == 1.0 && zv == xv) return axpy10(b, NV_DATA_S(yv), NV_DATA_S(xv));
+  const realtype* x = NV_DATA_S(xv);
+  const realtype* y = NV_DATA_S(yv);
+  realtype* z = NV_DATA_S(zv);
+  if (a == 1.0 && b == 1.0) {  // VSum
+    for (int i = 0; i < kLength; ++i) z[i] = x[i] + y[i];
+    return;
   }
+  bool test;
+  if ((test = (a == 1.0 && b == -1.0)) || (a == -1.0 && b == 1.0)) {  // VDiff(v2, v1)
+    const realtype* v1 = test ? y : x;
+    const realtype* v2 = test ? x : y;
+    for (int i = 0; i < kLength; ++i) z[i] = v2[i] - v1[i];
+    return;
+  }
+  if ((test = (a == 1.0)) || b == 1.0) {  // VLin1(c, v1, v2)
+    const realtype c = test ? b : a;
+    const realtype* v1 = test ? y : x;
+    const realtype* v2 = test ? x : y;
+    for (int i = 0; i < kLength; ++i) z[i] = (c * v1[i]) + v2[i];
+    return;
+  }
+  if ((test = (a == -1.0)) || b == -1.0) {  // VLin2(c, v1, v2)
+    const realtype c = test ? b : a;
+    const realtype* v1 = test ? y : x;
+    const realtype* v2 = test ? x : y;
+    for (int i = 0; i < kLength; ++i) z[i] = (c * v1[i]) - v2[i];
+    return;
+  }
+  if (a == b) {  // VScaleSum
+    for (int i = 0; i < kLength; ++i) z[i] = a * (x[i] + y[i]);
+    return;
+  }
+  if (a == -b) {  // VScaleDiff
+    for (int i = 0; i < kLength; ++i) z[i] = a * (x[i] - y[i]);
+    return;
+  }
+  for (int i = 0; i < kLength; ++i) z[i] = (a * x[i]) + (b * y[i]);
+}
+
+bool length10(N_Vector v) { return NV_LENGTH_S(v) == kLength; }
+
+void linear_sum(realtype a, N_Vector x, realtype b, N_Vector y, N_Vector z) {
+  if (length10(x) && length10(y) && length10(z)) return linear_sum10(a, x, b, y, z);
   N_VLinearSum_Serial(a, x, b, y, z);
+}
+
+void scale(realtype c, N_Vector xv, N_Vector zv) {
+  if (!length10(xv) || !length10(zv)) return N_VScale_Serial(c, xv, zv);
+  const realtype* x = NV_DATA_S(xv);
+  realtype* z = NV_DATA_S(zv);
+  if (zv == xv) {  // VScaleBy
+    for (int i = 0; i < kLength; ++i) z[i] *= c;
+  } else if (c == 1.0) {  // VCopy
+    for (int i = 0; i < kLength; ++i) z[i] = x[i];
+  } else if (c == -1.0) {  // VNeg
+    for (int i = 0; i < kLength; ++i) z[i] = -x[i];
+  } else {
+    for (int i = 0; i < kLength; ++i) z[i] = c * x[i];
+  }
+}
+
+realtype wrms_norm(N_Vector xv, N_Vector wv) {
+  if (!length10(xv) || !length10(wv)) return N_VWrmsNorm_Serial(xv, wv);
+  const realtype* x = NV_DATA_S(xv);
+  const realtype* w = NV_DATA_S(wv);
+  realtype sum = 0.0;  // N_VWSqrSumLocal_Serial
+  for (int i = 0; i < kLength; ++i) {
+    const realtype prodi = x[i] * w[i];
+    sum += prodi * prodi;
+  }
+  sum = sum / static_cast<realtype>(kLength);
+  return sum <= 0.0 ? 0.0 : std::sqrt(sum);  // SUNRsqrt
+}
+
+// The operations above on a vector of this integrator (its clones copy them),
+// its clones made by `clone`.
+void use_own_ops(N_Vector v, N_Vector (*clone)(N_Vector)) {
+  v->ops->nvclone = clone;
+  v->ops->nvlinearsum = &linear_sum;
+  v->ops->nvscale = &scale;
+  v->ops->nvwrmsnorm = &wrms_norm;
 }
 
 }  // namespace
@@ -147,13 +229,11 @@ Status CvodeIntegrator::create(CvodeMethod method, double rtol, double atol, Rhs
   if (SUNContext_Create(nullptr, &ctx_) != 0) return Status::SolverFailure;
   spare_ = N_VNew_Serial(10, ctx_);
   if (!spare_) return Status::SolverFailure;
+  use_own_ops(spare_, &CvodeIntegrator::clone_or_spare);
   spare_->ops->nvdestroy = &keep_spare;
-  spare_->ops->nvclone = &CvodeIntegrator::clone_or_spare;
-  spare_->ops->nvlinearsum = &linear_sum;
   y_ = N_VNew_Serial(10, ctx_);
   if (!y_) return Status::SolverFailure;
-  y_->ops->nvclone = &CvodeIntegrator::clone_or_spare;
-  y_->ops->nvlinearsum = &linear_sum;  // CVodeInit's clones copy it
+  use_own_ops(y_, &CvodeIntegrator::clone_or_spare);  // CVodeInit's clones copy them
   mem_ = CVodeCreate(method == CvodeMethod::BDF ? CV_BDF : CV_ADAMS, ctx_);
   if (!mem_) return Status::SolverFailure;
   CVodeSetErrHandlerFn(mem_, &CvodeIntegrator::error_handler, this);
@@ -179,7 +259,7 @@ Status CvodeIntegrator::create(CvodeMethod method, double rtol, double atol, Rhs
   // each), so the integrand's jump there costs no step.
   atol_ = N_VNew_Serial(10, ctx_);
   if (!atol_) return Status::SolverFailure;
-  atol_->ops->nvclone = &CvodeIntegrator::clone_or_spare;
+  use_own_ops(atol_, &CvodeIntegrator::clone_or_spare);
   for (int k = 0; k < 10; ++k) N_VGetArrayPointer(atol_)[k] = atol;
   flag |= CVodeSVtolerances(mem_, rtol, atol_);
   // Enough for a long communication interval at the natural step (~1 ms),

@@ -4,17 +4,7 @@
 
 namespace pkm {
 
-Status actuator_positions(const Model& m, const Pose& pose, Vec4& rho) {
-  if (!pose.allFinite()) return Status::NonFinite;
-  const PlatformConfig pc = platform_config(pose);
-  for (int i = 0; i < kLegs; ++i) {
-    LegConfig c;
-    const Status s = leg_inverse_kinematics(m, i, pc, c);
-    if (s != Status::Ok) return s;
-    rho[i] = c.rho;
-  }
-  return Status::Ok;
-}
+// actuator_positions: reduced_dynamics.cpp (the derivative's legs as lanes).
 
 Status stop_indicators(const Model& m, const Pose& pose, double g[kStopIndicators]) {
   Vec4 rho;

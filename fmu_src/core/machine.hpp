@@ -161,7 +161,9 @@ inline void stop_indicators(const Params& p, const Vec4& rho, double g[kStopIndi
 }
 
 /// The actuator positions rho_1..4 at a platform pose (closed-form leg
-/// inverse kinematics). Status::Unreachable outside the workspace.
+/// inverse kinematics; the four legs as lanes, bit for bit leg_inverse_kinematics
+/// leg by leg: ReducedDynamics::leg_positions). Status::Unreachable outside
+/// the workspace (rho untouched), NonFinite for a non-finite pose.
 Status actuator_positions(const Model& m, const Pose& pose, Vec4& rho);
 
 /// The indicators at a platform pose (any state: they depend on the pose only).

@@ -124,17 +124,27 @@ PKM_LANES_INLINE lanes::Pack passive_force(const Params& p, int first, unsigned 
   return lanes::pack(F[0], F[1], F[2], F[3]);
 }
 
+// leg_inverse_kinematics per lane (with rotated_attachment): the
+// derivative's legs and actuator_positions. out_of_reach: the lanes it
+// reports Unreachable for (their other members are meaningless).
 template <class T>
-PKM_LANES_INLINE Status leg_contribution(const Model& m, int first, const PlatformConfig& pc, const Pose& pd,
-                                         unsigned stops, const LegInputs<T>& in, LegContribution<T>& out) {
-  const Params& p = m.p;
+struct LegPosition {
+  T ax, ay;          // Rz(phi) r_Qi (its z is 0)
+  T c1, s1, c2, s2;  // the leg's angles' cosines and sines
+  T rho;
+  decltype(lanes::not_ge(T(), 0.0)) out_of_reach;
+};
+
+template <class T>
+PKM_LANES_INLINE LegPosition<T> leg_position(const Params& p, const PlatformConfig& pc, const LegInputs<T>& in) {
+  LegPosition<T> o;
   // rotated_attachment: Rz(phi) r_Qi (its z is 0).
-  const T ax = pc.cphi * in.rx - pc.sphi * in.ry;
-  const T ay = pc.sphi * in.rx + pc.cphi * in.ry;
+  o.ax = pc.cphi * in.rx - pc.sphi * in.ry;
+  o.ay = pc.sphi * in.rx + pc.cphi * in.ry;
   // leg_inverse_kinematics: q~ = Rz(beta_i)^T (p + attach - B_i), then the
   // elbow-down branch.
-  const T vx = (pc.pose[0] + ax) - in.Bx;
-  const T vy = (pc.pose[1] + ay) - in.By;
+  const T vx = (pc.pose[0] + o.ax) - in.Bx;
+  const T vy = (pc.pose[1] + o.ay) - in.By;
   const T qz = (pc.pose[2] + 0.0) - in.Bz;
   const T qx = in.cb * vx + in.sb * vy;
   const T qy = -in.sb * vx + in.cb * vy;
@@ -142,13 +152,23 @@ PKM_LANES_INLINE Status leg_contribution(const Model& m, int first, const Platfo
   const T A2 = r2 - p.h_prime * p.h_prime;
   const auto below = lanes::not_ge(A2, 0.0);  // also catches NaN
   const T A = lanes::sqrt(lanes::zero_where(below, A2));
-  const auto out_of_reach = lanes::either(below, lanes::not_le(A, p.l));
-  const T c1 = (qx * A - qy * p.h_prime) / r2;
-  const T s1 = (qy * A + qx * p.h_prime) / r2;
-  const T c2 = A / p.l;
-  const T s2sq = 1.0 - c2 * c2;
-  const T s2 = -lanes::sqrt(lanes::select(lanes::gt(s2sq, 0.0), s2sq, 0.0));  // elbow-down
-  const T rho = qz - p.h - p.l * s2;
+  o.out_of_reach = lanes::either(below, lanes::not_le(A, p.l));
+  o.c1 = (qx * A - qy * p.h_prime) / r2;
+  o.s1 = (qy * A + qx * p.h_prime) / r2;
+  o.c2 = A / p.l;
+  const T s2sq = 1.0 - o.c2 * o.c2;
+  o.s2 = -lanes::sqrt(lanes::select(lanes::gt(s2sq, 0.0), s2sq, 0.0));  // elbow-down
+  o.rho = qz - p.h - p.l * o.s2;
+  return o;
+}
+
+template <class T>
+PKM_LANES_INLINE Status leg_contribution(const Model& m, int first, const PlatformConfig& pc, const Pose& pd,
+                                         unsigned stops, const LegInputs<T>& in, LegContribution<T>& out) {
+  const Params& p = m.p;
+  const LegPosition<T> lp = leg_position(p, pc, in);
+  const T ax = lp.ax, ay = lp.ay, c1 = lp.c1, s1 = lp.s1, c2 = lp.c2, s2 = lp.s2, rho = lp.rho;
+  const auto& out_of_reach = lp.out_of_reach;
   // leg_singularity_measure.
   const auto singular = lanes::lt(lanes::abs(c2 * s2), kLegSingularFloor);
   if (lanes::any(lanes::either(out_of_reach, singular))) {
@@ -238,10 +258,8 @@ LegInputs<double> leg_inputs(const Model& m, int leg, double f_rho) {
           m.r_Q[leg].x(), m.r_Q[leg].y(), f_rho};
 }
 
-// The four legs as lanes, their contributions summed in leg order
-// ((0 + leg 0) + leg 1) + ... as the scalar accumulation does.
-PKM_LANES_INLINE Status legs_as_lanes(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
-                                      unsigned stops, LegSums& sums) {
+// The four legs' geometry as lanes (f_rho left 0).
+PKM_LANES_INLINE LegInputs<lanes::Pack> lane_inputs(const Model& m) {
   using lanes::pack;
   LegInputs<lanes::Pack> in;
   in.Bx = pack(m.B[0].x(), m.B[1].x(), m.B[2].x(), m.B[3].x());
@@ -251,7 +269,40 @@ PKM_LANES_INLINE Status legs_as_lanes(const Model& m, const PlatformConfig& pc, 
   in.sb = pack(m.sin_beta[0], m.sin_beta[1], m.sin_beta[2], m.sin_beta[3]);
   in.rx = pack(m.r_Q[0].x(), m.r_Q[1].x(), m.r_Q[2].x(), m.r_Q[3].x());
   in.ry = pack(m.r_Q[0].y(), m.r_Q[1].y(), m.r_Q[2].y(), m.r_Q[3].y());
-  in.f_rho = pack(f[leg_offset(0)], f[leg_offset(1)], f[leg_offset(2)], f[leg_offset(3)]);
+  in.f_rho = lanes::broadcast(0.0);
+  return in;
+}
+
+// The four legs' actuator positions as lanes; on failure the first failing
+// leg's status (Unreachable, as leg_inverse_kinematics leg by leg), rho untouched.
+PKM_LANES_INLINE Status positions_as_lanes(const Model& m, const PlatformConfig& pc, Vec4& rho) {
+  const LegPosition<lanes::Pack> lp = leg_position(m.p, pc, lane_inputs(m));
+  if (lanes::any(lp.out_of_reach)) return Status::Unreachable;
+  for (int i = 0; i < kLegs; ++i) rho[i] = lanes::lane(lp.rho, i);
+  return Status::Ok;
+}
+
+Status positions_scalar(const Model& m, const PlatformConfig& pc, Vec4& rho) {
+  Vec4 r;
+  for (int i = 0; i < kLegs; ++i) {
+    const LegPosition<double> lp = leg_position(m.p, pc, leg_inputs(m, i, 0.0));
+    if (lp.out_of_reach) return Status::Unreachable;
+    r[i] = lp.rho;
+  }
+  rho = r;
+  return Status::Ok;
+}
+
+Status positions_generic(const Model& m, const PlatformConfig& pc, Vec4& rho) {
+  return positions_as_lanes(m, pc, rho);
+}
+
+// The four legs as lanes, their contributions summed in leg order
+// ((0 + leg 0) + leg 1) + ... as the scalar accumulation does.
+PKM_LANES_INLINE Status legs_as_lanes(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
+                                      unsigned stops, LegSums& sums) {
+  LegInputs<lanes::Pack> in = lane_inputs(m);
+  in.f_rho = lanes::pack(f[leg_offset(0)], f[leg_offset(1)], f[leg_offset(2)], f[leg_offset(3)]);
   LegContribution<lanes::Pack> c;
   const Status s = leg_contribution(m, 0, pc, pd, stops, in, c);
   if (s != Status::Ok) return s;
@@ -295,6 +346,9 @@ Status legs_generic(const Model& m, const PlatformConfig& pc, const Pose& pd, co
 __attribute__((target("avx"))) Status legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
                                                const Vec16& f, unsigned stops, LegSums& sums) {
   return legs_as_lanes(m, pc, pd, f, stops, sums);
+}
+__attribute__((target("avx"))) Status positions_avx(const Model& m, const PlatformConfig& pc, Vec4& rho) {
+  return positions_as_lanes(m, pc, rho);
 }
 #endif
 
@@ -393,6 +447,31 @@ Status ReducedDynamics::platform_only(const Model& m, const PlatformConfig& pc, 
     rhod[j] = sums.rhod[j];
   }
   return Status::Ok;
+}
+
+Status ReducedDynamics::leg_positions(const Model& m, const PlatformConfig& pc, Vec4& rho, LegLanes kernel) {
+  switch (kernel) {
+    case LegLanes::Best:
+#if PKM_LANES_AVX_DISPATCH
+      if (m.avx) return positions_avx(m, pc, rho);
+#endif
+      return positions_generic(m, pc, rho);
+    case LegLanes::Scalar: return positions_scalar(m, pc, rho);
+    case LegLanes::Generic: return positions_generic(m, pc, rho);
+    case LegLanes::Avx:
+#if PKM_LANES_AVX_DISPATCH
+      if (!lanes_available(LegLanes::Avx)) return Status::InvalidArgument;
+      return positions_avx(m, pc, rho);
+#else
+      return Status::InvalidArgument;
+#endif
+  }
+  return Status::InvalidArgument;
+}
+
+Status actuator_positions(const Model& m, const Pose& pose, Vec4& rho) {
+  if (!pose.allFinite()) return Status::NonFinite;
+  return ReducedDynamics::leg_positions(m, platform_config(pose), rho);
 }
 
 Status ReducedDynamics::platform_derivative(const Model& m, const PlatformConfig& pc, const Pose& pd,

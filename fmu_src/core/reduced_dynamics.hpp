@@ -70,6 +70,13 @@ class ReducedDynamics {
                                     unsigned stops, Vec4* rho, Vec4* rhod, Pose& pdd);
   Status platform_only(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
                        Vec4& rho, Vec4& rhod, LegLanes kernel = LegLanes::Best);
+  /// The actuator positions rho_1..4 (actuator_positions without the
+  /// finiteness check): the legs' inverse kinematics of platform_only, four
+  /// lanes, the same bits as leg_inverse_kinematics leg by leg. On failure
+  /// Status::Unreachable (the first failing leg's, as leg by leg), rho
+  /// untouched; InvalidArgument for an unavailable kernel.
+  static Status leg_positions(const Model& m, const PlatformConfig& pc, Vec4& rho,
+                              LegLanes kernel = LegLanes::Best);
 
   struct Leg {
     LegConfig c;
