@@ -353,14 +353,37 @@ __attribute__((target("avx"))) Status positions_avx(const Model& m, const Platfo
 #endif
 
 using LegsKernel = Status (*)(const Model&, const PlatformConfig&, const Pose&, const Vec16&, unsigned, LegSums&);
+using PositionsKernel = Status (*)(const Model&, const PlatformConfig&, Vec4&);
+struct Kernels {
+  LegsKernel legs;
+  PositionsKernel positions;
+};
 
-LegsKernel best_kernel(const Model& m) {
+// The variant `kind` of the legs' lanes (Best: AVX where model_avx, i.e.
+// Model::avx); false for an AVX variant this build or processor cannot run.
+bool kernels_for(bool model_avx, ReducedDynamics::LegLanes kind, Kernels& k) {
+  using K = ReducedDynamics::LegLanes;
+  k = {legs_generic, positions_generic};
+  switch (kind) {
+    case K::Generic: return true;
+    case K::Scalar: k = {legs_scalar, positions_scalar}; return true;
+    case K::Best:
 #if PKM_LANES_AVX_DISPATCH
-  if (m.avx) return legs_avx;
+      if (model_avx) k = {legs_avx, positions_avx};
 #else
-  (void)m;
+      (void)model_avx;
 #endif
-  return legs_generic;
+      return true;
+    case K::Avx:
+#if PKM_LANES_AVX_DISPATCH
+      if (!lanes::cpu_runs_avx()) return false;
+      k = {legs_avx, positions_avx};
+      return true;
+#else
+      return false;
+#endif
+  }
+  return false;
 }
 
 // The reduced system with the platform, its payload and the external
@@ -411,62 +434,15 @@ Status solve_reduced(const Model& m, const Wrench& we, const double mr[10], cons
 
 }  // namespace
 
-bool ReducedDynamics::lanes_available(LegLanes kernel) {
-  if (kernel == LegLanes::Avx) return PKM_LANES_AVX_DISPATCH && lanes::cpu_runs_avx();
-  return true;
+bool ReducedDynamics::lanes_available(LegLanes kind) {
+  Kernels k;
+  return kernels_for(false, kind, k);
 }
 
-Status ReducedDynamics::platform_only(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
-                                      unsigned stops, Vec4& rho, Vec4& rhod, LegLanes kernel) {
-  LegsKernel run = legs_generic;
-  switch (kernel) {
-    case LegLanes::Best: run = best_kernel(m); break;
-    case LegLanes::Scalar: run = legs_scalar; break;
-    case LegLanes::Generic: run = legs_generic; break;
-    case LegLanes::Avx:
-#if PKM_LANES_AVX_DISPATCH
-      if (!lanes_available(LegLanes::Avx)) return Status::InvalidArgument;
-      run = legs_avx;
-      break;
-#else
-      return Status::InvalidArgument;
-#endif
-  }
-  cphi_ = pc.cphi;
-  sphi_ = pc.sphi;
-  phid_ = pd[3];
-  LegSums sums;
-  const Status s = run(m, pc, pd, f, stops, sums);
-  if (s != Status::Ok) return s;
-  int n = 0;
-  for (int j = 0; j < 4; ++j)
-    for (int k = j; k < 4; ++k) Mr_(j, k) = sums.mr[n++];
-  for (int j = 0; j < 4; ++j) {
-    rhs_[j] = sums.rhs[j];
-    rho[j] = sums.rho[j];
-    rhod[j] = sums.rhod[j];
-  }
-  return Status::Ok;
-}
-
-Status ReducedDynamics::leg_positions(const Model& m, const PlatformConfig& pc, Vec4& rho, LegLanes kernel) {
-  switch (kernel) {
-    case LegLanes::Best:
-#if PKM_LANES_AVX_DISPATCH
-      if (m.avx) return positions_avx(m, pc, rho);
-#endif
-      return positions_generic(m, pc, rho);
-    case LegLanes::Scalar: return positions_scalar(m, pc, rho);
-    case LegLanes::Generic: return positions_generic(m, pc, rho);
-    case LegLanes::Avx:
-#if PKM_LANES_AVX_DISPATCH
-      if (!lanes_available(LegLanes::Avx)) return Status::InvalidArgument;
-      return positions_avx(m, pc, rho);
-#else
-      return Status::InvalidArgument;
-#endif
-  }
-  return Status::InvalidArgument;
+Status ReducedDynamics::leg_positions(const Model& m, const PlatformConfig& pc, Vec4& rho, LegLanes kind) {
+  Kernels k;
+  if (!kernels_for(m.avx, kind, k)) return Status::InvalidArgument;
+  return k.positions(m, pc, rho);
 }
 
 Status actuator_positions(const Model& m, const Pose& pose, Vec4& rho) {
@@ -475,9 +451,12 @@ Status actuator_positions(const Model& m, const Pose& pose, Vec4& rho) {
 }
 
 Status ReducedDynamics::platform_derivative(const Model& m, const PlatformConfig& pc, const Pose& pd,
-                                            const Vec16& f, unsigned stops, Vec4* rho, Vec4* rhod, Pose& pdd) {
+                                            const Vec16& f, unsigned stops, Vec4* rho, Vec4* rhod, Pose& pdd,
+                                            LegLanes kind) {
+  Kernels k;
+  if (!kernels_for(m.avx, kind, k)) return Status::InvalidArgument;
   LegSums sums;
-  const Status s = best_kernel(m)(m, pc, pd, f, stops, sums);
+  const Status s = k.legs(m, pc, pd, f, stops, sums);
   if (s != Status::Ok) return s;
   if (rho) *rho = Vec4(sums.rho[0], sums.rho[1], sums.rho[2], sums.rho[3]);
   if (rhod) *rhod = Vec4(sums.rhod[0], sums.rhod[1], sums.rhod[2], sums.rhod[3]);

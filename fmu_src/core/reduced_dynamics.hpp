@@ -45,38 +45,36 @@ class ReducedDynamics {
   /// for every leg).
   void reduced_system(const Model& m, const Wrench& we, Mat4& Mr, Vec4& rhs) const;
 
-  /// The integrators' hot path, without keeping the legs' terms (solve()
-  /// needs them, solve_platform does not): the reduced system of all four
-  /// legs, then solve_platform. The same arithmetic as prepare_leg,
-  /// leg_velocity and add_leg, with the zeros and ones of J_i^{-1}, A_i and
-  /// M_i written out, computed for the four legs at once as lanes
-  /// (lanes.hpp) and summed in leg order: bit for bit the same result.
-  /// leg() is not valid afterwards. f holds the applied forces (on rho_i at
-  /// leg_offset(i)); the passive joint forces (stops held as `stops`) are
-  /// added here. rho and rhod receive the actuated joints and their rates
-  /// (untouched on failure). On failure the status of the first failing leg
-  /// (Unreachable, Singular), as leg by leg.
+  /// The variants of the legs' lanes (lanes.hpp): the same template, the
+  /// same bits; tests run each of them explicitly.
   enum class LegLanes {
     Best,     // Avx where m.avx (x86-64 GCC/Clang off Windows), else Generic
     Scalar,   // one leg at a time (the same template for double)
     Generic,  // the baseline instruction set (SSE2 pairs on x86-64, NEON on aarch64)
     Avx,      // AVX; Status::InvalidArgument where unavailable
   };
-  static bool lanes_available(LegLanes kernel);
-  /// platform_only + solve_platform without the object (the integrators'
-  /// hot path, state_derivative): the best lanes, the same solver, the same
-  /// bits. rho and rhod (if given) are written once the legs succeed.
+  static bool lanes_available(LegLanes kind);
+  /// The integrators' hot path (state_derivative): the platform's
+  /// accelerations pdd without keeping the legs' terms (solve() needs them,
+  /// solve_platform does not). The same arithmetic as prepare_leg,
+  /// leg_velocity, add_leg and solve_platform, with the zeros and ones of
+  /// J_i^{-1}, A_i and M_i written out, computed for the four legs at once
+  /// as lanes and summed in leg order: bit for bit the same result. f holds
+  /// the applied forces (on rho_i at leg_offset(i)); the passive joint
+  /// forces (stops held as `stops`) are added here. rho and rhod (if given)
+  /// receive the actuated joints and their rates, untouched on failure. On
+  /// failure the status of the first failing leg (Unreachable, Singular),
+  /// as leg by leg; InvalidArgument for an unavailable variant.
   static Status platform_derivative(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
-                                    unsigned stops, Vec4* rho, Vec4* rhod, Pose& pdd);
-  Status platform_only(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
-                       Vec4& rho, Vec4& rhod, LegLanes kernel = LegLanes::Best);
+                                    unsigned stops, Vec4* rho, Vec4* rhod, Pose& pdd,
+                                    LegLanes kind = LegLanes::Best);
   /// The actuator positions rho_1..4 (actuator_positions without the
-  /// finiteness check): the legs' inverse kinematics of platform_only, four
-  /// lanes, the same bits as leg_inverse_kinematics leg by leg. On failure
-  /// Status::Unreachable (the first failing leg's, as leg by leg), rho
-  /// untouched; InvalidArgument for an unavailable kernel.
+  /// finiteness check): the legs' inverse kinematics of platform_derivative,
+  /// four lanes, the same bits as leg_inverse_kinematics leg by leg. On
+  /// failure Status::Unreachable (the first failing leg's, as leg by leg),
+  /// rho untouched; InvalidArgument for an unavailable variant.
   static Status leg_positions(const Model& m, const PlatformConfig& pc, Vec4& rho,
-                              LegLanes kernel = LegLanes::Best);
+                              LegLanes kind = LegLanes::Best);
 
   struct Leg {
     LegConfig c;

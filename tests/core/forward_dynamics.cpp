@@ -73,7 +73,7 @@ TEST(ForwardDynamics, StateDerivativeHotPathEqualsFullEvaluation) {
 
 namespace {
 
-// The legs' lanes of the hot path (ReducedDynamics::platform_only) that
+// The legs' lanes of the hot path (ReducedDynamics::platform_derivative) that
 // this processor can run: the scalar instance of the same template, the
 // baseline lanes and, where the processor has it, the AVX variant.
 std::vector<ReducedDynamics::LegLanes> lane_kernels() {
@@ -96,7 +96,7 @@ Status reference_derivative(const Model& m, const Vec8& y, const Vec16& f, unsig
 }  // namespace
 
 TEST(ForwardDynamics, HotPathIsBitIdenticalToTheReducedTermsWithTheLegs) {
-  // state_derivative's hot path (ReducedDynamics::platform_only) writes out
+  // state_derivative's hot path (ReducedDynamics::platform_derivative) writes out
   // the zeros and ones of J_i^-1, A_i and M_i instead of keeping the legs'
   // terms and computes the four legs as lanes: the same products summed in
   // the same order as reduced_terms + solve_platform, so the same bits, for
@@ -136,11 +136,11 @@ TEST(ForwardDynamics, HotPathIsBitIdenticalToTheReducedTermsWithTheLegs) {
           EXPECT_EQ(hot.rhod[k], legs.rhod[k]) << "seed " << seed;
         }
         for (const auto kernel : kernels) {
-          ReducedDynamics rd;
           Vec4 rho, rhod;
-          ASSERT_EQ(rd.platform_only(m, platform_config(s.pose), s.vel, f, st, rho, rhod, kernel), Status::Ok);
           Pose pdd;
-          ASSERT_EQ(rd.solve_platform(m, f.segment<4>(kPlatform), pdd), Status::Ok);
+          ASSERT_EQ(ReducedDynamics::platform_derivative(m, platform_config(s.pose), s.vel, f, st, &rho, &rhod, pdd,
+                                                         kernel),
+                    Status::Ok);
           for (int k = 0; k < 4; ++k) {
             EXPECT_EQ(pdd[k], ref[k]) << "kernel " << static_cast<int>(kernel) << " seed " << seed << " stops " << st;
             EXPECT_EQ(rho[k], legs.rho[k]) << "kernel " << static_cast<int>(kernel) << " seed " << seed;
@@ -244,9 +244,11 @@ TEST(ForwardDynamics, HotPathReportsTheFirstFailingLeg) {
     Vec8 ydot;
     EXPECT_EQ(state_derivative(m, Formulation::LegPartitioned, y, f, ydot), c.expected);
     for (const auto kernel : kernels) {
-      ReducedDynamics rd;
       Vec4 rho = Vec4::Constant(7.0), rhod = Vec4::Constant(7.0);
-      EXPECT_EQ(rd.platform_only(m, platform_config(pose), vel, f, kStopsFromState, rho, rhod, kernel), c.expected)
+      Pose pdd;
+      EXPECT_EQ(ReducedDynamics::platform_derivative(m, platform_config(pose), vel, f, kStopsFromState, &rho, &rhod,
+                                                     pdd, kernel),
+                c.expected)
           << "kernel " << static_cast<int>(kernel);
       EXPECT_EQ(rho, Vec4::Constant(7.0));  // untouched on failure
       EXPECT_EQ(rhod, Vec4::Constant(7.0));
