@@ -64,6 +64,8 @@ const Formulation kFormulations[kForms] = {Formulation::LegPartitioned, Formulat
 const char* const kFormNames[kForms] = {"LegPartitioned", "NullSpaceQR", "Augmented"};
 
 const char* ok_mark(double value, double target) { return value <= target ? "ok" : "OVER"; }
+// One LegPartitioned state derivative (issue 16), s.
+constexpr double kDerivativeTarget = 0.25e-6;
 
 void rule() {
   std::printf("------------------------------------------------------------------------------------------------\n");
@@ -282,7 +284,8 @@ StateDerivativeFigures state_derivative_section(Bench& b) {
   for (int i = 0; i < kForms; ++i) {
     const Figure& f = sd[static_cast<size_t>(i)];
     char target[32] = "";
-    if (i == 0) std::snprintf(target, sizeof target, "<= 0.25 us  %s", ok_mark(sd[0].median, 0.25e-6));
+    if (i == 0) std::snprintf(target, sizeof target, "<= %g us  %s", kDerivativeTarget * 1e6,
+                            ok_mark(sd[0].median, kDerivativeTarget));
     std::printf("   %-16s %12s %12s %10ld %8.2fx %16s %13.2e\n", kFormNames[i], fmt_time(f.median).c_str(),
                 fmt_time(f.min).c_str(), f.per_batch, f.median / sd[0].median, target, acc_err[i]);
   }
@@ -748,8 +751,8 @@ void ratios_section(const StateDerivativeFigures& sd, double jac_ratio, const In
               static_cast<double>(a.cvd_rt.rhs) / 8000.0);
   std::printf("   CVODE run_autotest / RK4 run_autotest: 1e-12 %.2f, 1e-8 %.2f\n",
               a.cvt_rt.fig.median / a.rk4_rt.fig.median, a.cvd_rt.fig.median / a.rk4_rt.fig.median);
-  std::printf("   targets: state derivative <= 0.25 us (issue 16): %s (%s);  2-s RK4 forward run <= 10 ms: %s (%s)\n",
-              ok_mark(sd0, 0.25e-6), fmt_time(sd0).c_str(), ok_mark(a.rk4_fwd.fig.median, 10e-3),
+  std::printf("   targets: state derivative <= %g us (issue 16): %s (%s);  2-s RK4 forward run <= 10 ms: %s (%s)\n",
+              kDerivativeTarget * 1e6, ok_mark(sd0, kDerivativeTarget), fmt_time(sd0).c_str(), ok_mark(a.rk4_fwd.fig.median, 10e-3),
               fmt_time(a.rk4_fwd.fig.median).c_str());
   rule();
 }
