@@ -180,12 +180,8 @@ int ark_rhs(double t, N_Vector y, N_Vector ydot, void* user) {
 
 int ark_roots(double, N_Vector y, double* g, void* user) {  // as Plant::cvode_roots
   const auto* p = static_cast<const ArkProblem*>(user);
-  Vec4 rho;
-  if (pkm::actuator_positions(*p->model, Eigen::Map<const Pose>(N_VGetArrayPointer(y)), rho) != Status::Ok) {
+  if (pkm::stop_indicators(*p->model, Eigen::Map<const Pose>(N_VGetArrayPointer(y)), g) != Status::Ok)
     for (int k = 0; k < pkm::kStopIndicators; ++k) g[k] = 1.0;
-    return 0;
-  }
-  pkm::stop_indicators(p->model->p, rho, g);
   return 0;
 }
 

@@ -352,12 +352,8 @@ Status Plant::machine_rates(const InputSignal& inputs, double t, const Vec10& x,
 int Plant::cvode_roots(double t, const Vec10& x, double* g, void* self) {
   (void)t;
   const auto* me = static_cast<const Plant*>(self);
-  Vec4 rho;
-  if (actuator_positions(me->model_, x.head<4>(), rho) != Status::Ok) {
+  if (stop_indicators(me->model_, x.head<4>(), g) != Status::Ok)
     for (int k = 0; k < kStopIndicators; ++k) g[k] = 1.0;  // off the workspace: the rhs reports it
-    return 0;
-  }
-  stop_indicators(me->model_.p, rho, g);
   return 0;
 }
 
