@@ -13,7 +13,9 @@ cd "$(dirname "${BASH_SOURCE[0]}")"
 # What the build needs first (Debian packages, fmpy's FMI headers); the rest
 # of the Python requirements (the checks' numpy, SciPy, MuJoCo, Pinocchio,
 # ...) install beside the build, which does not need them.
-PKM_SETUP=for-build ./scripts/build.sh --configure-only
+# Every platform: the Windows and aarch64 FMUs, built and tested under wine
+# and qemu-user (cmake/Platforms.cmake).
+PKM_SETUP=for-build ./scripts/build.sh --configure-only -DPKM_PLATFORMS=ON
 setup_log=build/setup.log
 ./scripts/setup.sh >"$setup_log" 2>&1 &
 setup_pid=$!

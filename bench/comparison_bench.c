@@ -65,7 +65,7 @@
 
 #define PKM_HARNESS_NAME "pkm_comparison_bench"
 #include "fmu_harness.h"
-#include "pkm.h"
+#include "pkm4puu/pkm.h"
 
 #ifndef PKM_FMU_PLANT_SO
 #define PKM_FMU_PLANT_SO "PKM4PUU.so"

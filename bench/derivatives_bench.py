@@ -148,7 +148,7 @@ def main(argv=None):
     prog = "derivatives_bench"
     ap = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
     ap.add_argument("--build", type=Path, default=REPO / "build",
-                    help="build directory holding fmu_src/libpkm.so and bench/pkm_bench (default: %(default)s)")
+                    help="build directory holding lib/libpkm.so and bench/pkm_bench (default: %(default)s)")
     ap.add_argument("--rounds", type=int, default=7, help="interleaved rounds (default %(default)s)")
     ap.add_argument("--calls", type=int, default=2000, help="calls per case and round (default %(default)s)")
     ap.add_argument("--no-pkm-bench", action="store_true", help="do not run pkm_bench for its C++ item 1b")

@@ -20,7 +20,7 @@
 #include <unistd.h>
 
 #include "fmi2FunctionTypes.h"
-#include "fmi_functions.h"
+#include "fmi/fmi_functions.h"
 
 /* Each harness uses some of the functions below. */
 #if defined(__GNUC__)
@@ -33,7 +33,7 @@
 #error "define PKM_HARNESS_NAME before including fmu_harness.h"
 #endif
 
-/* Every FMI 2.0 function the binaries export (fmu_src/fmi/fmi_functions.h). */
+/* Every FMI 2.0 function the binaries export (src/fmi/fmi_functions.h). */
 typedef struct {
   void* handle;
 #define PKM_HARNESS_DECLARE(name) name##TYPE* name;

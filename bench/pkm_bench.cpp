@@ -30,16 +30,16 @@
 #include <sundials/sundials_config.h>
 
 #include "alloc_count.hpp"
-#include "autotest.hpp"
-#include "inverse_dynamics.hpp"
-#include "inverse_dynamics_derivatives.hpp"
-#include "lagrangian.hpp"
-#include "minimal_state.hpp"
-#include "plant.hpp"
-#include "reduced_dynamics_derivatives.hpp"
-#include "servo_kinematics.hpp"
+#include "apps/autotest.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/dynamics/state_derivative.hpp"
+#include "pkm4puu/sim/plant.hpp"
+#include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
+#include "pkm4puu/kinematics/servo_kinematics.hpp"
 #include "timing.hpp"
-#include "trajectory.hpp"
+#include "apps/trajectory.hpp"
 
 namespace {
 

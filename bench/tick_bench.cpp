@@ -32,11 +32,11 @@
 #include <cstdio>
 #include <vector>
 
-#include "inverse_dynamics.hpp"
-#include "lagrangian.hpp"
-#include "machine.hpp"
-#include "minimal_state.hpp"
-#include "plant.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/dynamics/state_derivative.hpp"
+#include "pkm4puu/sim/plant.hpp"
 
 #if PKM_TICK_BENCH_ARKODE
 #include <arkode/arkode_erkstep.h>

@@ -1,63 +1,29 @@
 # The FMUs: the FMI 2.0 and 3.0 headers, the FMU shared objects and their
 # .fmu archives.
 #
-#   FMI2_HEADERS_DIR  (cache) directory holding fmi2Functions.h and fmi3Functions.h. Default:
-#                     fmpy's c-code directory, found with the project's
-#                     .venv/bin/python (else python3). The headers are used
-#                     in place, never copied into the repository.
-#   PKM_FMU_PYTHON    (cache) the Python that has fmpy (tests: fmpy validate).
+#   PKM_FMU_PYTHON    (cache) the Python that has fmpy (tests: fmpy validate);
+#                     default: the project's .venv, else python3.
 #
-#   pkm_add_fmu(<modelIdentifier> DEFINITION <C++ function> MODEL_DESCRIPTIONS <dir>
-#               SOURCES <front ends .cpp> LIBRARIES <libs...>
-#               VERSION_SCRIPT <map> DOC_TOOL <executable target>)
+#   pkm_add_fmu(<modelIdentifier> DEFINITION <function in namespace pkm_fmi>
+#               SOURCES <the model's sources...>)
 include_guard(GLOBAL)
 
-set(FMI2_HEADERS_DIR "" CACHE PATH "Directory with the FMI 2.0 headers (fmi2Functions.h); default: fmpy's c-code")
-set(PKM_FMU_PYTHON "" CACHE FILEPATH "Python interpreter with fmpy installed (FMU tests)")
+# The FMI standard's headers, vendored (third_party/fmi, BSD-2-Clause).
+if(NOT TARGET pkm_fmi_headers)
+  add_library(pkm_fmi_headers INTERFACE)
+  target_include_directories(pkm_fmi_headers SYSTEM INTERFACE "${PROJECT_SOURCE_DIR}/third_party/fmi/include")
+  add_library(pkm::fmi_headers ALIAS pkm_fmi_headers)
+endif()
 
+set(PKM_FMU_PYTHON "" CACHE FILEPATH "Python interpreter with fmpy installed (FMU tests)")
 if(NOT PKM_FMU_PYTHON)
-  if(EXISTS "${CMAKE_SOURCE_DIR}/.venv/bin/python")
-    set(_pkm_python "${CMAKE_SOURCE_DIR}/.venv/bin/python")
+  if(EXISTS "${PROJECT_SOURCE_DIR}/.venv/bin/python")
+    set(PKM_FMU_PYTHON "${PROJECT_SOURCE_DIR}/.venv/bin/python" CACHE FILEPATH "Python interpreter with fmpy installed (FMU tests)" FORCE)
   else()
     find_program(PKM_PYTHON3_EXECUTABLE NAMES python3)
     mark_as_advanced(PKM_PYTHON3_EXECUTABLE)
-    set(_pkm_python "${PKM_PYTHON3_EXECUTABLE}")
+    set(PKM_FMU_PYTHON "${PKM_PYTHON3_EXECUTABLE}" CACHE FILEPATH "Python interpreter with fmpy installed (FMU tests)" FORCE)
   endif()
-else()
-  set(_pkm_python "${PKM_FMU_PYTHON}")
-endif()
-
-set(_pkm_fmpy_dir "")
-if(_pkm_python)
-  execute_process(
-    COMMAND "${_pkm_python}" -c "import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), 'c-code'))"
-    OUTPUT_VARIABLE _pkm_fmpy_dir OUTPUT_STRIP_TRAILING_WHITESPACE
-    RESULT_VARIABLE _pkm_fmpy_rc ERROR_QUIET)
-  if(NOT _pkm_fmpy_rc EQUAL 0)
-    set(_pkm_fmpy_dir "")
-  elseif(NOT PKM_FMU_PYTHON)
-    set(PKM_FMU_PYTHON "${_pkm_python}" CACHE FILEPATH "Python interpreter with fmpy installed (FMU tests)" FORCE)
-  endif()
-endif()
-
-if(NOT FMI2_HEADERS_DIR AND _pkm_fmpy_dir AND EXISTS "${_pkm_fmpy_dir}/fmi2Functions.h")
-  set(FMI2_HEADERS_DIR "${_pkm_fmpy_dir}" CACHE PATH
-      "Directory with the FMI 2.0 headers (fmi2Functions.h); default: fmpy's c-code" FORCE)
-endif()
-if(NOT FMI2_HEADERS_DIR OR NOT EXISTS "${FMI2_HEADERS_DIR}/fmi2Functions.h"
-   OR NOT EXISTS "${FMI2_HEADERS_DIR}/fmi2FunctionTypes.h" OR NOT EXISTS "${FMI2_HEADERS_DIR}/fmi2TypesPlatform.h"
-   OR NOT EXISTS "${FMI2_HEADERS_DIR}/fmi3Functions.h")
-  message(FATAL_ERROR
-    "FMI 2.0 headers not found (FMI2_HEADERS_DIR = '${FMI2_HEADERS_DIR}'). They come from the fmpy package: "
-    "run ./scripts/setup.sh to create .venv with python_checks/requirements.txt (fmpy), or install fmpy for "
-    "python3, or pass -DFMI2_HEADERS_DIR=<directory with fmi2Functions.h>.")
-endif()
-message(STATUS "FMI 2.0 headers: ${FMI2_HEADERS_DIR}")
-
-if(NOT TARGET pkm_fmi2_headers)
-  add_library(pkm_fmi2_headers INTERFACE)
-  target_include_directories(pkm_fmi2_headers SYSTEM INTERFACE "${FMI2_HEADERS_DIR}")
-  add_library(pkm::fmi2_headers ALIAS pkm_fmi2_headers)
 endif()
 
 # FMI platform directories of the binaries: FMI 2.0 (linux64, win64, ...)
@@ -94,7 +60,7 @@ set(PKM_FMU3_PLATFORM "${_pkm_cpu}-${_pkm_fmi3_os}")
 if(DEFINED ENV{SOURCE_DATE_EPOCH})
   set(PKM_SOURCE_DATE_EPOCH "$ENV{SOURCE_DATE_EPOCH}")
 else()
-  execute_process(COMMAND git -C "${CMAKE_SOURCE_DIR}" log -1 --format=%ct
+  execute_process(COMMAND git -C "${PROJECT_SOURCE_DIR}" log -1 --format=%ct
                   OUTPUT_VARIABLE PKM_SOURCE_DATE_EPOCH OUTPUT_STRIP_TRAILING_WHITESPACE
                   RESULT_VARIABLE _pkm_git_rc ERROR_QUIET)
   if(NOT _pkm_git_rc EQUAL 0 OR NOT PKM_SOURCE_DATE_EPOCH MATCHES "^[0-9]+$")
@@ -108,20 +74,64 @@ else()
 endif()
 set(PKM_PACK_FMU "${CMAKE_CURRENT_LIST_DIR}/pack_fmu.py")
 
-# One FMU binary <id> (PREFIX "", only the fmi2* and fmi3* functions
-# exported, the C++ runtime linked statically) and its two archives:
+# One FMU from its model's folder (the caller's CMAKE_CURRENT_SOURCE_DIR/<id>):
+#   pkm_model_<id>  its sources (the variable table and the data hooks) on
+#                   the core and the generic FMI layer, for the binary, the
+#                   tests and the tools;
+#   <id>_files      the build tool that writes its model descriptions
+#                   (build/modelDescription/fmi<v>/<id>.xml) and its
+#                   documentation page from the table;
+#   <id>            the binary (PREFIX "", only the fmi2* and fmi3* functions
+#                   exported, the C++ runtime linked statically);
 #   ${CMAKE_BINARY_DIR}/<id>.fmu       FMI 2.0 (Co-Simulation and Model Exchange)
 #   ${CMAKE_BINARY_DIR}/fmi3/<id>.fmu  FMI 3.0 (Co-Simulation and Model Exchange)
-# Each ships the committed model description MODEL_DESCRIPTIONS/fmi<N>/<id>.xml
-# and the documentation page written by DOC_TOOL. Targets <id>_fmu and
-# <id>_fmu3 (part of ALL). Sets <id>_FMU_DIR, <id>_FMU_FILE, <id>_FMU3_DIR
-# and <id>_FMU3_FILE in the caller's scope.
+# Each archive ships the committed model description <id>/fmi<v>/modelDescription.xml.
+# Targets <id>_fmu and <id>_fmu3 (part of ALL). Sets <id>_FMU_DIR,
+# <id>_FMU_FILE, <id>_FMU3_DIR and <id>_FMU3_FILE in the caller's scope and
+# appends <id> to the global property PKM_FMU_MODELS.
 function(pkm_add_fmu id)
-  cmake_parse_arguments(F "" "DEFINITION;MODEL_DESCRIPTIONS;VERSION_SCRIPT;DOC_TOOL" "SOURCES;LIBRARIES" ${ARGN})
+  cmake_parse_arguments(F "" "DEFINITION" "SOURCES" ${ARGN})
+  set(model_dir "${CMAKE_CURRENT_SOURCE_DIR}/${id}")
   set(binary_name "${id}${CMAKE_SHARED_LIBRARY_SUFFIX}")
-  add_library(${id} SHARED ${F_SOURCES})
+  set_property(GLOBAL APPEND PROPERTY PKM_FMU_MODELS ${id})
+  set_property(GLOBAL PROPERTY PKM_FMU_DEFINITION_${id} ${F_DEFINITION})
+
+  add_library(pkm_model_${id} STATIC ${F_SOURCES})
+  target_link_libraries(pkm_model_${id} PUBLIC pkm_fmi pkm_core PRIVATE pkm::sundials pkm::options)
+  set_target_properties(pkm_model_${id} PROPERTIES CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON)
+  pkm_fat_lto_objects(pkm_model_${id})  # cmake/Lto.cmake: the tests and the tools link it without LTO
+
+  add_executable(${id}_files ${PROJECT_SOURCE_DIR}/src/fmi/fmu_files.cpp)
+  target_compile_definitions(${id}_files PRIVATE PKM_FMI_DEFINITION=${F_DEFINITION})
+  target_link_libraries(${id}_files PRIVATE pkm_model_${id} pkm::sundials pkm::options)
+  pkm_without_lto(${id}_files)
+  set(generated_md "${CMAKE_BINARY_DIR}/modelDescription")
+  add_custom_command(
+    OUTPUT "${generated_md}/fmi2/${id}.xml" "${generated_md}/fmi3/${id}.xml"
+    COMMAND ${CMAKE_COMMAND} -E make_directory "${generated_md}/fmi2" "${generated_md}/fmi3"
+    COMMAND ${id}_files --xml "${generated_md}"
+    DEPENDS ${id}_files
+    COMMENT "Generating ${id}'s model descriptions from its variable table"
+    VERBATIM)
+  add_custom_target(${id}_model_descriptions ALL
+                    DEPENDS "${generated_md}/fmi2/${id}.xml" "${generated_md}/fmi3/${id}.xml")
+  # `cmake --build build --target update_model_descriptions` writes them into
+  # the model's folder (commit them); the test model_descriptions_up_to_date
+  # compares the two.
+  add_custom_target(${id}_update_model_descriptions
+    COMMAND ${CMAKE_COMMAND} -E copy "${generated_md}/fmi2/${id}.xml" "${model_dir}/fmi2/modelDescription.xml"
+    COMMAND ${CMAKE_COMMAND} -E copy "${generated_md}/fmi3/${id}.xml" "${model_dir}/fmi3/modelDescription.xml"
+    DEPENDS ${id}_model_descriptions
+    COMMENT "Copying ${id}'s generated model descriptions into ${model_dir} (commit them)"
+    VERBATIM)
+  if(NOT TARGET update_model_descriptions)
+    add_custom_target(update_model_descriptions)
+  endif()
+  add_dependencies(update_model_descriptions ${id}_update_model_descriptions)
+
+  add_library(${id} SHARED ${PKM_FMI_FRONT_ENDS})
   target_compile_definitions(${id} PRIVATE PKM_FMI_DEFINITION=${F_DEFINITION})
-  target_link_libraries(${id} PRIVATE ${F_LIBRARIES} pkm::fmi2_headers)
+  target_link_libraries(${id} PRIVATE pkm_model_${id} pkm::sundials pkm::fmi_headers pkm::options)
   set_target_properties(${id} PROPERTIES
     PREFIX ""
     OUTPUT_NAME "${id}"
@@ -130,7 +140,7 @@ function(pkm_add_fmu id)
     C_VISIBILITY_PRESET hidden
     CXX_VISIBILITY_PRESET hidden
     VISIBILITY_INLINES_HIDDEN ON
-    LINK_DEPENDS "${F_VERSION_SCRIPT}")
+    LINK_DEPENDS "${PKM_FMI_EXPORTS_MAP}")
   if(CMAKE_SYSTEM_NAME STREQUAL "Linux")
     # Portable binary: nothing but libc/libm/ld-linux needed at run time.
     # Except under clang's sanitizers (PKM_FUZZ): the binary then takes the
@@ -140,8 +150,12 @@ function(pkm_add_fmu id)
       set(_no_undefined)
     endif()
     target_link_options(${id} PRIVATE
-      "LINKER:--version-script=${F_VERSION_SCRIPT}" ${_no_undefined} "LINKER:--exclude-libs,ALL"
+      "LINKER:--version-script=${PKM_FMI_EXPORTS_MAP}" ${_no_undefined} "LINKER:--exclude-libs,ALL"
       -static-libstdc++ -static-libgcc)
+    if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+      # Linked with -static-libstdc++: free its private exception pool on unload (fmu_binary.cpp).
+      target_compile_definitions(${id} PRIVATE PKM_FMI_FREE_EH_POOL=1)
+    endif()
   elseif(MINGW)
     target_link_options(${id} PRIVATE -static)
   endif()
@@ -158,7 +172,7 @@ function(pkm_add_fmu id)
       set(platform "${PKM_FMU3_PLATFORM}")
       set(target ${id}_fmu3)
     endif()
-    set(md "${F_MODEL_DESCRIPTIONS}/fmi${version}/${id}.xml")
+    set(md "${model_dir}/fmi${version}/modelDescription.xml")
     add_custom_command(
       OUTPUT "${fmu}"
       COMMAND ${CMAKE_COMMAND} -E rm -rf "${stage}" "${fmu}"
@@ -166,20 +180,22 @@ function(pkm_add_fmu id)
               "${CMAKE_BINARY_DIR}/fmi3"
       COMMAND ${CMAKE_COMMAND} -E copy "${md}" "${stage}/modelDescription.xml"
       COMMAND ${CMAKE_COMMAND} -E copy "$<TARGET_FILE:${id}>" "${stage}/binaries/${platform}/${binary_name}"
-      COMMAND ${F_DOC_TOOL} ${id} "${stage}/documentation/index.html"
+      COMMAND ${id}_files ${id} "${stage}/documentation/index.html"
       COMMAND ${CMAKE_COMMAND} -E env SOURCE_DATE_EPOCH=${PKM_SOURCE_DATE_EPOCH}
               "${_pkm_pack_python}" "${PKM_PACK_FMU}" "${fmu}" "${stage}"
               modelDescription.xml "binaries/${platform}/${binary_name}" documentation/index.html
-      DEPENDS ${id} "${md}" ${F_DOC_TOOL} "${PKM_PACK_FMU}"
+      DEPENDS ${id} "${md}" ${id}_files "${PKM_PACK_FMU}"
       COMMENT "Packaging ${fmu} (FMI ${version}.0)"
       VERBATIM)
     add_custom_target(${target} ALL DEPENDS "${fmu}")
     if(PKM_BUILD_TESTS AND NOT CMAKE_CROSSCOMPILING)
       add_test(NAME fmu_archive_reproducible_fmi${version}_${id}
-               COMMAND ${CMAKE_COMMAND} -DFMU=${fmu} -DSTAGE=${stage} -DID=${id} -DDOC_TOOL=$<TARGET_FILE:${F_DOC_TOOL}>
+               COMMAND ${CMAKE_COMMAND} -DFMU=${fmu} -DSTAGE=${stage} -DID=${id} -DDOC_TOOL=$<TARGET_FILE:${id}_files>
                        -DPYTHON=${_pkm_pack_python} -DPACK=${PKM_PACK_FMU} -DEPOCH=${PKM_SOURCE_DATE_EPOCH}
                        -DWORK=${CMAKE_BINARY_DIR}/reproducible/fmi${version}_${id}
                        -P ${CMAKE_CURRENT_FUNCTION_LIST_DIR}/check_reproducible_fmu.cmake)
+      add_test(NAME model_descriptions_up_to_date_fmi${version}_${id}
+               COMMAND ${CMAKE_COMMAND} -E compare_files "${generated_md}/fmi${version}/${id}.xml" "${md}")
     endif()
     if(version EQUAL 2)
       set(${id}_FMU_DIR "${stage}" PARENT_SCOPE)

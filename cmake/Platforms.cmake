@@ -10,9 +10,9 @@
 #   build/dist/fmi2/<id>.fmu   binaries/linux64, binaries/win64, sources/
 #   build/dist/fmi3/<id>.fmu   binaries/x86_64-linux, x86_64-windows, aarch64-linux, sources/
 #
-#   PKM_PLATFORMS  (option, ON) all of this; OFF: the host's FMUs only.
+#   PKM_PLATFORMS  (option, OFF) ON: all of this (the test command); OFF: the host's FMUs only.
 include_guard(GLOBAL)
-option(PKM_PLATFORMS "Cross-build the FMUs for Windows x64 and Linux aarch64, test them under wine and qemu-user, merge every platform into one archive per FMU" ON)
+option(PKM_PLATFORMS "Cross-build the FMUs for Windows x64 and Linux aarch64, test them under wine and qemu-user, merge every platform into one archive per FMU (the test command turns it on)" OFF)
 if(NOT PKM_PLATFORMS OR CMAKE_CROSSCOMPILING)
   return()
 endif()
@@ -58,7 +58,7 @@ foreach(_t IN ITEMS win64 aarch64)
     BINARY_DIR "${_bin}"
     CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/cmake/toolchains/${_toolchain}.cmake
                -DCMAKE_BUILD_TYPE=Release -DPKM_BUILD_BENCHMARKS=OFF -DPKM_PLATFORMS=OFF
-               -DPKM_CROSS_PREFIX=${_prefix} -DFMI2_HEADERS_DIR=${FMI2_HEADERS_DIR}
+               -DPKM_CROSS_PREFIX=${_prefix}
                -DPKM_FMU_PYTHON=${PKM_FMU_PYTHON} -DPKM_TRACE_REFERENCE=${PKM_TRACE_DIR}
     BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR> -j2
                   --target PKM4PUU PKM4PUU_Inverse fmi_state_machine fmi_variables fmi_fmu_state fmi_stepping
@@ -84,47 +84,54 @@ if(PKM_BUILD_TESTS)
   # CVODE linked in) and export exactly the FMI functions of fmi_functions.h.
   add_test(NAME platform_win64_binaries_imports_and_exports
            COMMAND ${CMAKE_COMMAND} -DOBJDUMP=x86_64-w64-mingw32-objdump
-                   "-DBINARIES=${PKM_win64_BINARIES}" -DFUNCTIONS=${PROJECT_SOURCE_DIR}/fmu_src/fmi/fmi_functions.h
+                   "-DBINARIES=${PKM_win64_BINARIES}" -DFUNCTIONS=${PROJECT_SOURCE_DIR}/src/fmi/fmi_functions.h
                    -P ${PROJECT_SOURCE_DIR}/cmake/check_windows_dll.cmake)
 endif()
 
 # ---------------------------------------------------------------- the merged archives
 # Source build: the core without SUNDIALS (cvode_unavailable.cpp for
-# cvode_integrator.cpp: RK4 only) and the FMI layer, Eigen inside.
+# cvode_integrator.cpp: RK4 only), the generic FMI layer and the model's own
+# sources, Eigen inside; every file keeps its path below src/ (sources/ is
+# the include root, as src/ is here).
+set(_src "${PROJECT_SOURCE_DIR}/src")
 get_target_property(_core_src pkm_core SOURCES)
-get_target_property(_fmi_src pkm_fmi_models SOURCES)
-set(_sources)
+get_target_property(_fmi_src pkm_fmi SOURCES)
+set(_common_sources)
 foreach(_f IN LISTS _core_src)
-  if(NOT _f STREQUAL "core/cvode_integrator.cpp")
-    list(APPEND _sources "${PROJECT_SOURCE_DIR}/fmu_src/${_f}")
+  if(NOT _f MATCHES "cvode_integrator.cpp$")
+    list(APPEND _common_sources "${_src}/${_f}")
   endif()
 endforeach()
-list(APPEND _sources "${PROJECT_SOURCE_DIR}/fmu_src/core/cvode_unavailable.cpp")
-foreach(_f IN LISTS _fmi_src ITEMS fmu_binary.cpp)
-  list(APPEND _sources "${PROJECT_SOURCE_DIR}/fmu_src/fmi/${_f}")
+list(APPEND _common_sources "${_src}/pkm4puu/integrators/cvode_unavailable.cpp")
+foreach(_f IN LISTS _fmi_src)
+  list(APPEND _common_sources "${_src}/fmi/${_f}")
 endforeach()
-file(GLOB _headers "${PROJECT_SOURCE_DIR}/fmu_src/core/*.hpp" "${PROJECT_SOURCE_DIR}/fmu_src/fmi/*.hpp"
-     "${PROJECT_SOURCE_DIR}/fmu_src/fmi/*.h")
-list(APPEND _headers "${PROJECT_SOURCE_DIR}/fmu_src/fmi/fmi2_functions.cpp"
-     "${PROJECT_SOURCE_DIR}/fmu_src/fmi/fmi3_functions.cpp")
+list(APPEND _common_sources "${_src}/fmi/fmu_binary.cpp")
+file(GLOB_RECURSE _headers "${_src}/pkm4puu/*.hpp" "${_src}/fmi/*.hpp" "${_src}/fmi/*.h" "${_src}/models/*.hpp")
+list(APPEND _headers "${_src}/fmi/fmi2_functions.cpp" "${_src}/fmi/fmi3_functions.cpp")
 get_target_property(_eigen_inc Eigen3::Eigen INTERFACE_INCLUDE_DIRECTORIES)
 list(GET _eigen_inc 0 _eigen_inc)
 set(_eigen_license /usr/share/doc/libeigen3-dev/copyright)
-set(_src_args)
-foreach(_f IN LISTS _sources)
-  list(APPEND _src_args --source "${_f}")
-endforeach()
+set(_header_args --source-root "${_src}")
 foreach(_f IN LISTS _headers)
-  list(APPEND _src_args --header "${_f}")
+  list(APPEND _header_args --header "${_f}")
 endforeach()
-list(APPEND _src_args --eigen "${_eigen_inc}" --eigen-license "${_eigen_license}")
+list(APPEND _header_args --eigen "${_eigen_inc}" --eigen-license "${_eigen_license}")
 
 set(_merged)
-foreach(_id IN ITEMS PKM4PUU PKM4PUU_Inverse)
-  # The model's table, as pkm_add_fmu compiled the binary with it.
-  get_target_property(_defs ${_id} COMPILE_DEFINITIONS)
-  list(FILTER _defs INCLUDE REGEX "^PKM_FMI_DEFINITION=")
-  string(REPLACE "PKM_FMI_DEFINITION=" "" _def "${_defs}")
+get_property(_models GLOBAL PROPERTY PKM_FMU_MODELS)
+foreach(_id IN LISTS _models)
+  # The model's table and sources, as pkm_add_fmu compiled the binary with them.
+  get_property(_def GLOBAL PROPERTY PKM_FMU_DEFINITION_${_id})
+  get_target_property(_model_src pkm_model_${_id} SOURCES)
+  set(_sources ${_common_sources})
+  foreach(_f IN LISTS _model_src)
+    list(APPEND _sources "${_src}/models/${_f}")
+  endforeach()
+  set(_src_args ${_header_args})
+  foreach(_f IN LISTS _sources)
+    list(APPEND _src_args --source "${_f}")
+  endforeach()
   foreach(_v 2 3)
     set(_bins)
     foreach(_t IN ITEMS win64 aarch64)

@@ -2,7 +2,7 @@ cmake_minimum_required(VERSION 3.18)
 # ctest platform_win64_binaries_imports_and_exports: each Windows DLL
 # imports only DLLs that every Windows has (KERNEL32, msvcrt: libstdc++,
 # libgcc, winpthread and CVODE are linked in) and exports exactly the FMI
-# functions listed in fmu_src/fmi/fmi_functions.h.
+# functions listed in src/fmi/fmi_functions.h.
 #   cmake -DOBJDUMP=... -DBINARIES=a.dll;b.dll -DFUNCTIONS=fmi_functions.h -P check_windows_dll.cmake
 set(_system_dlls KERNEL32.dll msvcrt.dll)
 file(READ "${FUNCTIONS}" _h)

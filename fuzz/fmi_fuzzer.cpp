@@ -35,8 +35,8 @@
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include "fmi2FunctionTypes.h"
-#include "fmi_functions.h"
-#include "models.hpp"
+#include "fmi/fmi_functions.h"
+#include "models/models.hpp"
 
 // The two in-process FMUs' exported FMI 2.0 functions: fmi_functions.h.
 #define PKM_FUZZ_FMI2_FUNCTIONS PKM_FMI2_FUNCTIONS

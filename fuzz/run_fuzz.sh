@@ -21,7 +21,7 @@
 # 45-second run would never get past them.
 # --coverage-report builds a source-coverage variant in DIR-cov, replays the
 # seed corpus and DIR/corpus through it and prints llvm-cov's region, line
-# and branch coverage of fmu_src/ (no fuzzing).
+# and branch coverage of src/ (no fuzzing).
 # Exit status: 0 no finding, 1 a finding (or a build failure), 77 when clang
 # or its libFuzzer runtime is missing (ctest reports the test as skipped;
 # scripts/setup.sh installs them).
@@ -68,8 +68,6 @@ if ! echo 'extern "C" int LLVMFuzzerTestOneInput(const unsigned char*, unsigned 
 fi
 
 mkdir -p "$build"
-fmi_headers=()
-if [ -n "${FMI2_HEADERS_DIR:-}" ]; then fmi_headers=(-DFMI2_HEADERS_DIR="$FMI2_HEADERS_DIR"); fi
 
 if [ "$coverage" -eq 1 ]; then
   cov="$build-cov"
@@ -79,7 +77,7 @@ if [ "$coverage" -eq 1 ]; then
   if [ -z "$profdata" ] || [ -z "$llvmcov" ]; then echo "run_fuzz: llvm-profdata/llvm-cov not found" >&2; exit 77; fi
   if [ ! -f "$cov/CMakeCache.txt" ]; then
     CC="$cc" CXX="$cxx" cmake -S "$root" -B "$cov" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPKM_FUZZ=ON \
-      -DPKM_BUILD_TESTS=OFF -DPKM_BUILD_BENCHMARKS=OFF -DPKM_LTO=OFF -DPKM_PLATFORMS=OFF "${fmi_headers[@]}" \
+      -DPKM_BUILD_TESTS=OFF -DPKM_BUILD_BENCHMARKS=OFF -DPKM_LTO=OFF -DPKM_PLATFORMS=OFF \
       -DCMAKE_CXX_FLAGS="-fprofile-instr-generate -fcoverage-mapping" \
       -DCMAKE_EXE_LINKER_FLAGS="-fprofile-instr-generate" >"$cov/configure.log" 2>&1 || {
       cat "$cov/configure.log" >&2; exit 1; }
@@ -93,8 +91,7 @@ if [ "$coverage" -eq 1 ]; then
     tail -30 "$cov/replay.log" >&2; exit 1; }
   "$profdata" merge -sparse "$cov/replay.profraw" -o "$cov/replay.profdata"
   "$llvmcov" report "$cov/fuzz/pkm_fmi_fuzzer" -instr-profile="$cov/replay.profdata" \
-    "$root/fmu_src/fmi/fmi2_cs.cpp" "$root/fmu_src/fmi/fmi2_functions.cpp" "$root/fmu_src/fmi/pkm4puu.cpp" \
-    "$root/fmu_src/fmi/pkm4puu_inverse.cpp" "$root"/fmu_src/core/*.cpp
+    "$root"/src/fmi/*.cpp "$root"/src/models/*/*.cpp "$root"/src/pkm4puu/*/*.cpp
   exit 0
 fi
 if [ ! -f "$build/CMakeCache.txt" ]; then
@@ -104,7 +101,7 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
   CC="$cc" CXX="$cxx" cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPKM_FUZZ=ON \
     -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
-    -DPKM_BUILD_TESTS=OFF -DPKM_BUILD_BENCHMARKS=OFF -DPKM_LTO=OFF -DPKM_PLATFORMS=OFF "${fmi_headers[@]}" \
+    -DPKM_BUILD_TESTS=OFF -DPKM_BUILD_BENCHMARKS=OFF -DPKM_LTO=OFF -DPKM_PLATFORMS=OFF \
     >"$build/configure.log" 2>&1 || { cat "$build/configure.log" >&2; exit 1; }
 fi
 cmake --build "$build" --target pkm_fmi_fuzzer pkm_fmus -j"$(nproc)" >"$build/build.log" 2>&1 || {

@@ -33,7 +33,7 @@ def _built(name: str, what: str):
 
 plant_fmu = _built("PKM4PUU.fmu", "the forward-dynamics plant")
 inverse_fmu = _built("PKM4PUU_Inverse.fmu", "the algebraic inverse dynamics")
-pkm_library = _built("fmu_src/libpkm.so", "the plain C API (pkm.h)")
+pkm_library = _built("lib/libpkm.so", "the plain C API (pkm.h)")
 plant_fmu3 = _built("fmi3/PKM4PUU.fmu", "the plant as FMI 3.0 (Co-Simulation and Model Exchange)")
 inverse_fmu3 = _built("fmi3/PKM4PUU_Inverse.fmu", "the inverse dynamics as FMI 3.0")
 

@@ -162,7 +162,7 @@ def test_kkt_equals_pinocchio_constraint_dynamics():
 
 
 def test_capi_binding_matches_pkm_h():
-    """engines/pkm_capi.py's ctypes structs against fmu_src/capi/pkm.h: the same
+    """engines/pkm_capi.py's ctypes structs against src/pkm4puu/pkm.h: the same
     fields at the same offsets (fields appended to pkm.h later must fit in the
     binding's reserve)."""
     from pkm4puu import capi as pkm_capi

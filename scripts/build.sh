@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing (scripts/setup.sh), then configures and builds
 # everything in build/ (Ninja, Release).
-#   scripts/build.sh [--configure-only]
+#   scripts/build.sh [--configure-only] [-D<cmake option>=<value>...]
 # PKM_SETUP=for-build installs only what the build needs (setup.sh
 # --for-build); PKM_SETUP=none installs nothing (./run_tests.sh).
 set -euo pipefail
@@ -17,6 +17,8 @@ if [ -f build/CMakeCache.txt ] && ! grep -q '^CMAKE_GENERATOR:INTERNAL=Ninja$' b
   echo "build: build/ was not configured with Ninja, reconfiguring" >&2
   rm -rf build/CMakeCache.txt build/CMakeFiles
 fi
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
-if [ "${1:-}" = "--configure-only" ]; then exit 0; fi
+configure_only=0
+if [ "${1:-}" = "--configure-only" ]; then configure_only=1; shift; fi
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release "$@"
+if [ "$configure_only" -eq 1 ]; then exit 0; fi
 cmake --build build -j2

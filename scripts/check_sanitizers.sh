@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 build=build-sanitize
 if [[ "${1:-}" == "--build-dir" ]]; then build="$2"; fi
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPKM_SANITIZE=ON -DPKM_LTO=OFF \
-      -DPKM_BUILD_BENCHMARKS=OFF ${FMI2_HEADERS_DIR:+-DFMI2_HEADERS_DIR=$FMI2_HEADERS_DIR} >/dev/null
+      -DPKM_BUILD_BENCHMARKS=OFF >/dev/null
 targets=(fmi_state_machine fmi_variables fmi_fmu_state fmi_stepping fmi_logging fmi_binary fmi_model_exchange
          fmi_machine fmi_bad_inputs_and_parameters fmi_singularities fmi_threads)
 cmake --build "$build" -j2 --target "${targets[@]}"

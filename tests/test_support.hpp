@@ -10,10 +10,10 @@
 
 #include <gtest/gtest.h>
 
-#include "constraints.hpp"
-#include "model.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
+#include "pkm4puu/model/model.hpp"
 #include "reference_model.hpp"
-#include "servo_kinematics.hpp"
+#include "pkm4puu/kinematics/servo_kinematics.hpp"
 
 namespace pkm_test {
 

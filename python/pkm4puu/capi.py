@@ -1,5 +1,5 @@
-"""ctypes binding of this project's C API (fmu_src/capi/pkm.h), for the
-engine comparisons. The library is <build>/fmu_src/libpkm.so; the build
+"""ctypes binding of this project's C API (src/pkm4puu/pkm.h), for the
+engine comparisons. The library is <build>/lib/libpkm.so; the build
 directory is $PKM_BUILD_DIR (default <repo>/build), as for the FMU checks.
 
     lib = load()                      # or load(path)
@@ -83,7 +83,7 @@ TORQUE_FN = ct.CFUNCTYPE(None, ct.c_void_p, ct.c_double, ct.POINTER(ct.c_double)
 
 
 def library_path(build=None):
-    return (Path(build).resolve() if build else build_dir()) / "fmu_src" / "libpkm.so"
+    return (Path(build).resolve() if build else build_dir()) / "lib" / "libpkm.so"
 
 
 def load(path=None):
@@ -301,7 +301,7 @@ class Model:
 _C_TYPES = {"double": (8, 8), "int": (4, 4), "unsigned": (4, 4)}
 
 
-def header_structs(path=REPO / "fmu_src" / "capi" / "pkm.h"):
+def header_structs(path=REPO / "src" / "pkm4puu" / "pkm.h"):
     """{struct name: [(field name, offset, size)]} for pkm.h's plain structs of
     doubles and ints (C layout rules for x86_64), and their sizes."""
     import re
@@ -326,7 +326,7 @@ def header_structs(path=REPO / "fmu_src" / "capi" / "pkm.h"):
     return out
 
 
-def binding_mismatches(path=REPO / "fmu_src" / "capi" / "pkm.h"):
+def binding_mismatches(path=REPO / "src" / "pkm4puu" / "pkm.h"):
     """Differences between this binding's structs and pkm.h's (empty: they agree).
     pkm.h may have appended fields, as long as they fit in the reserve."""
     structs = header_structs(path)

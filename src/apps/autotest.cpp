@@ -1,4 +1,4 @@
-#include "autotest.hpp"
+#include "apps/autotest.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "inverse_dynamics.hpp"
-#include "plant.hpp"
-#include "trajectory.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
+#include "pkm4puu/sim/plant.hpp"
+#include "apps/trajectory.hpp"
 
 namespace pkm {
 

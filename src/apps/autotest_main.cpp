@@ -13,7 +13,7 @@
 #include <string>
 #include <sys/stat.h>
 
-#include "autotest.hpp"
+#include "apps/autotest.hpp"
 
 namespace {
 

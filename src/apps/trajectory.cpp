@@ -1,4 +1,4 @@
-#include "trajectory.hpp"
+#include "apps/trajectory.hpp"
 
 namespace pkm {
 

@@ -4,7 +4,7 @@
 // and at P1 after t = T.
 #pragma once
 
-#include "types.hpp"
+#include "pkm4puu/base/types.hpp"
 
 namespace pkm {
 

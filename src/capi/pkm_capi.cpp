@@ -1,6 +1,6 @@
 // The C API over the core (pkm.h). Converts arrays and status codes; holds
 // no mathematics of its own.
-#include "pkm.h"
+#include "pkm4puu/pkm.h"
 
 #include <cstdio>
 #include <cstring>
@@ -8,12 +8,12 @@
 #include <new>
 #include <string>
 
-#include "constraints.hpp"
-#include "inverse_dynamics.hpp"
-#include "inverse_dynamics_derivatives.hpp"
-#include "lagrangian.hpp"
-#include "plant.hpp"
-#include "reduced_dynamics_derivatives.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/sim/plant.hpp"
+#include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
 
 struct pkm_model {
   explicit pkm_model(const pkm::Model& m) : plant(m) {}

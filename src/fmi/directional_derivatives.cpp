@@ -7,9 +7,9 @@
 // the rest (ModelData::partial_derivatives) and applies the seed.
 #include <cmath>
 
-#include "instance.hpp"
-#include "model_description.hpp"
-#include "state_machine.hpp"
+#include "fmi/instance.hpp"
+#include "fmi/model_description.hpp"
+#include "fmi/state_machine.hpp"
 
 namespace pkm_fmi {
 namespace {

@@ -8,12 +8,15 @@
 #include <string>
 
 #include "fmi2Functions.h"
-#include "instance.hpp"
-#include "models.hpp"
+#include "fmi/instance.hpp"
 
 #ifndef PKM_FMI_DEFINITION
-#error "PKM_FMI_DEFINITION must name the model's definition, e.g. pkm_fmi::pkm4puu_definition"
+#error "PKM_FMI_DEFINITION must name the model's definition, a function in namespace pkm_fmi"
 #endif
+
+namespace pkm_fmi {
+const ModelDefinition& PKM_FMI_DEFINITION();
+}
 
 // In-process builds of several FMUs into one program (the fuzzer): every
 // function is named <prefix>fmi2Xxx. fmi2Functions.h fixes fmi2FullName to
@@ -30,7 +33,7 @@ using pkm_fmi::Status;
 
 namespace {
 
-const pkm_fmi::ModelDefinition& definition() { return PKM_FMI_DEFINITION(); }
+const pkm_fmi::ModelDefinition& definition() { return pkm_fmi::PKM_FMI_DEFINITION(); }
 
 fmi2Status to_fmi2(Status s) { return static_cast<fmi2Status>(static_cast<int>(s)); }
 

@@ -11,12 +11,15 @@
 #define FMI3_FUNCTION_PREFIX PKM_FMI_FUNCTION_PREFIX
 #endif
 #include "fmi3Functions.h"
-#include "instance.hpp"
-#include "models.hpp"
+#include "fmi/instance.hpp"
 
 #ifndef PKM_FMI_DEFINITION
-#error "PKM_FMI_DEFINITION must name the model's definition, e.g. pkm_fmi::pkm4puu_definition"
+#error "PKM_FMI_DEFINITION must name the model's definition, a function in namespace pkm_fmi"
 #endif
+
+namespace pkm_fmi {
+const ModelDefinition& PKM_FMI_DEFINITION();
+}
 
 using pkm_fmi::Instance;
 using pkm_fmi::Interface;
@@ -24,7 +27,7 @@ using pkm_fmi::Status;
 
 namespace {
 
-const pkm_fmi::ModelDefinition& definition() { return PKM_FMI_DEFINITION(); }
+const pkm_fmi::ModelDefinition& definition() { return pkm_fmi::PKM_FMI_DEFINITION(); }
 
 fmi3Status to_fmi3(Status s) { return static_cast<fmi3Status>(static_cast<int>(s)); }
 

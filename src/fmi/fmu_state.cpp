@@ -1,13 +1,13 @@
-#include "fmu_state.hpp"
+#include "fmi/fmu_state.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <memory>
 
-#include "fnv1a.hpp"
-#include "instance.hpp"
-#include "state_machine.hpp"
+#include "fmi/fnv1a.hpp"
+#include "fmi/instance.hpp"
+#include "fmi/state_machine.hpp"
 
 namespace pkm_fmi {
 namespace {

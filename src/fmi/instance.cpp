@@ -1,11 +1,11 @@
-#include "instance.hpp"
+#include "fmi/instance.hpp"
 
 #include <cmath>
 #include <cstring>
 #include <utility>
 
-#include "fmu_state.hpp"
-#include "state_machine.hpp"
+#include "fmi/fmu_state.hpp"
+#include "fmi/state_machine.hpp"
 
 namespace pkm_fmi {
 namespace {

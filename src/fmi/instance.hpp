@@ -29,10 +29,10 @@
 #include <unordered_set>
 #include <vector>
 
-#include "fmi_status.hpp"
-#include "logger.hpp"
-#include "model_data.hpp"
-#include "variables.hpp"
+#include "fmi/fmi_status.hpp"
+#include "fmi/logger.hpp"
+#include "fmi/model_data.hpp"
+#include "fmi/variables.hpp"
 
 /// The name of an FMI function in this instance's version, for messages
 /// (inside Instance methods): PKM_FN(DoStep) is "fmi2DoStep" or "fmi3DoStep".

@@ -1,4 +1,4 @@
-#include "logger.hpp"
+#include "fmi/logger.hpp"
 
 #include <cstdio>
 #include <cstring>

@@ -27,7 +27,7 @@
 #include <cstdarg>
 #include <string>
 
-#include "fmi_status.hpp"
+#include "fmi/fmi_status.hpp"
 
 namespace pkm_fmi {
 

@@ -7,9 +7,9 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "fmi_status.hpp"
-#include "logger.hpp"
-#include "state_bytes.hpp"
+#include "fmi/fmi_status.hpp"
+#include "fmi/logger.hpp"
+#include "fmi/state_bytes.hpp"
 
 namespace pkm_fmi {
 

@@ -1,4 +1,4 @@
-#include "model_description.hpp"
+#include "fmi/model_description.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -7,7 +7,7 @@
 #include <map>
 #include <set>
 
-#include "logger.hpp"
+#include "fmi/logger.hpp"
 
 namespace pkm_fmi {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "variables.hpp"
+#include "fmi/variables.hpp"
 
 namespace pkm_fmi {
 

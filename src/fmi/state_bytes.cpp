@@ -1,4 +1,4 @@
-#include "state_bytes.hpp"
+#include "fmi/state_bytes.hpp"
 
 #include <cstring>
 

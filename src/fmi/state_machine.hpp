@@ -2,7 +2,7 @@
 // machines, merged: ME and CS states are distinct bits), in one place.
 #pragma once
 
-#include "instance.hpp"
+#include "fmi/instance.hpp"
 
 namespace pkm_fmi {
 

@@ -2,8 +2,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "instance.hpp"
-#include "state_machine.hpp"
+#include "fmi/instance.hpp"
+#include "fmi/state_machine.hpp"
 
 namespace pkm_fmi {
 

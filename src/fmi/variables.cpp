@@ -1,12 +1,12 @@
-#include "variables.hpp"
+#include "fmi/variables.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <string>
 
-#include "fmi_status.hpp"
-#include "fnv1a.hpp"
+#include "fmi/fmi_status.hpp"
+#include "fmi/fnv1a.hpp"
 
 namespace pkm_fmi {
 

@@ -1,7 +1,7 @@
 // The two FMUs of the project (MODEL_SPEC "FMU interface contract").
 #pragma once
 
-#include "variables.hpp"
+#include "fmi/variables.hpp"
 
 namespace pkm_fmi {
 

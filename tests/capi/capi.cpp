@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pkm.h"
+#include "pkm4puu/pkm.h"
 
 namespace {
 

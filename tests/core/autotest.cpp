@@ -3,7 +3,7 @@
 // loop over the full 2 s, reproduce the prescribed path.
 #include <cmath>
 
-#include "autotest.hpp"
+#include "apps/autotest.hpp"
 #include "test_support.hpp"
 
 using namespace pkm_test;

@@ -6,13 +6,13 @@
 // with nonzero rates and every machine term on, and with an end stop pushing.
 #include <cstdio>
 
-#include "inverse_dynamics.hpp"
-#include "inverse_dynamics_derivatives.hpp"
-#include "lagrangian.hpp"
-#include "machine.hpp"
-#include "minimal_state.hpp"
-#include "reduced_dynamics_derivatives.hpp"
-#include "rk4.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/dynamics/state_derivative.hpp"
+#include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
+#include "pkm4puu/integrators/rk4.hpp"
 #include "test_support.hpp"
 
 using namespace pkm_test;

@@ -1,8 +1,8 @@
 // The Lagrangian terms of Eq. 1 against the independent reference model:
 // M as the Hessian of the kinetic energy in qd, V and G from finite
 // differences of the Lagrangian (Eq. 14), plus the spec's static check.
-#include "inverse_dynamics.hpp"
-#include "lagrangian.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
 #include "test_support.hpp"
 
 using namespace pkm_test;

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <vector>
 
-#include "inverse_dynamics.hpp"
-#include "lagrangian.hpp"
-#include "plant.hpp"
-#include "reduced_dynamics.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/sim/plant.hpp"
+#include "pkm4puu/dynamics/reduced_dynamics.hpp"
 #include "test_support.hpp"
 
 using namespace pkm_test;

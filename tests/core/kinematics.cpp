@@ -5,7 +5,7 @@
 
 #include "reference_model.hpp"
 #include "test_support.hpp"
-#include "trajectory.hpp"
+#include "apps/trajectory.hpp"
 
 using namespace pkm_test;
 

@@ -24,10 +24,10 @@
 
 #include <gtest/gtest.h>
 
-#include "constraints.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
 #include "hardening_table.hpp"
-#include "lagrangian.hpp"
-#include "plant.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/sim/plant.hpp"
 
 namespace {
 

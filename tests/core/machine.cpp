@@ -8,11 +8,11 @@
 #include <cstdio>
 #include <vector>
 
-#include "autotest.hpp"
-#include "inverse_dynamics.hpp"
-#include "lagrangian.hpp"
-#include "machine.hpp"
-#include "plant.hpp"
+#include "apps/autotest.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/sim/plant.hpp"
 #include "reference_model.hpp"
 #include "test_support.hpp"
 
@@ -492,7 +492,7 @@ TEST(MachineStops, IndicatorsAndStopForcesAtAnArbitraryState) {
 // The C API (pkm.h)
 // ---------------------------------------------------------------------------
 
-#include "pkm.h"
+#include "pkm4puu/pkm.h"
 
 TEST(MachineCApi, ParametersInputsAndOutputs) {
   pkm_params p;

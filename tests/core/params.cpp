@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "model.hpp"
+#include "pkm4puu/model/model.hpp"
 
 using namespace pkm;
 

@@ -29,7 +29,7 @@
 #include <gtest/gtest.h>
 
 #include "fmu_loader.hpp"
-#include "trajectory.hpp"
+#include "apps/trajectory.hpp"
 
 namespace {
 

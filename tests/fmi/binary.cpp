@@ -10,9 +10,9 @@
 #include <gtest/gtest.h>
 
 #include "fmi2FunctionTypes.h"
-#include "fmi_functions.h"
+#include "fmi/fmi_functions.h"
 #include "fmu_fixture.hpp"
-#include "models.hpp"
+#include "models/models.hpp"
 
 namespace {
 
@@ -58,7 +58,7 @@ TEST(FmuBinaries, ExportExactlyTheListedFmiFunctions) {
     if (!tool_lines("nm -D --defined-only", so, lines, &out)) GTEST_SKIP() << "nm not available: " << out;
     std::set<std::string> exported;
     for (const std::string& line : lines) exported.insert(line.substr(line.rfind(' ') + 1));
-    EXPECT_EQ(exported, listed) << so;  // fmu_src/fmi/fmi_functions.h: 44 of FMI 2.0, 75 of FMI 3.0
+    EXPECT_EQ(exported, listed) << so;  // src/fmi/fmi_functions.h: 44 of FMI 2.0, 75 of FMI 3.0
     EXPECT_EQ(exported.size(), 119u);
   }
 }

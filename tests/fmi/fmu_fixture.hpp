@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "fmu_loader.hpp"
-#include "fnv1a.hpp"
+#include "fmi/fnv1a.hpp"
 #include "hardening_table.hpp"
 
 namespace pkm_test {

@@ -31,8 +31,8 @@
 #include <gtest/gtest.h>
 
 #include "fmi2FunctionTypes.h"
-#include "fmi_functions.h"
-#include "models.hpp"
+#include "fmi/fmi_functions.h"
+#include "models/models.hpp"
 
 // The instantiation tokens (GUIDs): hashes of the variable tables, as in the model descriptions.
 #define PKM_FMU_PLANT_GUID (pkm_fmi::pkm4puu_definition().guid().c_str())

@@ -16,7 +16,7 @@
 
 #include "fmi2FunctionTypes.h"
 #include "fmu_fixture.hpp"
-#include "models.hpp"
+#include "models/models.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// The interface as the variable tables declare it (fmu_src/fmi), from which
+// The interface as the variable tables declare it (src/models/<id>), from which
 // every modelDescription.xml is generated (the ctest
 // model_descriptions_up_to_date checks that the committed files are those):
 // every name of MODEL_SPEC's "FMU interface contract", start values equal to
@@ -15,11 +15,11 @@
 
 #include <gtest/gtest.h>
 
-#include "instance.hpp"
-#include "model_description.hpp"
-#include "models.hpp"
-#include "params.hpp"
-#include "plant.hpp"
+#include "fmi/instance.hpp"
+#include "fmi/model_description.hpp"
+#include "models/models.hpp"
+#include "pkm4puu/model/params.hpp"
+#include "pkm4puu/sim/plant.hpp"
 
 namespace {
 

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "autotest.hpp"
+#include "apps/autotest.hpp"
 #include "fmu_loader.hpp"
 #include "test_support.hpp"
 

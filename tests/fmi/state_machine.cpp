@@ -20,7 +20,7 @@
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
 #include "fmu_fixture.hpp"
-#include "models.hpp"
+#include "models/models.hpp"
 
 namespace {
 

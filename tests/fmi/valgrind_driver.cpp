@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "fmi2FunctionTypes.h"
-#include "models.hpp"
-#include "trajectory.hpp"
+#include "models/models.hpp"
+#include "apps/trajectory.hpp"
 
 namespace {
 

@@ -753,7 +753,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(prog=prog, description="Validation against Pinocchio and MuJoCo models of the "
                                  "same mechanism (inverse dynamics along the auto-test, the comparison test).")
     ap.add_argument("--build", type=Path, default=REPO / "build",
-                    help="build directory holding fmu_src/libpkm.so and the FMUs (default: %(default)s)")
+                    help="build directory holding lib/libpkm.so and the FMUs (default: %(default)s)")
     ap.add_argument("--out", type=Path, default=REPO / "results",
                     help="directory for the CSV and PNG files (default: %(default)s)")
     ap.add_argument("--no-sweep", action="store_true", help="skip the table of MuJoCo constraint settings")

@@ -47,13 +47,13 @@
 #include <iterator>
 #include <memory>
 
-#include "constraints.hpp"
-#include "reduced_dynamics_derivatives.hpp"
-#include "machine.hpp"
-#include "mechanism_parameters.hpp"
-#include "models.hpp"
-#include "plant.hpp"
-#include "workspace_guard.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
+#include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
+#include "pkm4puu/machine/machine.hpp"
+#include "models/common/mechanism_parameters.hpp"
+#include "models/models.hpp"
+#include "pkm4puu/sim/plant.hpp"
+#include "pkm4puu/kinematics/workspace_guard.hpp"
 
 namespace pkm_fmi {
 namespace {

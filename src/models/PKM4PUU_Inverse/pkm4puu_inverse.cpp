@@ -29,12 +29,12 @@
 #include <iterator>
 #include <memory>
 
-#include "constraints.hpp"
-#include "inverse_dynamics.hpp"
-#include "inverse_dynamics_derivatives.hpp"
-#include "mechanism_parameters.hpp"
-#include "models.hpp"
-#include "workspace_guard.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
+#include "models/common/mechanism_parameters.hpp"
+#include "models/models.hpp"
+#include "pkm4puu/kinematics/workspace_guard.hpp"
 
 namespace pkm_fmi {
 namespace {

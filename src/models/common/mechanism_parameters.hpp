@@ -4,11 +4,11 @@
 // with the core's defaults as start values.
 #pragma once
 
-#include "model_data.hpp"
-#include "variables.hpp"
-#include "param_ranges.hpp"
-#include "params.hpp"
-#include "workspace_guard.hpp"
+#include "fmi/model_data.hpp"
+#include "fmi/variables.hpp"
+#include "pkm4puu/model/param_ranges.hpp"
+#include "pkm4puu/model/params.hpp"
+#include "pkm4puu/kinematics/workspace_guard.hpp"
 
 namespace pkm_fmi {
 

@@ -1,4 +1,4 @@
-#include "status.hpp"
+#include "pkm4puu/base/status.hpp"
 
 namespace pkm {
 

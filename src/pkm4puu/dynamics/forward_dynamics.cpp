@@ -1,11 +1,11 @@
-#include "forward_dynamics.hpp"
+#include "pkm4puu/dynamics/forward_dynamics.hpp"
 
 #include <cmath>
 
-#include "constraints.hpp"
-#include "lagrangian.hpp"
-#include "reduced_dynamics.hpp"
-#include "small_dense.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/dynamics/reduced_dynamics.hpp"
+#include "pkm4puu/base/small_dense.hpp"
 
 namespace pkm {
 namespace {

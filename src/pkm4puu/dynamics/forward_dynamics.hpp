@@ -3,7 +3,7 @@
 //   M qdd + V + G + C_q^T lambda = f,   C_q qdd + gamma = 0.
 #pragma once
 
-#include "model.hpp"
+#include "pkm4puu/model/model.hpp"
 
 namespace pkm {
 

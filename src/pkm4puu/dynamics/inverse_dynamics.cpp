@@ -1,8 +1,8 @@
-#include "inverse_dynamics.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
 
-#include "constraints.hpp"
-#include "lagrangian.hpp"
-#include "machine.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/machine/machine.hpp"
 
 namespace pkm {
 namespace {

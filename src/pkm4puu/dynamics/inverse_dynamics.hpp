@@ -5,7 +5,7 @@
 // (Eq. 10); the 4 rows of rho_i then give F (Eq. 11).
 #pragma once
 
-#include "servo_kinematics.hpp"
+#include "pkm4puu/kinematics/servo_kinematics.hpp"
 
 namespace pkm {
 

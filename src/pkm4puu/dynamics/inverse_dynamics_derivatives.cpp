@@ -1,9 +1,9 @@
-#include "inverse_dynamics_derivatives.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
 
-#include "lagrangian.hpp"
-#include "machine.hpp"
-#include "minimal_state.hpp"
-#include "reduced_dynamics_derivatives.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/dynamics/state_derivative.hpp"
+#include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
 
 namespace pkm {
 

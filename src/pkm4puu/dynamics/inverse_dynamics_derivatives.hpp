@@ -9,7 +9,7 @@
 // and, beyond a stop, the stop's force.
 #pragma once
 
-#include "model.hpp"
+#include "pkm4puu/model/model.hpp"
 
 namespace pkm {
 

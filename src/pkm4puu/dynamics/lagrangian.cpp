@@ -1,9 +1,9 @@
-#include "lagrangian.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
 
 #include <cmath>
 
-#include "constraints.hpp"
-#include "machine.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
+#include "pkm4puu/machine/machine.hpp"
 
 namespace pkm {
 LegMassSlopes leg_mass_slopes(const Params& p, const LegConfig& c) {

@@ -20,7 +20,7 @@
 //             m_r l/2 c2       0                                    m_r l^2/4 + Iz ]
 #pragma once
 
-#include "leg_kinematics.hpp"
+#include "pkm4puu/kinematics/leg_kinematics.hpp"
 
 namespace pkm {
 

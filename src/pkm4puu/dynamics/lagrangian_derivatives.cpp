@@ -1,6 +1,6 @@
-#include "lagrangian_derivatives.hpp"
+#include "pkm4puu/dynamics/lagrangian_derivatives.hpp"
 
-#include "lagrangian.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
 
 namespace pkm {
 

@@ -11,7 +11,7 @@
 // (machine.hpp, passive_joint_force_slopes).
 #pragma once
 
-#include "leg_kinematics.hpp"
+#include "pkm4puu/kinematics/leg_kinematics.hpp"
 
 namespace pkm {
 

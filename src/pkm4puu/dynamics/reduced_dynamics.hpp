@@ -12,7 +12,7 @@
 
 #include <array>
 
-#include "leg_kinematics.hpp"
+#include "pkm4puu/kinematics/leg_kinematics.hpp"
 
 namespace pkm {
 

@@ -1,10 +1,10 @@
-#include "reduced_dynamics_derivatives.hpp"
+#include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
 
-#include "lagrangian.hpp"
-#include "lagrangian_derivatives.hpp"
-#include "leg_kinematics_derivatives.hpp"
-#include "machine.hpp"
-#include "minimal_state.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/dynamics/lagrangian_derivatives.hpp"
+#include "pkm4puu/kinematics/leg_kinematics_derivatives.hpp"
+#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/dynamics/state_derivative.hpp"
 
 namespace pkm {
 namespace {

@@ -30,7 +30,7 @@
 //   dw_p/dphid = (-2 mwx phid, -2 mwy phid, 0, 0)
 #pragma once
 
-#include "reduced_dynamics.hpp"
+#include "pkm4puu/dynamics/reduced_dynamics.hpp"
 
 namespace pkm {
 
@@ -42,7 +42,7 @@ struct ResidualPartials {
   Mat4 drhod_dp = Mat4::Zero();  // d rhod/dp (row i = the rho row of d qd_i/dp); d rhod/dpd = J_rho
 };
 
-/// The partials at the reduced terms `rd` (reduced_terms, minimal_state.hpp:
+/// The partials at the reduced terms `rd` (reduced_terms, state_derivative.hpp:
 /// every leg prepared and added with its applied and passive forces),
 /// rates pd, accelerations pdd. `F_extra` is an actuator force not yet
 /// in rd (inverse dynamics: the unknown F), zero otherwise. `stops` as in

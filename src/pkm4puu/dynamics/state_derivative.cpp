@@ -1,9 +1,9 @@
-#include "minimal_state.hpp"
+#include "pkm4puu/dynamics/state_derivative.hpp"
 
-#include "constraints.hpp"
-#include "machine.hpp"
-#include "reduced_dynamics.hpp"
-#include "servo_kinematics.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
+#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/dynamics/reduced_dynamics.hpp"
+#include "pkm4puu/kinematics/servo_kinematics.hpp"
 
 namespace pkm {
 

@@ -11,7 +11,7 @@
 // at rounding level (~1e-17 m) over any run length.
 #pragma once
 
-#include "forward_dynamics.hpp"
+#include "pkm4puu/dynamics/forward_dynamics.hpp"
 
 namespace pkm {
 

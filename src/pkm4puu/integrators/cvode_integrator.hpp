@@ -1,5 +1,5 @@
 // SUNDIALS CVODE (variable-order, variable-step Adams or BDF) on the
-// plant's integrated vector: the 8-dimensional state of minimal_state.hpp
+// plant's integrated vector: the 8-dimensional state of state_derivative.hpp
 // and the two running energy integrals (plant.hpp). Optional root finding
 // (the end stops' event indicators). All SUNDIALS objects are created once
 // in init(); advancing allocates nothing.
@@ -7,8 +7,8 @@
 
 #include <string>
 
-#include "status.hpp"
-#include "types.hpp"
+#include "pkm4puu/base/status.hpp"
+#include "pkm4puu/base/types.hpp"
 
 // SUNDIALS handle types, declared here so its headers stay in the .cpp.
 struct _SUNContext;

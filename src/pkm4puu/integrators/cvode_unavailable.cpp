@@ -3,7 +3,7 @@
 // C++17 compiler. cvode_available() is false, so the solver settings refuse
 // solver = 0 before anything is integrated (plant.cpp, validate); should
 // anything call in regardless, every call fails with that reason.
-#include "cvode_integrator.hpp"
+#include "pkm4puu/integrators/cvode_integrator.hpp"
 
 namespace pkm {
 

@@ -1,8 +1,8 @@
 // Classical fixed-step Runge-Kutta (4th order), the paper's integrator.
 #pragma once
 
-#include "status.hpp"
-#include "types.hpp"
+#include "pkm4puu/base/status.hpp"
+#include "pkm4puu/base/types.hpp"
 
 namespace pkm {
 

@@ -1,4 +1,4 @@
-#include "constraints.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
 
 #include <cmath>
 #include <limits>

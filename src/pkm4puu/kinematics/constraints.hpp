@@ -2,7 +2,7 @@
 // the 4x4 actuator Jacobian. Full-size forms, as in the paper.
 #pragma once
 
-#include "leg_kinematics.hpp"
+#include "pkm4puu/kinematics/leg_kinematics.hpp"
 
 namespace pkm {
 

@@ -1,4 +1,4 @@
-#include "leg_kinematics.hpp"
+#include "pkm4puu/kinematics/leg_kinematics.hpp"
 
 #include <cmath>
 

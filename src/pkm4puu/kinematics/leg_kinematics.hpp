@@ -2,7 +2,7 @@
 // Table I, standard DH). Everything here is per leg and allocation free.
 #pragma once
 
-#include "model.hpp"
+#include "pkm4puu/model/model.hpp"
 
 namespace pkm {
 

@@ -11,7 +11,7 @@
 //   T(v) = d H(v, v)/dq  (H(v, v) = leg_point_quadratic)
 #pragma once
 
-#include "leg_kinematics.hpp"
+#include "pkm4puu/kinematics/leg_kinematics.hpp"
 
 namespace pkm {
 

@@ -1,8 +1,8 @@
-#include "servo_kinematics.hpp"
+#include "pkm4puu/kinematics/servo_kinematics.hpp"
 
 #include <cmath>
 
-#include "constraints.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
 
 namespace pkm {
 Status ServoJacobian::factor(const Model& m, const Vec16& q) {

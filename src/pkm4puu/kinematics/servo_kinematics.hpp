@@ -7,7 +7,7 @@
 //   acceleration: Phi_q qdd = [-gamma; pose_dd],       Eqs. 7-9
 #pragma once
 
-#include "model.hpp"
+#include "pkm4puu/model/model.hpp"
 
 namespace pkm {
 

@@ -1,11 +1,11 @@
-#include "workspace_guard.hpp"
+#include "pkm4puu/kinematics/workspace_guard.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
-#include "constraints.hpp"
-#include "leg_kinematics.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
+#include "pkm4puu/kinematics/leg_kinematics.hpp"
 
 namespace pkm {
 namespace {

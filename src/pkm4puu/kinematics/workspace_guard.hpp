@@ -13,7 +13,7 @@
 
 #include <string>
 
-#include "leg_kinematics.hpp"
+#include "pkm4puu/kinematics/leg_kinematics.hpp"
 
 namespace pkm {
 

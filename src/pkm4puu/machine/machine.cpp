@@ -1,6 +1,6 @@
-#include "machine.hpp"
+#include "pkm4puu/machine/machine.hpp"
 
-#include "leg_kinematics.hpp"
+#include "pkm4puu/kinematics/leg_kinematics.hpp"
 
 namespace pkm {
 

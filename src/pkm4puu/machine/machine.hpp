@@ -20,7 +20,7 @@
 
 #include <cmath>
 
-#include "model.hpp"
+#include "pkm4puu/model/model.hpp"
 
 namespace pkm {
 

@@ -1,8 +1,8 @@
-#include "model.hpp"
+#include "pkm4puu/model/model.hpp"
 
 #include <cmath>
 
-#include "lanes.hpp"
+#include "pkm4puu/base/lanes.hpp"
 
 namespace pkm {
 

@@ -6,9 +6,9 @@
 #include <array>
 #include <string>
 
-#include "params.hpp"
-#include "status.hpp"
-#include "types.hpp"
+#include "pkm4puu/model/params.hpp"
+#include "pkm4puu/base/status.hpp"
+#include "pkm4puu/base/types.hpp"
 
 namespace pkm {
 

@@ -5,7 +5,7 @@
 
 #include <string_view>
 
-#include "params.hpp"
+#include "pkm4puu/model/params.hpp"
 
 namespace pkm {
 

@@ -1,6 +1,6 @@
-#include "params.hpp"
+#include "pkm4puu/model/params.hpp"
 
-#include "param_ranges.hpp"
+#include "pkm4puu/model/param_ranges.hpp"
 
 #include <cmath>
 #include <cstdio>

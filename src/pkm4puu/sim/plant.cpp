@@ -1,15 +1,15 @@
-#include "plant.hpp"
+#include "pkm4puu/sim/plant.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
-#include "constraints.hpp"
-#include "inverse_dynamics.hpp"
-#include "lagrangian.hpp"
-#include "rk4.hpp"
-#include "servo_kinematics.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/integrators/rk4.hpp"
+#include "pkm4puu/kinematics/servo_kinematics.hpp"
 
 namespace pkm {
 namespace {

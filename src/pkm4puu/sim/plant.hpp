@@ -5,10 +5,10 @@
 
 #include <string>
 
-#include "cvode_integrator.hpp"
-#include "machine.hpp"
-#include "minimal_state.hpp"
-#include "workspace_guard.hpp"
+#include "pkm4puu/integrators/cvode_integrator.hpp"
+#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/dynamics/state_derivative.hpp"
+#include "pkm4puu/kinematics/workspace_guard.hpp"
 
 namespace pkm {
 

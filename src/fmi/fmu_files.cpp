@@ -1,14 +1,23 @@
-// Build tool: writes an FMU's documentation/index.html from its variable
-// table, so that the page always lists the variables the binary has.
-//   pkm_fmu_doc <modelIdentifier> <output.html>
+// Build tool, compiled per FMU with PKM_FMI_DEFINITION naming its model:
+// writes the files an archive ships from the model's variable table, so
+// that they always describe the binary.
+//   <tool> <modelIdentifier> <output.html>   documentation/index.html
+//   <tool> --xml <directory>                 <directory>/fmi2/<id>.xml and fmi3/<id>.xml
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <string>
 
-#include "model_description.hpp"
-#include "models.hpp"
+#include "fmi/model_description.hpp"
+
+#ifndef PKM_FMI_DEFINITION
+#error "PKM_FMI_DEFINITION must name the model's definition (a function in namespace pkm_fmi)"
+#endif
+
+namespace pkm_fmi {
+const ModelDefinition& PKM_FMI_DEFINITION();
+}
 
 namespace {
 
@@ -30,19 +39,32 @@ void section(std::ofstream& out, const pkm_fmi::ModelDefinition& def, pkm_fmi::C
   out << "</table>\n";
 }
 
+/// The model descriptions of both FMI versions into <dir>/fmi<v>/<id>.xml.
+int write_model_descriptions(const char* prog, const pkm_fmi::ModelDefinition& def, const std::string& dir) {
+  for (int version : {2, 3}) {
+    const std::string path = dir + "/fmi" + std::to_string(version) + "/" + def.identifier + ".xml";
+    std::ofstream out(path, std::ios::binary);
+    out << pkm_fmi::model_description_xml(def, version);
+    out.close();
+    if (!out) {
+      std::fprintf(stderr, "%s: cannot write %s (does the directory exist?)\n", prog, path.c_str());
+      return 1;
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  const pkm_fmi::ModelDefinition* def = &pkm_fmi::PKM_FMI_DEFINITION();
+  if (argc == 3 && std::strcmp(argv[1], "--xml") == 0) return write_model_descriptions(argv[0], *def, argv[2]);
   if (argc != 3) {
-    std::fprintf(stderr, "usage: %s <modelIdentifier> <output.html>\n", argv[0]);
+    std::fprintf(stderr, "usage: %s %s <output.html> | --xml <directory>\n", argv[0], def->identifier);
     return 2;
   }
-  const pkm_fmi::ModelDefinition* defs[] = {&pkm_fmi::pkm4puu_definition(), &pkm_fmi::pkm4puu_inverse_definition()};
-  const pkm_fmi::ModelDefinition* def = nullptr;
-  for (const auto* d : defs)
-    if (std::strcmp(d->identifier, argv[1]) == 0) def = d;
-  if (!def) {
-    std::fprintf(stderr, "%s: unknown model %s\n", argv[0], argv[1]);
+  if (std::strcmp(def->identifier, argv[1]) != 0) {
+    std::fprintf(stderr, "%s: this tool writes %s, not %s\n", argv[0], def->identifier, argv[1]);
     return 2;
   }
   std::ofstream out(argv[2]);
