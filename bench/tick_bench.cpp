@@ -34,7 +34,7 @@
 
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
-#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/machine/passive_force.hpp"
 #include "pkm4puu/dynamics/state_derivative.hpp"
 #include "pkm4puu/sim/plant.hpp"
 

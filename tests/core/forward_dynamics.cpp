@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "pkm4puu/kinematics/actuator_positions.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
 #include "pkm4puu/sim/plant.hpp"

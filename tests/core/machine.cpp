@@ -11,7 +11,7 @@
 #include "apps/autotest.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
-#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/machine/end_stops.hpp"
 #include "pkm4puu/sim/plant.hpp"
 #include "reference_model.hpp"
 #include "test_support.hpp"

@@ -49,7 +49,8 @@
 
 #include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
-#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/machine/passive_force.hpp"
+#include "pkm4puu/kinematics/actuator_positions.hpp"
 #include "models/common/mechanism_parameters.hpp"
 #include "models/models.hpp"
 #include "pkm4puu/sim/plant.hpp"
@@ -108,9 +109,9 @@ struct PlantData final : MechanismData {
   double energy[2] = {};  // actuator_work, dissipated_energy (states)
   double dy[kStates] = {};  // der(x) .. der(dphi), der(actuator_work), der(dissipated_energy)
   double z[kIndicators] = {};  // the event indicators: guards, then end stops
-  // Model Exchange: which end-stop indicators were negative at the last
-  // event (bit k: indicator k), to log contacts and releases.
-  unsigned stops_beyond = 0;
+  // Model Exchange: the stops passed at the last event (end_stops.hpp's
+  // contact mode), to log contacts and releases.
+  unsigned logged_stops = 0;
   // Co-Simulation: end-stop events located so far (logged per step).
   long contact_events = 0;
   // Co-Simulation: the inputs at the end of the last step and whether CVODE
@@ -158,8 +159,8 @@ struct PlantData final : MechanismData {
   /// The plant, built from the current parameters in initialisation mode.
   Status ready(Context& ctx, const char* function);
   pkm::LinearInputs inputs(double t0) const;
-  /// The end-stop indicators that are negative now (bit k: indicator k).
-  unsigned beyond_stops() const;
+  /// The stops passed now (end_stops.hpp's contact mode; bit k: indicator k < 0).
+  unsigned stops_passed_now() const;
   /// Logs (logEvents) each stop passed or left since the last call.
   void log_stop_changes(Context& ctx, unsigned now, const char* where);
 };
@@ -228,22 +229,19 @@ Status PlantData::build(Context& ctx, const char* function) {
   }
   plant = std::move(p);
   contact_events = plant->contact_events();
-  stops_beyond = beyond_stops();
+  logged_stops = stops_passed_now();
   may_continue = false;
   return Status::OK;
 }
 
-unsigned PlantData::beyond_stops() const {
-  double g[pkm::kStopIndicators];
-  unsigned mask = 0;
-  if (pkm::stop_indicators(plant->model(), plant->state().head<4>(), g) != pkm::Status::Ok) return mask;
-  for (int k = 0; k < pkm::kStopIndicators; ++k)
-    if (g[k] < 0.0) mask |= 1u << k;
-  return mask;
+unsigned PlantData::stops_passed_now() const {
+  pkm::Vec4 rho;
+  if (plant->actuator_positions(rho) != pkm::Status::Ok) return 0;
+  return pkm::stops_passed(plant->model().p, rho);
 }
 
 void PlantData::log_stop_changes(Context& ctx, unsigned now, const char* where) {
-  const unsigned changed = now ^ stops_beyond;
+  const unsigned changed = now ^ logged_stops;
   for (int k = 0; k < pkm::kStopIndicators; ++k) {
     if (!(changed & (1u << k))) continue;
     const bool lower = k < 4;
@@ -251,7 +249,7 @@ void PlantData::log_stop_changes(Context& ctx, unsigned now, const char* where) 
                   (now & (1u << k)) ? "passes" : "leaves", lower ? "lower" : "upper", lower ? "rho_min" : "rho_max",
                   lower ? plant->model().p.rho_min : plant->model().p.rho_max);
   }
-  stops_beyond = now;
+  logged_stops = now;
 }
 
 pkm::LinearInputs PlantData::inputs(double t0) const {
@@ -308,7 +306,7 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
   if (plant->contact_events() != contact_events) {
     contact_events = plant->contact_events();
     // Also with logEvents off: the record of the stops passed stays current.
-    log_stop_changes(ctx, beyond_stops(), "DoStep");
+    log_stop_changes(ctx, stops_passed_now(), "DoStep");
   }
   switch (s) {
     case pkm::Status::Ok:
@@ -389,7 +387,7 @@ Status PlantData::update_outputs(Context& ctx, unsigned groups) {
   }
   if (groups & kGroupSliders) {
     pkm::Vec4 r;
-    const pkm::Status s = plant->slider_positions(r);
+    const pkm::Status s = plant->actuator_positions(r);
     if (s != pkm::Status::Ok) {
       return cannot_assemble(s);
     }
@@ -614,7 +612,7 @@ void PlantData::save(StateWriter& w) const {
   w.f64s(plant->theta1_ref().data(), plant->theta1_ref().data() + 4);
   w.f64(plant->energy_integrals().actuator_work);
   w.f64(plant->energy_integrals().dissipated);
-  w.u32(stops_beyond);
+  w.u32(logged_stops);
 }
 
 bool PlantData::load(StateReader& r, Context& ctx) {
@@ -651,7 +649,7 @@ bool PlantData::load(StateReader& r, Context& ctx) {
   }
   if (fresh) plant = std::move(fresh);
   contact_events = plant->contact_events();  // the count continues from here
-  stops_beyond = beyond;
+  logged_stops = beyond;
   may_continue = false;  // the integrator restarts here, as the original run does after saving
   return true;
 }

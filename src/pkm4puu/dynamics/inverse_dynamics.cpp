@@ -2,7 +2,7 @@
 
 #include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
-#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/machine/passive_force.hpp"
 
 namespace pkm {
 namespace {
@@ -48,16 +48,6 @@ Status actuator_forces(const Model& m, const Vec16& q, const Vec16& qd, const Ve
   return forces(m, q, qd, qdd, we, /*passive=*/true, F, lambda);
 }
 
-unsigned joints_beyond_stops(const Params& p, const Vec16& q) {
-  unsigned mask = 0;
-  for (int i = 0; i < kLegs; ++i) {
-    const double rho = q[leg_offset(i)];
-    if (rho < p.rho_min) mask |= 1u << i;
-    if (rho > p.rho_max) mask |= 1u << (kLegs + i);
-  }
-  return mask;
-}
-
 Status holding_forces(const Model& m, const Vec16& q, const Wrench& we, Vec4& F) {
   // At rest friction is zero; the end stops' springs are not counted on:
   // no passive force at all (so that F does not follow rho through them).
@@ -82,7 +72,9 @@ Status inverse_dynamics(const Model& m, const Pose& pose, const Pose& pose_d, co
   if (s != Status::Ok) return s;
   out.qd = J.velocity(pose_d);
   out.qdd = J.acceleration(m, out.q, out.qd, pose_dd);
-  out.beyond_stops = joints_beyond_stops(m.p, out.q);
+  Vec4 rho;
+  for (int i = 0; i < kLegs; ++i) rho[i] = out.q[leg_offset(i)];
+  out.beyond_stops = stops_passed(m.p, rho);
   s = actuator_forces(m, out.q, out.qd, out.qdd, we, out.F, out.lambda);
   out.tau = out.F / m.drive_ratio;
   return s;

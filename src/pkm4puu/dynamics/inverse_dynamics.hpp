@@ -25,8 +25,6 @@ struct InverseDynamicsResult {
   unsigned beyond_stops = 0;
 };
 
-/// Bit mask of the joints beyond their end stops (InverseDynamicsResult).
-unsigned joints_beyond_stops(const Params& p, const Vec16& q);
 
 /// Eqs. 10-11 at a known motion (q, qd, qdd), external wrench `we`: the
 /// actuator forces on top of the joints' passive forces (header comment).

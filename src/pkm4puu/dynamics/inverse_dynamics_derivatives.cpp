@@ -1,7 +1,7 @@
 #include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
 
 #include "pkm4puu/dynamics/lagrangian.hpp"
-#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/machine/end_stops.hpp"
 #include "pkm4puu/dynamics/state_derivative.hpp"
 #include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
 

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "pkm4puu/kinematics/constraints.hpp"
-#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/machine/end_stops.hpp"
 
 namespace pkm {
 LegMassSlopes leg_mass_slopes(const Params& p, const LegConfig& c) {

@@ -3,7 +3,8 @@
 #include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
 #include "pkm4puu/base/lanes.hpp"
-#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/machine/passive_force.hpp"
+#include "pkm4puu/kinematics/actuator_positions.hpp"
 
 // x86-64 with GCC or Clang: an AVX variant of the legs' lanes beside the
 // SSE2 baseline, taken where Model::avx (make_model asks CPUID). Not on Windows: MinGW-w64's GCC

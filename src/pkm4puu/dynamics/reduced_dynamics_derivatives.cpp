@@ -3,7 +3,7 @@
 #include "pkm4puu/dynamics/lagrangian.hpp"
 #include "pkm4puu/dynamics/lagrangian_derivatives.hpp"
 #include "pkm4puu/kinematics/leg_kinematics_derivatives.hpp"
-#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/machine/passive_force.hpp"
 #include "pkm4puu/dynamics/state_derivative.hpp"
 
 namespace pkm {

@@ -1,7 +1,7 @@
 #include "pkm4puu/dynamics/state_derivative.hpp"
 
 #include "pkm4puu/kinematics/constraints.hpp"
-#include "pkm4puu/machine/machine.hpp"
+#include "pkm4puu/machine/passive_force.hpp"
 #include "pkm4puu/dynamics/reduced_dynamics.hpp"
 #include "pkm4puu/kinematics/servo_kinematics.hpp"
 

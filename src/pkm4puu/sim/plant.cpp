@@ -5,101 +5,26 @@
 #include <cstdio>
 #include <limits>
 
-#include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
-#include "pkm4puu/integrators/rk4.hpp"
+#include "pkm4puu/integrators/located_cvode.hpp"
+#include "pkm4puu/integrators/located_rk4.hpp"
+#include "pkm4puu/kinematics/actuator_positions.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/kinematics/servo_kinematics.hpp"
+#include "pkm4puu/machine/friction.hpp"
+#include "pkm4puu/machine/passive_force.hpp"
 
 namespace pkm {
-namespace {
 
-void eval_linear(void* user, double t, Vec4& F, Wrench& we) {
-  const auto* in = static_cast<const LinearInputs*>(user);
-  const double dt = t - in->t0;
-  F = in->F0 + in->dF * dt;
-  we = in->we0 + in->dwe * dt;
-}
-
-void eval_linear_tau(void* user, double t, Vec4& tau) {
-  const auto* in = static_cast<const LinearInputs*>(user);
-  tau = in->tau0 + in->dtau * (t - in->t0);
-}
-
-void read_inputs(const InputSignal& in, double t, Vec4& F, Wrench& we, Vec4& tau) {
-  if (in.eval) {
-    in.eval(in.user, t, F, we);
-  } else {
-    F.setZero();
-    we.setZero();
-  }
-  if (in.eval_tau) {
-    in.eval_tau(in.user, t, tau);
-  } else {
-    tau.setZero();
-  }
-}
-
-// RK4 contact location (Plant::advance_rk4): at most this many located
-// events per grid step (beyond, the step goes on without locating: a
-// chattering contact), and the bisection's resolution in time.
-constexpr int kMaxEventsPerStep = 64;
-double event_time_tolerance(double t) { return 1e-12 + 8.0 * std::numeric_limits<double>::epsilon() * std::fabs(t); }
-// CVODE: at most this many roots in one advance.
-constexpr int kMaxEventsPerAdvance = 100000;
-
-// |theta1| of a leg never comes near this: the closed form gives
-// |theta1| < 2 pi, and the legs keep the platform from turning a whole turn.
-constexpr double kMaxTheta1 = 8.0 * kPi;
-
-double unwrap_near(double angle, double ref) {
-  constexpr double two_pi = 2.0 * kPi;
-  return angle + two_pi * std::round((ref - angle) / two_pi);
-}
-
-}  // namespace
-
-InputSignal LinearInputs::signal() { return {&eval_linear, this, &eval_linear_tau}; }
-
-std::string validate(const SolverSettings& s) {
-  char buf[160];
-  // The choices first: the FMUs and the C API pass their integers through
-  // unchecked, and this is the one place that words them.
-  if (s.solver != Solver::Cvode && s.solver != Solver::Rk4) {
-    std::snprintf(buf, sizeof buf, "solver = %d must be 0 (CVODE) or 1 (RK4)", static_cast<int>(s.solver));
-    return buf;
-  }
-  if (s.cvode_method != CvodeMethod::Adams && s.cvode_method != CvodeMethod::BDF) {
-    std::snprintf(buf, sizeof buf, "cvode_method = %d must be 0 (Adams) or 1 (BDF)", static_cast<int>(s.cvode_method));
-    return buf;
-  }
-  if (s.formulation != Formulation::Augmented && s.formulation != Formulation::NullSpaceQR &&
-      s.formulation != Formulation::LegPartitioned) {
-    std::snprintf(buf, sizeof buf, "formulation = %d must be 0 (Eq. 12), 1 (Eq. 13, QR) or 2 (Eq. 13, leg-partitioned)",
-                  static_cast<int>(s.formulation));
-    return buf;
-  }
-  if (s.solver == Solver::Cvode && !cvode_available())
-    return "solver = 0 (CVODE) is not in this build (a source-code FMU compiled without SUNDIALS): set solver = 1 (RK4)";
-  if (!(s.rk4_step > 0.0) || !std::isfinite(s.rk4_step)) {
-    std::snprintf(buf, sizeof buf, "rk4_step = %.17g s must be positive and finite", s.rk4_step);
-    return buf;
-  }
-  if (!(s.rk4_step >= kMinRk4Step && s.rk4_step <= kMaxRk4Step)) {
-    std::snprintf(buf, sizeof buf, "rk4_step = %.17g s lies outside its range [%g, %g] s", s.rk4_step, kMinRk4Step,
-                  kMaxRk4Step);
-    return buf;
-  }
-  if (!(s.rtol > 0.0) || !(s.rtol < 1.0)) {
-    std::snprintf(buf, sizeof buf, "rtol = %.17g must lie in (0, 1)", s.rtol);
-    return buf;
-  }
-  if (!(s.atol > 0.0) || !(s.atol <= 1.0)) {
-    std::snprintf(buf, sizeof buf, "atol = %.17g must be positive and at most 1", s.atol);
-    return buf;
-  }
-  return validate(s.limits());
-}
+/// What located_rk4_step integrates: the plant's derivative under the held
+/// stops, and its contact mode.
+struct PlantOde {
+  Plant& plant;
+  Status rates(double t, const Vec10& x, Vec10& xdot) { return plant.derivative(t, x, xdot); }
+  void hold(unsigned stops) { plant.stops_ = stops; }
+  unsigned mode(const Vec10& x, Vec4& rho) const { return plant.contact_mode(x, rho); }
+};
 
 Plant::Plant(const Model& model) : model_(model) {}
 
@@ -149,7 +74,7 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
   rho_valid_ = false;
   t_ = t0;
   energy_ = EnergyIntegrals{};
-  for (int i = 0; i < kLegs; ++i) theta1_ref_[i] = q[leg_offset(i) + 1];
+  for (int i = 0; i < kLegs; ++i) theta1_.ref[i] = q[leg_offset(i) + 1];
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
   initialized_ = true;
@@ -198,7 +123,7 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
   t_ = t;
   y_ = y;
   rho_valid_ = false;
-  theta1_ref_ = theta1_ref;
+  theta1_.ref = theta1_ref;
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
   initialized_ = true;
@@ -256,9 +181,9 @@ void Plant::unpack(const Vec10& x) {
   energy_.dissipated = x[9];
 }
 
-Status Plant::slider_positions(Vec4& rho) const {
+Status Plant::actuator_positions(Vec4& rho) const {
   if (!rho_valid_) {
-    const Status s = actuator_positions(model_, y_.head<4>(), rho_);
+    const Status s = pkm::actuator_positions(model_, y_.head<4>(), rho_);
     if (s != Status::Ok) return s;
     rho_valid_ = true;
   }
@@ -266,39 +191,21 @@ Status Plant::slider_positions(Vec4& rho) const {
   return Status::Ok;
 }
 
-unsigned Plant::contact_mask(const Vec10& x, Vec4& rho) const {
-  if (actuator_positions(model_, x.head<4>(), rho) != Status::Ok) return ~0u;
-  return contact_mask_at(x, rho);
+unsigned Plant::contact_mode(const Vec10& x, Vec4& rho) const {
+  if (pkm::actuator_positions(model_, x.head<4>(), rho) != Status::Ok) return ~0u;
+  return contact_mode_at(x, rho);
 }
 
-unsigned Plant::contact_mask_at(const Vec10& x, const Vec4& rho) const {
-  unsigned mask = 0;
-  for (int i = 0; i < kLegs; ++i) {
-    if (rho[i] < model_.p.rho_min) mask |= 1u << i;
-    if (rho[i] > model_.p.rho_max) mask |= 1u << (kLegs + i);
-  }
-  if (mask == 0) return mask;
-  // Past a stop: also whether the stop is released (its spring and damper
-  // would pull, the force is held at 0), a kink in the force that RK4
-  // should not step across either. Needs the joint rates.
-  Vec16 q, qd;
+unsigned Plant::contact_mode_at(const Vec10& x, const Vec4& rho) const {
+  unsigned mode = stops_passed(model_.p, rho);
+  if (mode == 0) return mode;
+  Vec16 q, qd;  // the joint rates tell a released stop
   if (expand_state(model_, x.head<8>(), q, qd) != Status::Ok) return ~0u;
   for (int i = 0; i < kLegs; ++i) {
     const StopContact c = stop_contact(model_.p, rho[i], qd[leg_offset(i)]);
-    if (c.depth > 0.0 && c.force == 0.0) mask |= 1u << (2 * kLegs + i);
+    if (c.depth > 0.0 && c.force == 0.0) mode |= 1u << (2 * kLegs + i);
   }
-  return mask;
-}
-
-double Plant::contact_step() const {
-  // The fastest motion a stop can excite in one joint: its spring and
-  // damper against the least mass that can sit behind rho_i, the slider
-  // with its rotor (the rest of the mechanism only adds mass). A tenth of
-  // the inverse rate keeps RK4's error per step near (0.1)^5 / 120 ~ 1e-7
-  // of the contact's motion.
-  const double mass = model_.p.m_slider + model_.reflected_mass;
-  const double rate = std::sqrt(model_.p.stop_stiffness / mass) + model_.p.stop_damping / mass;
-  return rate > 0.0 ? 0.1 / rate : std::numeric_limits<double>::infinity();
+  return mode;
 }
 
 Status Plant::derivative(double t, const Vec10& x, Vec10& xdot) {
@@ -313,20 +220,6 @@ Status Plant::derivative(double t, const Vec10& x, Vec10& xdot) {
   if (s == Status::NonFinite && !inputs_fault) return Status::SolverFailure;
   return s;
 }
-
-namespace {
-
-/// The energy audit's integrands: the power of the actuator forces plus the
-/// screws' (Fa) and of the external wrench, and the power dissipated by
-/// friction and the end stops `stops`.
-void energy_rates(const Params& p, unsigned stops, const Vec4& Fa, const Wrench& we, const Pose& pose_rate,
-                  const Vec4& rho, const Vec4& rhod, double& power, double& dissipation) {
-  power = Fa.dot(rhod) + we.dot(pose_rate);
-  dissipation = 0.0;
-  for (int i = 0; i < kLegs; ++i) dissipation += dissipated_power(p, i, stops, rho[i], rhod[i]);
-}
-
-}  // namespace
 
 Status Plant::machine_rates(const InputSignal& inputs, double t, const Vec10& x, unsigned stops, Vec10& xdot,
                             bool* inputs_fault) const {
@@ -393,8 +286,6 @@ Status Plant::guard(const Vec8& y, double t) {
   return s;
 }
 
-double rk4_steps_for(double span, double rk4_step) { return std::ceil(span / rk4_step - 1e-9); }
-
 Status Plant::advance_rk4(double t_end) {
   const double span = t_end - t_;
   const double steps = rk4_steps_for(span, settings_.rk4_step);
@@ -409,72 +300,19 @@ Status Plant::advance_rk4(double t_end) {
   }
   const long n = std::max(1L, static_cast<long>(steps));
   const double h = span / static_cast<double>(n);
-  auto f = [this](double t, const Vec10& x, Vec10& xdot) { return derivative(t, x, xdot); };
   const double t0 = t_;
-  const double h_contact = contact_step();
+  const double h_contact = stop_contact_step(model_);
+  PlantOde ode{*this};
   for (long k = 0; k < n; ++k) {
     const double tk = (k == 0) ? t0 : t0 + static_cast<double>(k) * h;
     const double t_next = (k + 1 == n) ? t_end : t0 + static_cast<double>(k + 1) * h;
-    // One grid step, split where a joint reaches or leaves an end stop
-    // (the stop force switches on or off there) and, while a joint is past
-    // a stop, into substeps of h_contact. A split is located by bisection
-    // on re-stepping from the step's start: the shortest step after which
-    // the set of joints past their stops has changed.
     Vec10 x = packed();
+    // rho at x: the previous grid step's end computed it (actuator_positions).
+    Vec4 rho;
+    unsigned mode = actuator_positions(rho) == Status::Ok ? contact_mode_at(x, rho) : ~0u;
+    bool rho_valid = mode != ~0u;
     double t = tk;
-    // rho at x: the previous grid step's end computed it (slider_positions).
-    Vec4 rho_x;
-    unsigned mask = slider_positions(rho_x) == Status::Ok ? contact_mask_at(x, rho_x) : ~0u;
-    bool rho_x_valid = mask != ~0u;
-    int events = 0;
-    Status s = Status::Ok;
-    while (t < t_next && s == Status::Ok) {
-      double step = t_next - t;
-      bool to_end = true;
-      if (mask != 0 && step > h_contact) {
-        step = h_contact;
-        to_end = false;
-      }
-      stops_ = mask & 0xFFu;  // held on over the step (and its re-steps)
-      Vec10 trial = x;
-      s = rk4_step(f, t, step, trial);
-      if (s != Status::Ok) break;
-      Vec4 rho_trial;
-      unsigned trial_mask = contact_mask(trial, rho_trial);
-      bool rho_trial_valid = trial_mask != ~0u;
-      if (trial_mask == ~0u) trial_mask = mask;  // off the workspace: the guard reports it
-      if (trial_mask != mask && events < kMaxEventsPerStep) {
-        double lo = 0.0, hi = step;
-        const double tol = event_time_tolerance(t);
-        while (hi - lo > tol && s == Status::Ok) {
-          const double mid = 0.5 * (lo + hi);
-          Vec10 xm = x;
-          s = rk4_step(f, t, mid, xm);
-          Vec4 rho_m;
-          const unsigned mm = contact_mask(xm, rho_m);
-          if (mm == mask || mm == ~0u) {
-            lo = mid;
-          } else {
-            hi = mid;
-            trial = xm;
-            trial_mask = mm;
-            rho_trial = rho_m;
-            rho_trial_valid = true;
-          }
-        }
-        if (s != Status::Ok) break;
-        if (hi < step) to_end = false;
-        step = hi;
-        ++events;
-        ++contact_events_;
-      }
-      x = trial;
-      mask = trial_mask;
-      rho_x = rho_trial;
-      rho_x_valid = rho_trial_valid;
-      t = to_end ? t_next : t + step;
-    }
-    stops_ = kStopsFromState;
+    Status s = located_rk4_step(ode, tk, t_next, h_contact, x, mode, rho, rho_valid, contact_events_, t);
     if (s != Status::Ok) {
       char buf[160];
       std::snprintf(buf, sizeof buf, "the RK4 step from t = %.17g s could not be evaluated: %s", t,
@@ -486,8 +324,8 @@ Status Plant::advance_rk4(double t_end) {
     if (s != Status::Ok) return s;
     unpack(x);
     t_ = t_next;
-    if (rho_x_valid) {  // what slider_positions would compute at the new state
-      rho_ = rho_x;
+    if (rho_valid) {  // what actuator_positions would compute at the new state
+      rho_ = rho;
       rho_valid_ = true;
     }
   }
@@ -506,46 +344,14 @@ Status Plant::advance_cvode(double t_end, bool continuous) {
   }
   Vec10 x = packed();
   rhs_status_ = Status::Ok;
-  // CVODE stops at every root of the stop indicators (a joint reaching or
-  // leaving a stop: the stop force switches there); the history restarts
-  // at that point, then integration goes on to t_end.
-  // The stops held on between roots: those past at the start, then
-  // switched by the direction of each root (not by the side of zero on
-  // which the located state happens to fall).
+  // The stops held between roots: those past at the start, then switched at each root.
   Vec4 rho;
-  stops_ = (slider_positions(rho) == Status::Ok ? contact_mask_at(x, rho) : ~0u) & 0xFFu;
-  int events = 0;
-  Status s = Status::Ok;
-  for (;;) {
-    double t_reached = t_end;
-    bool root = false;
-    int dirs[kStopIndicators] = {};
-    s = cvode_.advance(t_end, x, t_reached, root, dirs);
-    if (s != Status::Ok) break;
-    if (!root) break;
-    for (int k = 0; k < kStopIndicators; ++k) {
-      if (dirs[k] < 0) stops_ |= 1u << k;   // indicator fell through 0: past the stop
-      if (dirs[k] > 0) stops_ &= ~(1u << k);
-    }
-    ++contact_events_;
-    if (++events > kMaxEventsPerAdvance) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "more than %d end-stop events before t = %.17g s (chattering contact)",
-                    kMaxEventsPerAdvance, t_end);
-      cvode_.reset(t_, packed());
-      stops_ = kStopsFromState;
-      error_ = buf;
-      return Status::SolverFailure;
-    }
-    if (!(t_reached < t_end)) break;
-    s = cvode_.reset(t_reached, x);
-    if (s != Status::Ok) break;
-  }
-  stops_ = kStopsFromState;
+  stops_ = (actuator_positions(rho) == Status::Ok ? contact_mode_at(x, rho) : ~0u) & 0xFFu;
+  bool chattering = false;
+  Status s = located_cvode_advance(cvode_, t_end, x, stops_, contact_events_, error_, chattering);
   if (s != Status::Ok) {
-    error_ = cvode_.last_error();
     cvode_.reset(t_, packed());
-    return rhs_status_ != Status::Ok ? rhs_status_ : s;
+    return (rhs_status_ != Status::Ok && !chattering) ? rhs_status_ : s;
   }
   s = guard(x.head<8>(), t_end);  // the interval ends within the limits, or is undone
   if (s != Status::Ok) {
@@ -571,17 +377,13 @@ Status Plant::advance(double t_end, const InputSignal& inputs, bool continuous) 
 }
 
 const Vec4& Plant::theta1_ref() const {
-  if (theta1_stale_) update_theta1_ref();
-  return theta1_ref_;
-}
-
-void Plant::update_theta1_ref() const {
   Vec16 q;
-  if (closed_form_position(model_, y_.head<4>(), q) == Status::Ok) refresh_theta1_ref(q);
+  if (theta1_stale_ && closed_form_position(model_, y_.head<4>(), q) == Status::Ok) follow_theta1(q);
+  return theta1_.ref;
 }
 
-void Plant::refresh_theta1_ref(const Vec16& q) const {
-  for (int i = 0; i < kLegs; ++i) theta1_ref_[i] = unwrap_near(q[leg_offset(i) + 1], theta1_ref_[i]);
+void Plant::follow_theta1(const Vec16& q) const {
+  theta1_.follow(q);
   theta1_stale_ = false;
 }
 
@@ -594,23 +396,17 @@ Status Plant::mechanism(const InputSignal& inputs, MechanismState& out) const {
   const Status s = state_derivative(model_, settings_.formulation, y_, generalized_forces(model_, F, tau, we),
                                     ydot, &out);
   if (s != Status::Ok) return s;
-  unwrap_theta1(out.q);
+  theta1_ref();  // brought up to date
+  theta1_.unwrap(out.q);
   return Status::Ok;
-}
-
-void Plant::unwrap_theta1(Vec16& q) const {
-  for (int i = 0; i < kLegs; ++i) {
-    double& th1 = q[leg_offset(i) + 1];
-    th1 = unwrap_near(th1, theta1_ref()[i]);
-  }
 }
 
 Status Plant::coordinates(Vec16& q, Vec16& qd) const {
   if (!initialized_) return Status::NotInitialized;
   const Status s = expand_state(model_, y_, q, qd);
   if (s != Status::Ok) return s;
-  if (theta1_stale_) refresh_theta1_ref(q);  // the closed form update_theta1_ref would evaluate again
-  unwrap_theta1(q);
+  if (theta1_stale_) follow_theta1(q);  // the closed form theta1_ref() would evaluate again
+  theta1_.unwrap(q);
   return Status::Ok;
 }
 

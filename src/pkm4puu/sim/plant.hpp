@@ -5,48 +5,14 @@
 
 #include <string>
 
-#include "pkm4puu/integrators/cvode_integrator.hpp"
-#include "pkm4puu/machine/machine.hpp"
 #include "pkm4puu/dynamics/state_derivative.hpp"
-#include "pkm4puu/kinematics/workspace_guard.hpp"
+#include "pkm4puu/integrators/cvode_integrator.hpp"
+#include "pkm4puu/kinematics/theta1_continuity.hpp"
+#include "pkm4puu/machine/end_stops.hpp"
+#include "pkm4puu/sim/input_signal.hpp"
+#include "pkm4puu/sim/solver_settings.hpp"
 
 namespace pkm {
-
-enum class Solver { Cvode = 0, Rk4 = 1 };
-
-struct SolverSettings {
-  Solver solver = Solver::Cvode;
-  double rk4_step = 1e-3;  // s; an interval is split into whole steps no longer than this
-  double rtol = 1e-8;      // CVODE
-  double atol = 1e-10;     // CVODE
-  CvodeMethod cvode_method = CvodeMethod::Adams;
-  Formulation formulation = Formulation::LegPartitioned;
-  // Singularity guards (workspace_guard.hpp), checked at the end of every
-  // step: a step ending beyond either is undone and reported (Status::Singular).
-  double max_jacobian_condition = GuardLimits{}.max_jacobian_condition;
-  double min_leg_measure = GuardLimits{}.min_leg_measure;
-
-  GuardLimits limits() const { return {max_jacobian_condition, min_leg_measure}; }
-};
-
-inline bool operator==(const SolverSettings& a, const SolverSettings& b) {
-  return a.solver == b.solver && a.rk4_step == b.rk4_step && a.rtol == b.rtol && a.atol == b.atol &&
-         a.cvode_method == b.cvode_method && a.formulation == b.formulation &&
-         a.max_jacobian_condition == b.max_jacobian_condition && a.min_leg_measure == b.min_leg_measure;
-}
-
-/// The range of rk4_step (s): a thousandth of the paper's 1 ms resolves the
-/// stiffest default dynamics (the end stops ring at about 6 ms) many times
-/// over; above 1 s RK4 says nothing about this machine.
-constexpr double kMinRk4Step = 1e-6, kMaxRk4Step = 1.0;
-
-/// At most this many RK4 steps in one advance (a longer interval or a
-/// smaller rk4_step is refused with Status::InvalidArgument before any
-/// work: about 25 s of computing at 2.5 us per step).
-constexpr double kMaxRk4StepsPerAdvance = 1e7;
-/// How many RK4 steps an advance over `span` takes (whole steps no longer
-/// than rk4_step); compare with kMaxRk4StepsPerAdvance before any work.
-double rk4_steps_for(double span, double rk4_step);
 
 /// The fastest the platform can move: |dx|, |dy|, |dz| and 0.1 m * |dphi|
 /// at most 1e3 m/s, a fifth of the speed of sound in steel (a rigid-body
@@ -54,28 +20,6 @@ double rk4_steps_for(double span, double rk4_step);
 /// singularity guards: a step ending faster is undone (SolverFailure), an
 /// initial velocity or a restored state faster is refused.
 constexpr double kMaxSpeed = 1e3;
-
-/// Returns "" if the settings are usable, otherwise a message naming the
-/// offending setting.
-std::string validate(const SolverSettings& s);
-
-/// Inputs over an interval: actuator forces F (N) and the external platform
-/// wrench (N, N*m) at time t; optionally the motor torques tau (N*m, zero
-/// when eval_tau is null), called with the same user pointer.
-struct InputSignal {
-  void (*eval)(void* user, double t, Vec4& F, Wrench& we) = nullptr;
-  void* user = nullptr;
-  void (*eval_tau)(void* user, double t, Vec4& tau) = nullptr;
-};
-
-/// Inputs held constant, or varying linearly: F(t) = F0 + dF (t - t0).
-struct LinearInputs {
-  double t0 = 0;
-  Vec4 F0 = Vec4::Zero(), dF = Vec4::Zero();
-  Wrench we0 = Wrench::Zero(), dwe = Wrench::Zero();
-  Vec4 tau0 = Vec4::Zero(), dtau = Vec4::Zero();
-  InputSignal signal();
-};
 
 /// The running integrals of the plant's energy audit (J), integrated with
 /// the motion by the same integrator: kinetic + potential - actuator_work +
@@ -180,9 +124,9 @@ class Plant {
   const Vec4& theta1_ref() const;
 
   /// The actuator positions rho_1..4 at the current state
-  /// (actuator_positions, bit for bit; the integrators compute them at the
-  /// end of every step for the end stops, so reading them is a copy).
-  Status slider_positions(Vec4& rho) const;
+  /// (pkm::actuator_positions, bit for bit; the integrators compute them at
+  /// the end of every step for the end stops, so reading them is a copy).
+  Status actuator_positions(Vec4& rho) const;
 
   /// ||C(q)|| at the current state (m).
   double constraint_residual() const;
@@ -195,6 +139,7 @@ class Plant {
   const std::string& last_error() const { return error_; }
 
  private:
+  friend struct PlantOde;  // the integrators' view (plant.cpp)
   static int cvode_rhs(double t, const Vec10& x, Vec10& xdot, void* self);
   static int cvode_roots(double t, const Vec10& x, double* g, void* self);
   /// d/dt of x = [y; actuator_work; dissipated] for the integrators
@@ -206,14 +151,14 @@ class Plant {
                        bool* inputs_fault = nullptr) const;
   Vec10 packed() const;
   void unpack(const Vec10& x);
-  /// Which joints are past a stop at the pose x.head<4>() (bit i: below
-  /// rho_min, bit 4 + i: above rho_max); all bits set if unreachable.
-  /// rho receives the actuator positions there (valid unless all bits are set).
-  unsigned contact_mask(const Vec10& x, Vec4& rho) const;
+  /// The contact mode at x (located_rk4.hpp): the stops passed at the pose
+  /// x.head<4>() and, bit 8 + i, leg i's stop passed but released (its
+  /// spring and damper would pull: a kink in the force that RK4 should not
+  /// step across either); ~0u if unreachable. rho receives the actuator
+  /// positions there (valid unless ~0u).
+  unsigned contact_mode(const Vec10& x, Vec4& rho) const;
   /// The same with rho, the actuator positions at x, known.
-  unsigned contact_mask_at(const Vec10& x, const Vec4& rho) const;
-  /// RK4 substep while a joint is past a stop (resolves the stop's spring).
-  double contact_step() const;
+  unsigned contact_mode_at(const Vec10& x, const Vec4& rho) const;
   /// Creates CVODE's objects (once, when it is the solver), so that no step
   /// allocates: at initialize() and restore().
   Status prepare_cvode();
@@ -222,11 +167,8 @@ class Plant {
   /// check_configuration of y's pose against the settings' limits; on
   /// failure error_ describes it.
   Status guard(const Vec8& y, double t);
-  void update_theta1_ref() const;
-  /// The references from the closed-form q of the current state.
-  void refresh_theta1_ref(const Vec16& q) const;
-  /// theta1 of every leg in q moved by whole turns next to its reference (continuity).
-  void unwrap_theta1(Vec16& q) const;
+  /// Brings theta1_ref_ to the closed-form q of the current state.
+  void follow_theta1(const Vec16& q) const;
 
   Model model_;
   SolverSettings settings_;
@@ -242,7 +184,7 @@ class Plant {
   // actuator_positions at y_, when rho_valid_ (every change of y_ clears it).
   mutable Vec4 rho_ = Vec4::Zero();
   mutable bool rho_valid_ = false;
-  mutable Vec4 theta1_ref_ = Vec4::Zero();
+  mutable Theta1References theta1_;
   mutable bool theta1_stale_ = false;
   long rhs_count_ = 0;
   Status rhs_status_ = Status::Ok;

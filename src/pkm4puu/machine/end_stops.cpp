@@ -1,0 +1,22 @@
+#include "pkm4puu/machine/end_stops.hpp"
+
+#include <limits>
+
+#include "pkm4puu/kinematics/actuator_positions.hpp"
+
+namespace pkm {
+
+Status stop_indicators(const Model& m, const Pose& pose, double g[kStopIndicators]) {
+  Vec4 rho;
+  const Status s = actuator_positions(m, pose, rho);
+  if (s == Status::Ok) stop_indicators(m.p, rho, g);
+  return s;
+}
+
+double stop_contact_step(const Model& m) {
+  const double mass = m.p.m_slider + m.reflected_mass;
+  const double rate = std::sqrt(m.p.stop_stiffness / mass) + m.p.stop_damping / mass;
+  return rate > 0.0 ? 0.1 / rate : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace pkm
