@@ -348,10 +348,10 @@ def main(argv=None):
     derivatives_comparison(build, median)
     for key in ("capi_rk4", "capi_cvode", "capi_cvode_tight", "capi_cvode_one_call"):
         ratio = t_mj / median[key]
-        ok = ratio >= 10.0 and c_cases[key]["max_c"] <= 1e-12
-        print(f"target (>= 10x faster than MuJoCo, ||C|| <= 1e-12 m): {LABELS[key][0]}: {ratio:.1f}x "
-              f"(best batches: {best['mujoco_rollout'] / best[key]:.1f}x), max ||C|| {c_cases[key]['max_c']:.1e} m: "
-              f"{'met' if ok else 'NOT met'}")
+        # ||C|| <= 1e-12 m is a test's verdict (python_checks/test_fmu_comparison.py, test_engines_forward.py)
+        print(f"target (>= 10x faster than MuJoCo): {LABELS[key][0]}: {ratio:.1f}x "
+              f"(best batches: {best['mujoco_rollout'] / best[key]:.1f}x): {'met' if ratio >= 10.0 else 'NOT met'}; "
+              f"max ||C|| {c_cases[key]['max_c']:.1e} m")
     # Issue 16 item 3: a control tick of the plant FMU (step + the 12 controller outputs) against mj_step, both
     # timed in a C loop (the C harness; mujoco.rollout), so neither carries Python's per-call overhead.
     for how, t in (("median", median), ("best batches", best)):
