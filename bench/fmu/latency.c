@@ -8,10 +8,10 @@
  *
  *   pkm_fmu_bench latency [--batches N] [--fmu SO] [--xml FILE]
  *
- * Scenario: --batches (default 1000) batches of 1000 ticks, each batch the same simulated second
- * from the home pose (the FMU state saved after initialisation is restored
- * between batches, outside the timing, so the platform never leaves the
- * workspace), F[1..4] = the static holding force (MODEL_SPEC), plus on F[1]
+ * Scenario: --batches (default 1000) batches of 1000 ticks, each batch the
+ * same simulated second from the home pose (the FMU state saved after
+ * initialisation is restored between batches, outside the timing, so the
+ * platform never leaves the workspace), F[1..4] = the static holding force (MODEL_SPEC), plus on F[1]
  * with RK4 0.2 cos(2 pi 3 t) N held over each tick (its midpoint value),
  * with CVODE the ramp 0.2 t N given as value and slope each tick (CVODE
  * continues across the ticks; it restarts at each batch's restore).
@@ -19,7 +19,7 @@
  * What the outliers are: the model's work at tick k of a batch is the same in
  * every batch (same state, same inputs, bit for bit), the machine's
  * interruptions (timer interrupts, another process) fall on random ticks. So
- * the minimum over the 1000 batches of tick k is the model's own time for
+ * the minimum over the batches of tick k is the model's own time for
  * that tick; its distribution (median, p99, p99.9, max over k) is the
  * model's share of the spread, the rest of the measured spread is the
  * machine's. (Hardware instruction counters are not available in every
