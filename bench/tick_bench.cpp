@@ -16,16 +16,9 @@
 // inputs integrated with CVODE at rtol 1e-12, restarted at every step
 // (exact for inputs that are smooth within each step).
 //
-// Built with ARKODE (PKM_TICK_BENCH_ARKODE, bench/CMakeLists.txt), a second
-// table: ARKODE's explicit adaptive Runge-Kutta (ERKStep, one-step methods
-// with no history to rebuild) on the same ODE as the Plant's CVODE (pose,
-// velocity and the two energy integrals from pkm::state_derivative with the
-// same forces; rtol and atol as CVODE's on every component; the end stops'
-// indicators as roots, none is reached here), restarted at every step
-// (ERKStepReInit: a fresh initial step estimate; ERKStepReset: keeps the last
-// step size) or continued across the steps (ramp only), beside the time one
-// derivative evaluation takes alone, so that the solver's own cost per step
-// (the time not spent in the derivative) can be read off.
+// A second table, ARKODE's explicit Runge-Kutta (ERKStep) on the same ODE,
+// was a one-off study; its conclusion is in the README ("CVODE across
+// communication points").
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -37,11 +30,6 @@
 #include "pkm4puu/machine/passive_force.hpp"
 #include "pkm4puu/dynamics/state_derivative.hpp"
 #include "pkm4puu/sim/plant.hpp"
-
-#if PKM_TICK_BENCH_ARKODE
-#include <arkode/arkode_erkstep.h>
-#include <nvector/nvector_serial.h>
-#endif
 
 namespace {
 
@@ -59,7 +47,7 @@ enum class Inputs { Ramp, Sampled, Held };
 
 struct Result {
   double median_us = 0, rhs_mean = 0, cvode_steps_mean = 0, max_dev = 0;
-  long rhs_max = 0, rhs_max_later = 0;  // the latter over the steps after the first
+  long rhs_max = 0;
   bool ok = true;
 };
 
@@ -91,7 +79,7 @@ std::vector<Pose> run_once(const pkm::Model& model, const pkm::SolverSettings& s
   }
   traj.push_back(plant.state().head<4>());
   pkm::LinearInputs in;
-  long rhs_max = 0, rhs_max_later = 0;
+  long rhs_max = 0;
   const auto t0 = Clock::now();
   for (int k = 0; k < kSteps; ++k) {
     const double t = k * kH;
@@ -102,14 +90,12 @@ std::vector<Pose> run_once(const pkm::Model& model, const pkm::SolverSettings& s
       return traj;
     }
     rhs_max = std::max(rhs_max, plant.rhs_evaluations() - before);
-    if (k > 0) rhs_max_later = std::max(rhs_max_later, plant.rhs_evaluations() - before);
     traj.push_back(plant.state().head<4>());
   }
   if (seconds) *seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   if (r) {
     r->rhs_mean = static_cast<double>(plant.rhs_evaluations()) / kSteps;
     r->rhs_max = rhs_max;
-    r->rhs_max_later = rhs_max_later;
     r->cvode_steps_mean = static_cast<double>(plant.cvode_steps()) / kSteps;
   }
   return traj;
@@ -142,156 +128,6 @@ Result measure(const pkm::Model& model, const pkm::SolverSettings& st, Inputs ki
                       reference);
 }
 
-#if PKM_TICK_BENCH_ARKODE
-
-/// The Plant's ODE (Plant::machine_rates with no motor torque, no external
-/// wrench and no end stop acting, as in these runs): pose and velocity from
-/// the minimal-state derivative, then the actuators' power and the power
-/// dissipated by friction.
-bool machine_rates(const pkm::Model& model, const pkm::LinearInputs& in, double t, const double* x, double* xdot) {
-  const Vec4 F = in.F0 + in.dF * (t - in.t0);
-  const pkm::Vec8 y = Eigen::Map<const pkm::Vec8>(x);
-  pkm::Vec8 ydot;
-  pkm::JointMotion jm;
-  constexpr unsigned kNoStops = 0u;
-  if (pkm::state_derivative(model, pkm::Formulation::LegPartitioned, y, pkm::generalized_forces(F, pkm::Wrench::Zero()),
-                            ydot, nullptr, &jm, kNoStops) != Status::Ok)
-    return false;
-  Eigen::Map<pkm::Vec8> out(xdot);
-  out = ydot;
-  xdot[8] = F.dot(jm.rhod);
-  xdot[9] = 0.0;
-  for (int i = 0; i < pkm::kLegs; ++i) xdot[9] += pkm::dissipated_power(model.p, i, kNoStops, jm.rho[i], jm.rhod[i]);
-  return true;
-}
-
-struct ArkProblem {
-  const pkm::Model* model = nullptr;
-  pkm::LinearInputs in;
-  long evals = 0;
-};
-
-int ark_rhs(double t, N_Vector y, N_Vector ydot, void* user) {
-  auto* p = static_cast<ArkProblem*>(user);
-  ++p->evals;
-  // A trial state off the workspace: recoverable, as in Plant::cvode_rhs.
-  return machine_rates(*p->model, p->in, t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot)) ? 0 : 1;
-}
-
-int ark_roots(double, N_Vector y, double* g, void* user) {  // as Plant::cvode_roots
-  const auto* p = static_cast<const ArkProblem*>(user);
-  if (pkm::stop_indicators(*p->model, Eigen::Map<const Pose>(N_VGetArrayPointer(y)), g) != Status::Ok)
-    for (int k = 0; k < pkm::kStopIndicators; ++k) g[k] = 1.0;
-  return 0;
-}
-
-enum class ArkMode { ReInit, Reset, Continue };
-
-struct ArkTable {
-  const char* name;
-  ARKODE_ERKTableID id;
-};
-
-std::vector<Pose> run_arkode(const pkm::Model& model, const pkm::SolverSettings& st, ARKODE_ERKTableID table,
-                             ArkMode mode, Inputs kind, const Vec4& F_static, Result* r, double* seconds,
-                             long* roots) {
-  std::vector<Pose> traj;
-  traj.reserve(kSteps + 1);
-  // The initial state as the Plant makes it; the energy integrals start at 0.
-  pkm::Plant plant(model);
-  if (plant.initialize(0.0, Pose(0, 0, 0.05, 0), Pose::Zero()) != Status::Ok) {
-    if (r) r->ok = false;
-    return traj;
-  }
-  SUNContext ctx = nullptr;
-  if (SUNContext_Create(nullptr, &ctx) != 0) {
-    if (r) r->ok = false;
-    return traj;
-  }
-  N_Vector y = N_VNew_Serial(10, ctx);
-  Eigen::Map<pkm::Vec10> yv(N_VGetArrayPointer(y));
-  yv.setZero();
-  yv.head<8>() = plant.state();
-  traj.push_back(yv.head<4>());
-  ArkProblem prob;
-  prob.model = &model;
-  void* mem = ERKStepCreate(&ark_rhs, 0.0, y, ctx);
-  int flag = mem ? 0 : -1;
-  if (mem) {
-    flag |= ERKStepSetTableNum(mem, table);
-    flag |= ERKStepSStolerances(mem, st.rtol, st.atol);  // CVODE's: atol on every component
-    flag |= ERKStepSetUserData(mem, &prob);
-    flag |= ERKStepSetMaxNumSteps(mem, 100000);  // CvodeIntegrator's limits
-    flag |= ERKStepSetMinStep(mem, pkm::kMinStep);
-    flag |= ERKStepRootInit(mem, pkm::kStopIndicators, &ark_roots);
-  }
-  long rhs_max = 0, rhs_max_later = 0, steps = 0;
-  if (roots) *roots = 0;
-  const auto t0 = Clock::now();
-  for (int k = 0; k < kSteps && flag == 0; ++k) {
-    const double t = k * kH;
-    step_inputs(kind, k, F_static, prob.in);
-    if (k > 0 && mode == ArkMode::ReInit) flag |= ERKStepReInit(mem, &ark_rhs, t, y);
-    if (k > 0 && mode == ArkMode::Reset) flag |= ERKStepReset(mem, t, y);
-    flag |= ERKStepSetStopTime(mem, t + kH);
-    long steps_before = 0, steps_after = 0;
-    ERKStepGetNumSteps(mem, &steps_before);
-    const long before = prob.evals;
-    double t_reached = t;
-    while (flag == 0 && t_reached < t + kH) {
-      const int f = ERKStepEvolve(mem, t + kH, y, &t_reached, ARK_NORMAL);
-      if (f < 0) flag = f;
-      if (f == ARK_ROOT_RETURN && roots) ++*roots;
-    }
-    ERKStepGetNumSteps(mem, &steps_after);
-    steps += steps_after - steps_before;
-    rhs_max = std::max(rhs_max, prob.evals - before);
-    if (k > 0) rhs_max_later = std::max(rhs_max_later, prob.evals - before);
-    traj.push_back(yv.head<4>());
-  }
-  if (seconds) *seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  if (mem) ERKStepFree(&mem);
-  N_VDestroy(y);
-  SUNContext_Free(&ctx);
-  if (r) {
-    r->ok = r->ok && flag == 0;
-    r->rhs_mean = static_cast<double>(prob.evals) / kSteps;
-    r->rhs_max = rhs_max;
-    r->rhs_max_later = rhs_max_later;
-    r->cvode_steps_mean = static_cast<double>(steps) / kSteps;
-  }
-  return traj;
-}
-
-Result measure_arkode(const pkm::Model& model, const pkm::SolverSettings& st, ARKODE_ERKTableID table, ArkMode mode,
-                      Inputs kind, const Vec4& F_static, const std::vector<Pose>& reference, long* roots) {
-  return measure_runs(
-      [&](Result* r, double* s) { return run_arkode(model, st, table, mode, kind, F_static, r, s, roots); },
-      reference);
-}
-
-/// One derivative evaluation alone (machine_rates at the home pose), us:
-/// the minimum over 5 runs of the mean of 20000 evaluations.
-double derivative_us(const pkm::Model& model, const Vec4& F_static) {
-  pkm::LinearInputs in;
-  in.F0 = F_static;
-  pkm::Vec10 x = pkm::Vec10::Zero(), xdot;
-  x.head<4>() = Pose(0, 0, 0.05, 0);
-  constexpr int kEvals = 20000;
-  double best = 1e30;
-  for (int run = 0; run < 5; ++run) {
-    const auto t0 = Clock::now();
-    for (int i = 0; i < kEvals; ++i) {
-      x[4] = 1e-9 * i;  // a new state each time
-      machine_rates(model, in, 0.0, x.data(), xdot.data());
-    }
-    best = std::min(best, std::chrono::duration<double>(Clock::now() - t0).count());
-  }
-  return 1e6 * best / kEvals;
-}
-
-#endif  // PKM_TICK_BENCH_ARKODE
-
 }  // namespace
 
 int main() {
@@ -320,13 +156,10 @@ int main() {
   int failures = 0;
   const Inputs kinds[] = {Inputs::Ramp, Inputs::Sampled, Inputs::Held};
   const char* knames[] = {"ramp", "sampled", "held"};
-  std::vector<Pose> references[3];
-  Result cvode_restarted[3];
   for (int ki = 0; ki < 3; ++ki) {
     const Inputs kind = kinds[ki];
     const char* kname = knames[ki];
-    references[ki] = run_once(model, tight, kind, false, F_static, nullptr, nullptr);
-    const std::vector<Pose>& reference = references[ki];
+    const std::vector<Pose> reference = run_once(model, tight, kind, false, F_static, nullptr, nullptr);
     struct Case {
       const char* name;
       const pkm::SolverSettings* st;
@@ -344,10 +177,7 @@ int main() {
         ++failures;
         continue;
       }
-      if (c.st == &cvode && !c.cont) {
-        restart_us = r.median_us;
-        cvode_restarted[ki] = r;
-      }
+      if (c.st == &cvode && !c.cont) restart_us = r.median_us;
       std::printf("%-44s %9.3f %9.2f %9ld %9.2f %12.2e", name, r.median_us, r.rhs_mean, r.rhs_max,
                   r.cvode_steps_mean, r.max_dev);
       if (c.st == &cvode && c.cont) std::printf("   %.1fx faster than restarting", restart_us / r.median_us);
@@ -356,49 +186,5 @@ int main() {
   }
   std::printf("\nreference: CVODE rtol 1e-12, restarted every step, the same inputs. Continuing across the jumps of\n"
               "sampled or held inputs costs accuracy: the FMU continues only where the inputs continue (pkm4puu.cpp).\n");
-#if PKM_TICK_BENCH_ARKODE
-  const double eval_us = derivative_us(model, F_static);
-  std::printf("\nARKODE %s ERKStep on the same ODE (pose, velocity, energy integrals), rtol %.0e, atol %.0e on every\n"
-              "component, the stop indicators as roots. One derivative evaluation alone: %.3f us; 'other us' is\n"
-              "us/step - rhs/step x that (the solver's own work, and the Plant's for CVODE).\n\n",
-              SUNDIALS_VERSION, cvode.rtol, cvode.atol, eval_us);
-  std::printf("%-56s %8s %8s %8s %8s %10s %12s %9s %9s\n", "run", "us/step", "rhs/step", "rhs max", "max k>0",
-              "steps/step", "max|dxyz| m", "vs CVODE", "other us");
-  const ArkTable tables[] = {{"ERK order 4 (Zonneveld 5-3-4, default)", ARKODE_ZONNEVELD_5_3_4},
-                             {"ERK Dormand-Prince 7-4-5", ARKODE_DORMAND_PRINCE_7_4_5},
-                             {"ERK Verner 8-5-6", ARKODE_VERNER_8_5_6}};
-  long roots_total = 0;
-  for (int ki = 0; ki < 3; ++ki) {
-    const Result& cv = cvode_restarted[ki];
-    if (!cv.ok || cv.median_us <= 0) continue;
-    char name[96];
-    std::snprintf(name, sizeof name, "%s: CVODE 1e-8, restart every step", knames[ki]);
-    std::printf("%-56s %8.3f %8.2f %8ld %8ld %10.2f %12.2e %8.2fx %9.2f\n", name, cv.median_us, cv.rhs_mean,
-                cv.rhs_max, cv.rhs_max_later, cv.cvode_steps_mean, cv.max_dev, 1.0, cv.median_us - cv.rhs_mean * eval_us);
-    for (const ArkTable& tb : tables) {
-      for (ArkMode mode : {ArkMode::ReInit, ArkMode::Reset, ArkMode::Continue}) {
-        if (mode == ArkMode::Continue && kinds[ki] != Inputs::Ramp) continue;  // jumps: a restart is needed
-        const char* mname = mode == ArkMode::ReInit ? "ReInit" : mode == ArkMode::Reset ? "Reset" : "continued";
-        long roots = 0;
-        const Result r = measure_arkode(model, cvode, tb.id, mode, kinds[ki], F_static, references[ki], &roots);
-        roots_total += roots;
-        std::snprintf(name, sizeof name, "%s: %s, %s", knames[ki], tb.name, mname);
-        if (!r.ok) {
-          std::printf("%-56s FAILED\n", name);
-          ++failures;
-          continue;
-        }
-        std::printf("%-56s %8.3f %8.2f %8ld %8ld %10.2f %12.2e %8.2fx %9.2f\n", name, r.median_us, r.rhs_mean,
-                    r.rhs_max, r.rhs_max_later, r.cvode_steps_mean, r.max_dev, r.median_us / cv.median_us, r.median_us - r.rhs_mean * eval_us);
-      }
-    }
-  }
-  std::printf("\n'vs CVODE': time per step over CVODE's restarted at every step, the same inputs. ReInit and Reset:\n"
-              "ERKStepReInit / ERKStepReset at every step (ReInit estimates the first step afresh; Reset keeps the last\n"
-              "step size); continued: neither. Roots found: %ld (no stop is reached in these runs).\n",
-              roots_total);
-#else
-  std::printf("\n(built without ARKODE: libsundials_arkode.a was not found at configure time)\n");
-#endif
   return failures ? 1 : 0;
 }

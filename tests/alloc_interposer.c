@@ -15,7 +15,7 @@ extern void __libc_free(void* p);
 static long count_;
 static long fail_at_;
 
-long alloc_count(void) { return count_; }
+long alloc_count(void) { return __atomic_load_n(&count_, __ATOMIC_RELAXED); }
 void alloc_fail_at(long n) { fail_at_ = n; }
 
 /* Called when the allocation made to fail is requested: a place for a
@@ -24,8 +24,8 @@ __attribute__((noinline)) void pkm_alloc_fault_hook(void) { __asm__ volatile("")
 
 /* Counts one request; 0 if it is the one to fail. */
 static int admit(void) {
-  ++count_;
-  if (fail_at_ != 0 && count_ == fail_at_) {
+  const long n = __atomic_add_fetch(&count_, 1, __ATOMIC_RELAXED);
+  if (fail_at_ != 0 && n == fail_at_) {
     pkm_alloc_fault_hook();
     errno = ENOMEM;
     return 0;

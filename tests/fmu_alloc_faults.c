@@ -37,7 +37,7 @@
 #include "fmi2FunctionTypes.h"
 
 #define PKM_HARNESS_NAME "fmu_alloc_faults"
-#include "fmu_harness.h"
+#include "harness.h"
 
 #define STATIC_FORCE 2.655616050 /* N, MODEL_SPEC */
 #define H 1e-3

@@ -30,7 +30,7 @@
 #include "fmi2FunctionTypes.h"
 
 #define PKM_HARNESS_NAME "fmu_allocations"
-#include "fmu_harness.h"
+#include "harness.h"
 
 #define STATIC_FORCE 2.655616050 /* N, MODEL_SPEC "A check anyone can derive" */
 #define PI 3.14159265358979323846

@@ -1,11 +1,11 @@
-/* pkm_comparison_bench: the cost of one simulated second of the paper's
+/* pkm_fmu_bench compare: the cost of one simulated second of the paper's
  * comparison test (MODEL_SPEC "Comparison test": from rest at P0, g = 0,
  * F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s), F2 = F3 = 0) at a 1 ms step, through
  * this project's plain C API (libpkm.so, pkm.h) and through the plant FMU
- * (PKM4PUU.so, dlopen + raw FMI 2.0 Co-Simulation calls, as a master would).
- * Plain C11. bench/engines_bench.py runs it beside MuJoCo and Pinocchio.
+ * (raw FMI 2.0 Co-Simulation calls, as a master would).
+ * bench/engines_bench.py runs it beside MuJoCo and Pinocchio.
  *
- *   pkm_comparison_bench [--out DIR] [--batches N] [--fmu PKM4PUU.so [--xml modelDescription.xml]]
+ *   pkm_fmu_bench compare [--out DIR] [--batches N] [--fmu PKM4PUU.so] [--xml modelDescription.xml]
  *
  * Cases (each step is 1 ms of simulated time; 1000 steps = 1 simulated s):
  *   capi_rk4        pkm_advance_fn to the next millisecond, forces from a C
@@ -46,38 +46,21 @@
  * one call), t, x, y, z, phi, rho1 and ||C(q)|| (pkm_get_outputs'
  * constraint_residual, the FMU's constraint_residual output); the largest
  * ||C(q)|| is printed, and with --out DIR the run is written to
- * DIR/<case>.csv and the summary to DIR/summary.csv.
- *
- * Exit status: 0, or 1 if anything fails. */
+ * DIR/<case>.csv and the summary to DIR/summary.csv. */
 #define _POSIX_C_SOURCE 200809L
 
-#include <dlfcn.h>
 #include <math.h>
-#include <stdarg.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <sys/utsname.h>
-#include <time.h>
-#include <unistd.h>
 
-#include "fmi2FunctionTypes.h"
-
-#define PKM_HARNESS_NAME "pkm_comparison_bench"
-#include "fmu_harness.h"
+#include "bench.h"
 #include "pkm4puu/pkm.h"
 
-#ifndef PKM_FMU_PLANT_SO
-#define PKM_FMU_PLANT_SO "PKM4PUU.so"
-#endif
-
-#define PI 3.14159265358979323846
 #define STEP 1e-3          /* s */
 #define STEPS_TIMED 1000   /* 1 simulated second */
 #define STEPS_TEST 1500    /* the whole 1.5 s comparison test */
 #define AMPLITUDE 0.02     /* N */
 #define PERIOD 1.5         /* s */
 #define MAX_BATCHES 101
+#define NAME PKM_HARNESS_NAME " compare"
 
 static const double P0[4] = {0.0, 0.0, 0.05, 0.0}; /* MODEL_SPEC home pose */
 
@@ -111,7 +94,7 @@ static int write_rows(const char* dir, const char* name, int n_rows) {
   snprintf(path, sizeof path, "%s/%s.csv", dir, name);
   fp = fopen(path, "w");
   if (!fp) {
-    fprintf(stderr, "pkm_comparison_bench: cannot write %s\n", path);
+    fprintf(stderr, NAME ": cannot write %s\n", path);
     return 0;
   }
   fprintf(fp, "t,x,y,z,phi,rho1,constraint_residual\n");
@@ -120,12 +103,6 @@ static int write_rows(const char* dir, const char* name, int n_rows) {
             rows[k].v[3], rows[k].v[4], rows[k].v[5], rows[k].v[6]);
   fclose(fp);
   return 1;
-}
-
-static double finish_timing(double* per, int n, double* min_out) {
-  qsort(per, (size_t)n, sizeof per[0], compare_double);
-  *min_out = per[0];
-  return per[n / 2];
 }
 
 /* ------------------------------------------------------------ the C API */
@@ -164,7 +141,7 @@ static void input_callback(void* user, double t, double F[4], double wrench[4]) 
   do {                                                                                               \
     const pkm_status s_ = (call);                                                                    \
     if (s_ != PKM_OK) {                                                                              \
-      fprintf(stderr, "pkm_comparison_bench: %s:%d: %s: %s (%s)\n", __FILE__, __LINE__, #call,       \
+      fprintf(stderr, NAME ": %s:%d: %s: %s (%s)\n", __FILE__, __LINE__, #call,       \
               pkm_status_string(s_), pkm_last_error(m));                                             \
       pkm_destroy(m);                                                                                \
       return 0;                                                                                      \
@@ -184,7 +161,7 @@ static int run_capi(const pkm_solver_settings* settings, int one_call, int batch
   pkm_default_params(&p);
   p.g = 0.0;
   if (pkm_create(&p, &m, err, sizeof err) != PKM_OK) {
-    fprintf(stderr, "pkm_comparison_bench: pkm_create: %s\n", err);
+    fprintf(stderr, NAME ": pkm_create: %s\n", err);
     return 0;
   }
   PKM_CHECK(pkm_set_solver(m, settings));
@@ -203,7 +180,7 @@ static int run_capi(const pkm_solver_settings* settings, int one_call, int batch
     }
     if (b >= 0) per[b] = now_seconds() - t0;
   }
-  res->median_s = finish_timing(per, batches, &res->min_s);
+  res->median_s = median_min(per, batches, &res->min_s);
   /* the untimed 1.5 s run: outputs at every millisecond (one_call: at the
    * ends of single calls to 0.5, 1.0 and 1.5 s only) */
   res->max_c = 0.0;
@@ -228,46 +205,17 @@ static int run_capi(const pkm_solver_settings* settings, int one_call, int batch
 
 /* ------------------------------------------------------------- the FMU */
 
-
-
+/* Beyond the plant's F and controller outputs: the outputs recorded in the
+ * 1.5 s run, the parameters set. */
 typedef struct {
-  char guid[128];
-  fmi2ValueReference F[4], pose[4], control[12], rho1, residual, solver, rk4_step, g, z0;
+  fmi2ValueReference rho1, residual;
+  fmi2ValueReference settings[3]; /* rk4_step, g, z0 */
 } Fmi;
-
-static int read_model_description(const char* xml, Fmi* md) {
-  static const char* f_names[] = {"F[1]", "F[2]", "F[3]", "F[4]"};
-  static const char* pose_names[] = {"x", "y", "z", "phi"};
-  static const char* control_names[12] = PKM_CONTROLLER_OUTPUTS;
-  char* text = read_text(xml);
-  const char *root, *root_end;
-  int i, ok = 1;
-  if (!text) {
-    fprintf(stderr, "pkm_comparison_bench: cannot read %s\n", xml);
-    return 0;
-  }
-  root = strstr(text, "<fmiModelDescription");
-  root_end = root ? strchr(root, '>') : NULL;
-  if (!root || !root_end || !attribute(root, root_end, "guid", md->guid, sizeof md->guid)) {
-    fprintf(stderr, "pkm_comparison_bench: no guid in %s\n", xml);
-    ok = 0;
-  }
-  for (i = 0; ok && i < 4; ++i)
-    ok = lookup_value_reference(text, f_names[i], &md->F[i]) &&
-         lookup_value_reference(text, pose_names[i], &md->pose[i]);
-  for (i = 0; ok && i < 12; ++i) ok = lookup_value_reference(text, control_names[i], &md->control[i]);
-  ok = ok && lookup_value_reference(text, "rho[1]", &md->rho1) &&
-       lookup_value_reference(text, "constraint_residual", &md->residual) &&
-       lookup_value_reference(text, "solver", &md->solver) && lookup_value_reference(text, "rk4_step", &md->rk4_step) &&
-       lookup_value_reference(text, "g", &md->g) && lookup_value_reference(text, "z0", &md->z0);
-  free(text);
-  return ok;
-}
 
 #define FMI_CHECK(call)                                                                              \
   do {                                                                                               \
     if ((call) != fmi2OK) {                                                                          \
-      fprintf(stderr, "pkm_comparison_bench: %s:%d: %s failed\n", __FILE__, __LINE__, #call);        \
+      fprintf(stderr, NAME ": %s:%d: %s failed\n", __FILE__, __LINE__, #call);        \
       ok = 0;                                                                                        \
       goto done;                                                                                     \
     }                                                                                                \
@@ -289,45 +237,32 @@ static void tick_forces(int k, int ramp, double F[4], double dF[4]) {
 }
 
 /* n_out: 4 (the pose) or 12 (the controller outputs); ramp: see tick_forces. */
-static int run_fmu(const Fmu* f, const Fmi* md, int solver, int ramp, int n_out, int batches, const char* out_dir,
-                   Result* res) {
-  fmi2CallbackFunctions callbacks = {logger, allocate_memory, free, NULL, NULL};
+static int run_fmu(const Plant* plant, const Fmi* md, int solver, int ramp, int n_out, int batches,
+                   const char* out_dir, Result* res) {
+  const Fmu* f = &plant->fmu;
+  const fmi2ValueReference* pose_vr = plant->control; /* x, y, z, phi first */
+  const fmi2Real settings[3] = {STEP, 0.0, P0[2]};   /* rk4_step, g, z0 (x0, y0, phi0 default to 0) */
   fmi2FMUstate home = NULL;
-  fmi2Component c;
+  fmi2Component c = instantiate_plant(plant, res->name, solver, 3, md->settings, settings, &home);
   const fmi2Integer order[4] = {1, 1, 1, 1};
-  const fmi2ValueReference* out_vr = n_out == 12 ? md->control : md->pose;
   double per[MAX_BATCHES], F[4], dF[4], out[12];
-  const fmi2Real g = 0.0, z0 = P0[2], rk4_step = STEP;
-  const fmi2Integer solver_value = solver;
   int b, k, ok = 1;
 
-  c = f->fmi2Instantiate(res->name, fmi2CoSimulation, md->guid, "", &callbacks, fmi2False, fmi2False);
-  if (!c) {
-    fprintf(stderr, "pkm_comparison_bench: fmi2Instantiate failed\n");
-    return 0;
-  }
-  FMI_CHECK(f->fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0));
-  FMI_CHECK(f->fmi2SetInteger(c, &md->solver, 1, &solver_value));
-  FMI_CHECK(f->fmi2SetReal(c, &md->rk4_step, 1, &rk4_step));
-  FMI_CHECK(f->fmi2SetReal(c, &md->g, 1, &g));
-  FMI_CHECK(f->fmi2SetReal(c, &md->z0, 1, &z0)); /* x0, y0, phi0 default to 0 */
-  FMI_CHECK(f->fmi2EnterInitializationMode(c));
-  FMI_CHECK(f->fmi2ExitInitializationMode(c));
-  FMI_CHECK(f->fmi2GetFMUstate(c, &home));
+  if (!c) return 0;
   for (b = -1; b < batches; ++b) {
     double t0;
     FMI_CHECK(f->fmi2SetFMUstate(c, home));
     t0 = now_seconds();
     for (k = 0; k < STEPS_TIMED; ++k) {
       tick_forces(k, ramp, F, dF);
-      FMI_CHECK(f->fmi2SetReal(c, md->F, 4, F));
-      if (ramp) FMI_CHECK(f->fmi2SetRealInputDerivatives(c, md->F, 4, order, dF));
+      FMI_CHECK(f->fmi2SetReal(c, plant->F, 4, F));
+      if (ramp) FMI_CHECK(f->fmi2SetRealInputDerivatives(c, plant->F, 4, order, dF));
       FMI_CHECK(f->fmi2DoStep(c, (double)k * STEP, STEP, fmi2True));
-      FMI_CHECK(f->fmi2GetReal(c, out_vr, (size_t)n_out, out));
+      FMI_CHECK(f->fmi2GetReal(c, pose_vr, (size_t)n_out, out));
     }
     if (b >= 0) per[b] = now_seconds() - t0;
   }
-  res->median_s = finish_timing(per, batches, &res->min_s);
+  res->median_s = median_min(per, batches, &res->min_s);
   /* the untimed 1.5 s run */
   res->max_c = 0.0;
   FMI_CHECK(f->fmi2SetFMUstate(c, home));
@@ -335,67 +270,36 @@ static int run_fmu(const Fmu* f, const Fmi* md, int solver, int ramp, int n_out,
     const double t = (double)k * STEP;
     if (k > 0) {
       tick_forces(k - 1, ramp, F, dF);
-      FMI_CHECK(f->fmi2SetReal(c, md->F, 4, F));
-      if (ramp) FMI_CHECK(f->fmi2SetRealInputDerivatives(c, md->F, 4, order, dF));
+      FMI_CHECK(f->fmi2SetReal(c, plant->F, 4, F));
+      if (ramp) FMI_CHECK(f->fmi2SetRealInputDerivatives(c, plant->F, 4, order, dF));
       FMI_CHECK(f->fmi2DoStep(c, t - STEP, STEP, fmi2True));
     }
     rows[k].v[0] = t;
-    FMI_CHECK(f->fmi2GetReal(c, md->pose, 4, &rows[k].v[1]));
+    FMI_CHECK(f->fmi2GetReal(c, pose_vr, 4, &rows[k].v[1]));
     FMI_CHECK(f->fmi2GetReal(c, &md->rho1, 1, &rows[k].v[5]));
     FMI_CHECK(f->fmi2GetReal(c, &md->residual, 1, &rows[k].v[6]));
     if (rows[k].v[6] > res->max_c) res->max_c = rows[k].v[6];
   }
 done:
-  if (home && f->fmi2FreeFMUstate(c, &home) != fmi2OK) ok = 0;
-  if (f->fmi2Terminate(c) != fmi2OK) ok = 0;
-  f->fmi2FreeInstance(c);
+  if (!free_plant(plant, c, &home)) ok = 0;
   return ok && write_rows(out_dir, res->name, STEPS_TEST + 1);
 }
 
 /* ------------------------------------------------------------------ main */
 
-static void usage(void) {
-  fprintf(stderr, "usage: pkm_comparison_bench [--out DIR] [--batches N] [--fmu PKM4PUU.so [--xml FILE]]\n");
-}
-
-int main(int argc, char** argv) {
-  const char* out_dir = NULL;
-  const char* so = PKM_FMU_PLANT_SO;
-  const char* xml_arg = NULL;
-  char* xml = NULL;
-  int batches = 21, i, ok = 1, n = 0;
+static int compare_run(const Plant* plant, const Options* o) {
+  static const char* const setting_names[] = {"rk4_step", "g", "z0"};
+  const char* out_dir = o->out;
+  const int batches = o->batches;
+  int i, ok, n = 0;
   Result results[9];
-  Fmu fmu;
   Fmi md;
   pkm_solver_settings rk4, cvode, cvode_tight;
 
-  for (i = 1; i < argc; ++i) {
-    if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
-      out_dir = argv[++i];
-    } else if (strcmp(argv[i], "--batches") == 0 && i + 1 < argc) {
-      batches = atoi(argv[++i]);
-      if (batches < 1 || batches > MAX_BATCHES) {
-        fprintf(stderr, "pkm_comparison_bench: --batches must be in 1..%d\n", MAX_BATCHES);
-        return 1;
-      }
-    } else if (strcmp(argv[i], "--fmu") == 0 && i + 1 < argc) {
-      so = argv[++i];
-    } else if (strcmp(argv[i], "--xml") == 0 && i + 1 < argc) {
-      xml_arg = argv[++i];
-    } else {
-      usage();
-      return 1;
-    }
-  }
-  xml = xml_arg ? NULL : default_xml_path(so);
-  if (!xml_arg && !xml) {
-    fprintf(stderr, "pkm_comparison_bench: cannot derive the model description path from %s\n", so);
-    return 1;
-  }
-  if (!read_model_description(xml_arg ? xml_arg : xml, &md) || !load_fmu(so, &fmu)) {
-    free(xml);
-    return 1;
-  }
+  ok = lookup_value_reference(plant->text, "rho[1]", &md.rho1) &&
+       lookup_value_reference(plant->text, "constraint_residual", &md.residual) &&
+       lookup_value_references(plant, setting_names, 3, md.settings);
+  if (!ok) return 0;
 
   pkm_default_solver_settings(&rk4);
   rk4.solver = PKM_SOLVER_RK4;
@@ -405,11 +309,11 @@ int main(int argc, char** argv) {
   cvode_tight.rtol = 1e-12;
   cvode_tight.atol = 1e-14;
 
-  printf("pkm_comparison_bench: one simulated second of the comparison test (MODEL_SPEC; g = 0,\n"
+  printf("pkm_fmu_bench compare: one simulated second of the comparison test (MODEL_SPEC; g = 0,\n"
          "F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s)) at a 1 ms step; median of %d batches after 1 warm-up\n",
          batches);
   print_machine();
-  printf("fmu:     %s\n\n", so);
+  printf("fmu:     %s\n\n", plant->so);
 
   fill_force_table();
   results[n] = (Result){"capi_rk4", "C API, RK4 1 ms, forces at stage times", 0, 0, 0};
@@ -423,13 +327,13 @@ int main(int argc, char** argv) {
   results[n] = (Result){"capi_cvode_one_call", "C API, CVODE rtol 1e-12, one call", 0, 0, 0};
   ok = ok && run_capi(&cvode_tight, 1, batches, out_dir, &results[n++]);
   results[n] = (Result){"fmu_rk4", "plant FMU, RK4 1 ms, midpoint-held F", 0, 0, 0};
-  ok = ok && run_fmu(&fmu, &md, 1, 0, 4, batches, out_dir, &results[n++]);
+  ok = ok && run_fmu(plant, &md, 1, 0, 4, batches, out_dir, &results[n++]);
   results[n] = (Result){"fmu_cvode", "plant FMU, CVODE rtol 1e-8, midpoint-held F", 0, 0, 0};
-  ok = ok && run_fmu(&fmu, &md, 0, 0, 4, batches, out_dir, &results[n++]);
+  ok = ok && run_fmu(plant, &md, 0, 0, 4, batches, out_dir, &results[n++]);
   results[n] = (Result){"fmu_rk4_ctrl12", "plant FMU, RK4 1 ms, held F, 12 outputs", 0, 0, 0};
-  ok = ok && run_fmu(&fmu, &md, 1, 0, 12, batches, out_dir, &results[n++]);
+  ok = ok && run_fmu(plant, &md, 1, 0, 12, batches, out_dir, &results[n++]);
   results[n] = (Result){"fmu_cvode_ramp_ctrl12", "plant FMU, CVODE 1e-8, F as ramp, 12 outputs", 0, 0, 0};
-  ok = ok && run_fmu(&fmu, &md, 0, 1, 12, batches, out_dir, &results[n++]);
+  ok = ok && run_fmu(plant, &md, 0, 1, 12, batches, out_dir, &results[n++]);
 
   if (ok) {
     printf("%-22s %-44s %14s %14s %16s\n", "case", "what", "median ms/s", "min ms/s", "max ||C|| (m)");
@@ -443,7 +347,7 @@ int main(int argc, char** argv) {
     snprintf(path, sizeof path, "%s/summary.csv", out_dir);
     fp = fopen(path, "w");
     if (!fp) {
-      fprintf(stderr, "pkm_comparison_bench: cannot write %s\n", path);
+      fprintf(stderr, NAME ": cannot write %s\n", path);
       ok = 0;
     } else {
       fprintf(fp, "case,what,median_s_per_sim_s,min_s_per_sim_s,max_constraint_residual\n");
@@ -453,7 +357,10 @@ int main(int argc, char** argv) {
       fclose(fp);
     }
   }
-  free(xml);
-  dlclose(fmu.handle);
-  return exit_status(ok);
+  return ok;
 }
+
+const Subcommand compare_subcommand = {"compare",
+                                       "one simulated second of the comparison test, C API and FMU; --out for "
+                                       "bench/engines_bench.py",
+                                       compare_run, 21, MAX_BATCHES, "--out DIR (the runs as CSV)"};

@@ -1,6 +1,5 @@
-/* pkm_cost_table: the plant FMU's cost in one table (issue 16 item 5),
- * through the FMU binary (PKM4PUU.so, dlopen + raw FMI 2.0 Co-Simulation, as
- * a master drives it; plain C, no Python in any timed loop):
+/* pkm_fmu_bench cost: the plant FMU's cost in one table (issue 16 item 5),
+ * through the FMU binary (no Python in any timed loop):
  *
  *   - wall time per simulated second against the communication step h
  *     (0.1, 1, 10 ms) and the solver and tolerance (RK4 with rk4_step =
@@ -30,9 +29,9 @@
  * batches of 1 simulated second per cell, the cells interleaved batch by
  * batch; the median, and the minimum in parentheses.
  *
- *   pkm_cost_table [--batches B] [--seconds S] [PKM4PUU.so [modelDescription.xml]]
+ *   pkm_fmu_bench cost [--batches B] [--seconds S] [--fmu SO] [--xml FILE]
  *
- * Prints a Markdown table. Exit status 0, 1 on any failure. */
+ * Prints a Markdown table. */
 #define _GNU_SOURCE
 
 #if defined(__GLIBC__) || defined(__linux__)
@@ -40,21 +39,9 @@
 #endif
 #include <math.h>
 #include <pthread.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <unistd.h>
 
-#include "fmi2FunctionTypes.h"
+#include "bench.h"
 
-#define PKM_HARNESS_NAME "pkm_cost_table"
-#include "fmu_harness.h"
-
-#ifndef PKM_FMU_PLANT_SO
-#define PKM_FMU_PLANT_SO "PKM4PUU.so"
-#endif
-
-#define STATIC_FORCE 2.655616050 /* N */
 #define SLOPE 0.2                /* N/s on F[1] */
 #define MAX_BATCHES 101
 #define N_STEPS 3
@@ -73,32 +60,18 @@ static const struct {
                         {"CVODE rtol 1e-10", 0, 1e-10}};
 
 typedef struct {
-  fmi2ValueReference F[4], control[12], solver, rtol, atol, rk4_step;
-  char guid[128];
+  fmi2ValueReference tolerances[2], rk4_step; /* rtol, atol */
 } Refs;
 
-static Fmu fmu;
+static const Plant* plant; /* the subcommand's, for the worker threads */
+static const Fmu* fmu;
 static Refs refs;
 
-static fmi2Component instantiate(const char* name, int solver, double rtol, double h) {
-  static const fmi2CallbackFunctions cb = {logger, allocate_memory, free, NULL, NULL};
-  fmi2Component c = fmu.fmi2Instantiate(name, fmi2CoSimulation, refs.guid, "", &cb, fmi2False, fmi2False);
-  const fmi2Integer s = solver;
-  const fmi2Real step = h < 1e-3 ? h : 1e-3, atol = rtol / 100.0;
-  int ok = c != NULL;
-  ok = ok && fmu.fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) == fmi2OK;
-  ok = ok && fmu.fmi2SetInteger(c, &refs.solver, 1, &s) == fmi2OK;
-  if (solver == 0)
-    ok = ok && fmu.fmi2SetReal(c, &refs.rtol, 1, &rtol) == fmi2OK && fmu.fmi2SetReal(c, &refs.atol, 1, &atol) == fmi2OK;
-  else
-    ok = ok && fmu.fmi2SetReal(c, &refs.rk4_step, 1, &step) == fmi2OK;
-  ok = ok && fmu.fmi2EnterInitializationMode(c) == fmi2OK && fmu.fmi2ExitInitializationMode(c) == fmi2OK;
-  if (!ok && c) {
-    fmu.fmi2FreeInstance(c);
-    c = NULL;
-  }
-  if (!c) fprintf(stderr, "pkm_cost_table: instantiation failed\n");
-  return c;
+/* CVODE: rtol and atol = rtol / 100; RK4: rk4_step = min(h, 1 ms). */
+static fmi2Component instantiate(const char* name, int solver, double rtol, double h, fmi2FMUstate* home) {
+  const fmi2Real tolerances[2] = {rtol, rtol / 100.0}, step = h < 1e-3 ? h : 1e-3;
+  if (solver == 0) return instantiate_plant(plant, name, solver, 2, refs.tolerances, tolerances, home);
+  return instantiate_plant(plant, name, solver, 1, &refs.rk4_step, &step, home);
 }
 
 /* One simulated second from the instance's current state at time t0. */
@@ -110,19 +83,13 @@ static int simulate_second(fmi2Component c, double t0, double h) {
   for (k = 0; k < n; ++k) {
     const double t = t0 + k * h;
     u[0] = STATIC_FORCE + SLOPE * t, u[1] = u[2] = u[3] = STATIC_FORCE;
-    if (fmu.fmi2SetReal(c, refs.F, 4, u) != fmi2OK || fmu.fmi2SetRealInputDerivatives(c, refs.F, 4, order, du) != fmi2OK ||
-        fmu.fmi2DoStep(c, t, h, fmi2True) != fmi2OK || fmu.fmi2GetReal(c, refs.control, 12, y) != fmi2OK) {
-      fprintf(stderr, "pkm_cost_table: a call failed at t = %g (h = %g)\n", t, h);
+    if (fmu->fmi2SetReal(c, plant->F, 4, u) != fmi2OK || fmu->fmi2SetRealInputDerivatives(c, plant->F, 4, order, du) != fmi2OK ||
+        fmu->fmi2DoStep(c, t, h, fmi2True) != fmi2OK || fmu->fmi2GetReal(c, plant->control, 12, y) != fmi2OK) {
+      fprintf(stderr, PKM_HARNESS_NAME " cost: a call failed at t = %g (h = %g)\n", t, h);
       return 0;
     }
   }
   return 1;
-}
-
-static double median_min(double* v, int n, double* min_out) {
-  qsort(v, (size_t)n, sizeof v[0], compare_double);
-  *min_out = v[0];
-  return v[n / 2];
 }
 
 /* --- batch throughput ----------------------------------------------------------------------------- */
@@ -144,13 +111,12 @@ static void* worker(void* arg) {
   w->sim_seconds = 0.0;
   w->ok = 1;
   while (now_seconds() - start < w->seconds) {
-    fmi2Component c = instantiate("batch", w->solver, w->rtol, 1e-3);
+    fmi2Component c = instantiate("batch", w->solver, w->rtol, 1e-3, NULL);
     if (!c || !simulate_second(c, 0.0, 1e-3)) {
       w->ok = 0;
       return NULL;
     }
-    fmu.fmi2Terminate(c);
-    fmu.fmi2FreeInstance(c);
+    free_plant(plant, c, NULL);
     w->sim_seconds += 1.0;
   }
   w->seconds = now_seconds() - start;
@@ -180,37 +146,24 @@ static double throughput(int n_threads, int solver, double rtol, double seconds,
   return sim / wall;
 }
 
-int main(int argc, char** argv) {
+static int cost_run(const Plant* p, const Options* o) {
+  static const char* const tolerance_names[] = {"rtol", "atol"};
   static double per[N_SOLVERS][N_STEPS][MAX_BATCHES];
-  const char *so = PKM_FMU_PLANT_SO, *xml_arg = NULL;
-  char *xml_path = NULL, *text;
-  int batches = 7, i, j, b, ok = 1, n_pos = 0;
-  double seconds = 3.0;
+  const int batches = o->batches;
+  const double seconds = o->seconds;
+  int i, j, b;
   long cores = sysconf(_SC_NPROCESSORS_ONLN);
-  for (i = 1; i < argc; ++i) {
-    if (strcmp(argv[i], "--batches") == 0 && i + 1 < argc) {
-      batches = atoi(argv[++i]);
-      if (batches < 1 || batches > MAX_BATCHES) return 1;
-    } else if (strcmp(argv[i], "--seconds") == 0 && i + 1 < argc) {
-      seconds = atof(argv[++i]);
-    } else if (n_pos == 0) {
-      so = argv[i], ++n_pos;
-    } else {
-      xml_arg = argv[i], ++n_pos;
-    }
-  }
+  plant = p;
+  fmu = &p->fmu;
   if (cores < 1) cores = 1;
   if (cores > 256) cores = 256;
-  if (!xml_arg) xml_path = default_xml_path(so);
-  text = read_text(xml_arg ? xml_arg : xml_path);
-  ok = read_controller_interface(text, refs.guid, sizeof refs.guid, refs.F, refs.control);
-  ok = ok && lookup_value_reference(text, "solver", &refs.solver) && lookup_value_reference(text, "rtol", &refs.rtol) &&
-       lookup_value_reference(text, "atol", &refs.atol) && lookup_value_reference(text, "rk4_step", &refs.rk4_step);
-  if (!ok || !load_fmu(so, &fmu)) return 1;
+  if (!lookup_value_references(p, tolerance_names, 2, refs.tolerances) ||
+      !lookup_value_reference(p->text, "rk4_step", &refs.rk4_step))
+    return 0;
 
-  printf("pkm_cost_table: the plant FMU's cost (FMI 2.0 CS through dlopen, plain C)\n");
+  printf("pkm_fmu_bench cost: the plant FMU's cost (FMI 2.0 CS through dlopen, plain C)\n");
   print_machine();
-  printf("fmu:     %s\n", so);
+  printf("fmu:     %s\n", p->so);
   printf("online cores: %ld; %d interleaved batches per cell (median, min in parentheses); throughput over %.1f s\n\n",
          cores, batches, seconds);
 
@@ -221,25 +174,20 @@ int main(int argc, char** argv) {
     fmi2FMUstate home[N_SOLVERS][N_STEPS];
     for (i = 0; i < N_SOLVERS; ++i)
       for (j = 0; j < N_STEPS; ++j) {
-        c[i][j] = instantiate("cell", solvers[i].solver, solvers[i].rtol, steps[j]);
         home[i][j] = NULL;
-        if (!c[i][j] || fmu.fmi2GetFMUstate(c[i][j], &home[i][j]) != fmi2OK) return 1;
+        if (!(c[i][j] = instantiate("cell", solvers[i].solver, solvers[i].rtol, steps[j], &home[i][j]))) return 0;
       }
     for (b = -1; b < batches; ++b)
       for (i = 0; i < N_SOLVERS; ++i)
         for (j = 0; j < N_STEPS; ++j) {
           double t0;
-          if (fmu.fmi2SetFMUstate(c[i][j], home[i][j]) != fmi2OK) return 1;
+          if (fmu->fmi2SetFMUstate(c[i][j], home[i][j]) != fmi2OK) return 0;
           t0 = now_seconds();
-          if (!simulate_second(c[i][j], 0.0, steps[j])) return 1;
+          if (!simulate_second(c[i][j], 0.0, steps[j])) return 0;
           if (b >= 0) per[i][j][b] = now_seconds() - t0;
         }
     for (i = 0; i < N_SOLVERS; ++i)
-      for (j = 0; j < N_STEPS; ++j) {
-        fmu.fmi2FreeFMUstate(c[i][j], &home[i][j]);
-        fmu.fmi2Terminate(c[i][j]);
-        fmu.fmi2FreeInstance(c[i][j]);
-      }
+      for (j = 0; j < N_STEPS; ++j) free_plant(p, c[i][j], &home[i][j]);
   }
   printf("| wall time per simulated second (tick: SetReal + SetRealInputDerivatives + DoStep + GetReal of 12) "
          "| h = 0.1 ms | h = 1 ms | h = 10 ms |\n|---|---|---|---|\n");
@@ -260,9 +208,9 @@ int main(int argc, char** argv) {
     malloc_trim(0);
     before = mallinfo2();
     for (j = 0; j < N_MEMORY; ++j)
-      if (!(cs[j] = instantiate("memory", solvers[i].solver, solvers[i].rtol, 1e-3))) return 1;
+      if (!(cs[j] = instantiate("memory", solvers[i].solver, solvers[i].rtol, 1e-3, NULL))) return 0;
     after = mallinfo2();
-    for (j = 0; j < N_MEMORY; ++j) fmu.fmi2FreeInstance(cs[j]);
+    for (j = 0; j < N_MEMORY; ++j) fmu->fmi2FreeInstance(cs[j]);
     printf("| memory per instance, %s, initialised (heap in use / %d instances) | %.1f kB | | |\n", solvers[i].name,
            N_MEMORY, (double)(after.uordblks + after.hblkhd - before.uordblks - before.hblkhd) / N_MEMORY / 1024.0);
   }
@@ -276,11 +224,10 @@ int main(int argc, char** argv) {
     double t_init[N_INIT], t_free[N_INIT], mn_i, mn_f, md_i, md_f;
     for (j = 0; j < N_INIT; ++j) {
       double t0 = now_seconds(), t1;
-      fmi2Component c = instantiate("init", solvers[i].solver, solvers[i].rtol, 1e-3);
+      fmi2Component c = instantiate("init", solvers[i].solver, solvers[i].rtol, 1e-3, NULL);
       t1 = now_seconds();
-      if (!c) return 1;
-      fmu.fmi2Terminate(c);
-      fmu.fmi2FreeInstance(c);
+      if (!c) return 0;
+      free_plant(p, c, NULL);
       t_init[j] = t1 - t0;
       t_free[j] = now_seconds() - t1;
     }
@@ -295,13 +242,14 @@ int main(int argc, char** argv) {
     double got_one, got_all;
     const double one = throughput(1, solvers[i].solver, solvers[i].rtol, seconds, &got_one);
     const double all = throughput((int)cores, solvers[i].solver, solvers[i].rtol, seconds, &got_all);
-    if (one < 0 || all < 0) return 1;
+    if (one < 0 || all < 0) return 0;
     printf("| batch throughput, %s, h = 1 ms, instantiation included: instances × simulated s per wall s | "
            "%.0f on %ld threads, which got %.2f cores' CPU time (per CPU second: %.0f); 1 thread: %.0f (got %.2f) "
            "| | |\n",
            solvers[i].name, all, cores, got_all, all / got_all, one, got_one);
   }
-  free(text);
-  free(xml_path);
-  return 0;
+  return 1;
 }
+
+const Subcommand cost_subcommand = {"cost", "the cost table: time per simulated second, memory, initialisation, throughput",
+                                    cost_run, 7, MAX_BATCHES, "--seconds S (throughput's wall time, default 3)"};

@@ -1,12 +1,11 @@
-/* What the C harnesses share (pkm_fmu_bench, pkm_comparison_bench,
- * pkm_fmu_latency_bench, pkm_cost_table):
+/* What the C harnesses share (pkm_fmu_bench's subcommands, and the C tests
+ * tests/fmu_allocations.c and tests/fmu_alloc_faults.c):
  * loading a built FMU binary with dlopen, a logger that stays silent unless
  * the FMU reports an error, reading modelDescription.xml's attributes and
  * value references, the controller's output names, the
  * clock and the machine's description. Static functions, one copy per
- * harness (the benchmarks, and the C tests tests/fmu_allocations.c and
- * tests/fmu_alloc_faults.c); define PKM_HARNESS_NAME (the program's name,
- * for messages) first. */
+ * file that includes this; define PKM_HARNESS_NAME (the program's name, for
+ * messages) first. */
 #ifndef PKM_BENCH_FMU_HARNESS_H
 #define PKM_BENCH_FMU_HARNESS_H
 
