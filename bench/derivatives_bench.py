@@ -12,7 +12,7 @@ forces there), per call:
                the ratio Jacobian / one ydot comes out below 1; pkm_bench's
                item 1b gives the ratio of the bare evaluations)
     a call     pkm_get_state: what a ctypes call costs by itself
-  Pinocchio, on the independent model (pkm4puu.references), from Python:
+  Pinocchio, on the independent model (pkm4puu.validation.references), from Python:
     dynamics   constraintDynamics (qdd of the 16 coordinates, 12 loop closures)
     derivs     constraintDynamics + computeConstraintDynamicsDerivatives
                (d qdd / d(q, v, tau), 16 x 48)
@@ -40,15 +40,14 @@ import platform
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
 from pkm4puu import capi, motions
-from pkm4puu.cli import machine_description
-from pkm4puu.fmu import REPO
-from pkm4puu.references.pinocchio_derivatives import PinocchioReducedDerivatives
+from pkm4puu.validation.cli import add_build_arg, machine_description
+from pkm4puu.locate import BENCH_PROGRAM, build_dir, build_path
+from pkm4puu.validation.references.pinocchio_derivatives import PinocchioReducedDerivatives
 
 T_STATE = 1.0  # s into the auto-test
 
@@ -64,7 +63,7 @@ class Cases:
     """The timed calls, each a closure over buffers made once."""
 
     def __init__(self, lib):
-        self.model = capi.Model(lib)
+        self.model = capi.Plant(lib)
         pose, rate, acc = motions.autotest_motion(T_STATE)
         F = np.array(self.model.inverse_dynamics(pose, rate, acc).F[:])
         self.y = np.concatenate([pose, rate])
@@ -125,7 +124,7 @@ class Cases:
 
 
 def pkm_bench_1b(build, log):
-    exe = build / "bench" / "pkm_bench"
+    exe = build_path(BENCH_PROGRAM, build)
     if not exe.is_file():
         return [f"{exe} not built"]
     log(f"running {exe} (about 10 s) for its item 1b")
@@ -147,19 +146,22 @@ LABELS = {
 def main(argv=None):
     prog = "derivatives_bench"
     ap = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
-    ap.add_argument("--build", type=Path, default=REPO / "build",
-                    help="build directory holding fmu_src/libpkm.so and bench/pkm_bench (default: %(default)s)")
+    add_build_arg(ap, f"libpkm.so and {BENCH_PROGRAM}")
     ap.add_argument("--rounds", type=int, default=7, help="interleaved rounds (default %(default)s)")
     ap.add_argument("--calls", type=int, default=2000, help="calls per case and round (default %(default)s)")
     ap.add_argument("--no-pkm-bench", action="store_true", help="do not run pkm_bench for its C++ item 1b")
     args = ap.parse_args(argv)
     if args.rounds < 1 or args.calls < 1:
         ap.error("--rounds and --calls must be >= 1")
-    build = args.build.resolve()
 
     def log(msg):
         print(f"{prog}: {msg}", file=sys.stderr, flush=True)
 
+    try:
+        build = build_dir(args.build)
+    except FileNotFoundError as e:
+        log(f"error: {e}")
+        return 1
     lib_path = capi.library_path(build)
     if not lib_path.is_file():
         log(f"error: {lib_path} not found: build the project first, or pass --build DIR")

@@ -4,7 +4,7 @@ driven open loop by those forces at a 1 ms communication step for 2 s, must
 reproduce the prescribed pose.
 
 The runner, the three input modes (a) midpoint, (b) first order, (c) zero-order
-hold, and the result writers are in pkm4puu.autotest (the main job runs the
+hold, and the result writers are in pkm4puu.validation.autotest (the main job runs the
 same code); the checks are here:
 
 (a) and (b) must reproduce the prescribed motion to TOL_POS / TOL_PHI with
@@ -17,10 +17,10 @@ same code); the checks are here:
 import numpy as np
 import pytest
 
-from pkm4puu.autotest import (BOUNDED_MODES, SOLVERS, TOL_PHI, TOL_POS, format_table, half_step_forces, run_all,
+from pkm4puu.validation.autotest import (BOUNDED_MODES, SOLVERS, TOL_PHI, TOL_POS, format_table, half_step_forces, run_all,
                           write_results)
 from pkm4puu.fmu import Fmu, inverse_forces
-from pkm4puu.interface import arr, POSE
+from pkm4puu.interface import indexed_names, POSE
 from pkm4puu.spec import P0, P1, STATIC_FORCE_P0, TOTAL_WEIGHT
 
 
@@ -58,7 +58,7 @@ def test_inverse_fmu_golden_poses(inverse_fmu, pose):
     q, expected = GOLDEN_RHO[pose]
     with Fmu(inverse_fmu) as inv:
         inv.set(POSE, q)
-        rho = inv.get(arr("rho", 4))
+        rho = inv.get(indexed_names("rho", 4))
     assert np.all(np.abs(rho - expected) <= 1e-9), f"rho at {pose} = {rho}, spec {expected}"
 
 

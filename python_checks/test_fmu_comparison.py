@@ -1,7 +1,7 @@
 """The paper's comparison test (section 5.2, MODEL_SPEC "Comparison test")
 through the plant FMU: 1.5 s from rest at P0, gravity off, F2 = F3 = 0,
 F1(t) = 0.02 N sin(2 pi t / 1.5 s) = -F4(t), midpoint-held at a 1 ms step.
-The runner and the result writer are in pkm4puu.comparison (the main job runs
+The runner and the result writer are in pkm4puu.validation.comparison (the main job runs
 the same code).
 
 Checked facts, each following from the model rather than from a past run:
@@ -16,7 +16,7 @@ Checked facts, each following from the model rather than from a past run:
 """
 import pytest
 
-from pkm4puu.comparison import (TOL_PHI, TOL_POS, max_constraint_residual, max_delta_rho1, nonfinite_outputs,
+from pkm4puu.validation.comparison import (TOL_PHI, TOL_POS, max_constraint_residual, max_delta_rho1, nonfinite_outputs,
                             run_all, solver_difference, vertical_com_drift, write_results)
 
 

@@ -31,7 +31,7 @@ import numpy as np
 import pytest
 from fmpy.util import add_remoting
 
-from pkm4puu.autotest import SOLVERS, TOL_PHI, TOL_POS, half_step_forces, run_case
+from pkm4puu.validation.autotest import SOLVERS, TOL_PHI, TOL_POS, half_step_forces, run_case
 from pkm4puu.fmu import Fmu
 
 PLATFORMS = {2: {"linux64", "win64"}, 3: {"x86_64-linux", "x86_64-windows", "aarch64-linux"}}

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import pkm4puu as pkm
-from pkm4puu.fmu import REPO
+from conftest import REPO
 
 MARKER = "The auto-test in a few lines:"
 

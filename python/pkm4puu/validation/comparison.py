@@ -19,7 +19,7 @@ The quantities (each bounded by test_fmu_comparison.py):
 - CVODE vs RK4: two different integrators must agree;
 - max |delta rho1|: the motion must be non-trivial.
 
-usage: python -m pkm4puu.comparison [--build DIR] [--out DIR]
+usage: python -m pkm4puu comparison [--build DIR] [--out DIR]
 """
 import argparse
 import csv
@@ -27,18 +27,15 @@ import math
 import sys
 from pathlib import Path
 
-import matplotlib
 import numpy as np
 
 from .cli import add_common_args, case_table, finish, run_cases, start
-from .fmu import Fmu, run
-from .interface import F, POSE, START_P0, arr
-from .motions import comparison_forces
-from .spec import CMP_AMPLITUDE, CMP_DURATION, L as L_ROD, M_PLATFORM, M_ROD, M_SLIDER, STEP
-from .plots import save_figure
+from ..fmu import Fmu, run
+from ..interface import F, POSE, START_P0, indexed_names
+from ..motions import comparison_forces
+from ..spec import CMP_AMPLITUDE, CMP_DURATION, L as L_ROD, M_PLATFORM, M_ROD, M_SLIDER, STEP
+from .plots import pyplot, save_figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 
 H = STEP
 N = round(CMP_DURATION / H)
@@ -48,7 +45,7 @@ TOL_PHI = 1e-7  # rad
 # here they only label the table.
 TOL_CONSTRAINT = 1e-12  # m, max ||C(q)||
 MIN_DELTA_RHO1 = 1e-5  # m, below this the forces barely moved the machine
-OUT = POSE + arr("rho", 4) + arr("theta2", 4) + ["constraint_residual"]
+OUT = POSE + indexed_names("rho", 4) + indexed_names("theta2", 4) + ["constraint_residual"]
 START = {"g": 0.0, **START_P0}
 # Integrators. RK4 at 1 ms is the paper's. CVODE's rtol bounds only the local
 # error of each internal step, relative to |y| (~0.05 m, and phi swings to
@@ -114,7 +111,7 @@ def vertical_com_drift(r):
 
 def solver_difference(a, b):
     """(largest |a - b| over x, y, z, rho1..rho4 (m), largest |a - b| of phi (rad))."""
-    d_pos = max(np.abs(a[n] - b[n]).max() for n in ["x", "y", "z"] + arr("rho", 4))
+    d_pos = max(np.abs(a[n] - b[n]).max() for n in ["x", "y", "z"] + indexed_names("rho", 4))
     d_phi = np.abs(a["phi"] - b["phi"]).max()
     return d_pos, d_phi
 
@@ -146,7 +143,7 @@ def write_results(runs, out_dir):
     r = runs["CVODE"]
     t = r["t"]
     d_rho1 = delta_rho1(r)
-    cols = ["x", "y", "z", "phi"] + arr("rho", 4)
+    cols = ["x", "y", "z", "phi"] + indexed_names("rho", 4)
     csv_path = out_dir / "comparison.csv"
     with open(csv_path, "w", newline="") as f:
         w = csv.writer(f)
@@ -154,6 +151,7 @@ def write_results(runs, out_dir):
         for i in range(len(t)):
             w.writerow([f"{t[i]:.6f}"] + [f"{r[c][i]:.12e}" for c in cols] + [f"{d_rho1[i]:.12e}"])
 
+    plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(9, 6), sharex=True)
     for ax, name, scale, unit in zip(axes.flat, POSE, (1e3, 1e3, 1e3, 180 / math.pi), ("mm", "mm", "mm", "deg")):
         ax.plot(t, scale * r[name])
@@ -179,7 +177,7 @@ def write_results(runs, out_dir):
 
 # --- command line ---------------------------------------------------------------------------
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m pkm4puu.comparison",
+    ap = argparse.ArgumentParser(prog="python -m pkm4puu comparison",
                                  description="The paper's comparison test (section 5.2) through the plant FMU, "
                                  "with CVODE and with RK4.")
     add_common_args(ap)

@@ -26,26 +26,23 @@ of max errors and writes to --out DIR:
                             (midpoint input, CVODE)
   fmu_autotest_forces.png   F1..F4 from the inverse FMU
 
-usage: python -m pkm4puu.autotest [--build DIR] [--out DIR]
+usage: python -m pkm4puu autotest [--build DIR] [--out DIR]
 """
 import argparse
 import csv
 import sys
 from pathlib import Path
 
-import matplotlib
 import numpy as np
 
 from . import plots
 from .cli import add_common_args, case_table, finish, run_cases, start
-from .fmu import Fmu, inverse_forces, run
-from .interface import ACC, F, POSE, START_P0, VEL
-from .motions import p
-from .spec import STEP as H, T_MOVE
-from .plots import save_figure
+from ..fmu import Fmu, inverse_forces, run
+from ..interface import ACC, F, POSE, START_P0, VEL
+from ..motions import pose_at
+from ..spec import STEP as H, T_MOVE
+from .plots import pyplot, save_figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 
 N = round(T_MOVE / H)
 # Bounds that test_fmu_autotest.py asserts for the BOUNDED_MODES; the ZOH mode
@@ -98,7 +95,7 @@ def static_forces(inverse_fmu, times):
     with Fmu(inverse_fmu) as inv:
         vr_in, vr_out = inv.vrs(POSE + VEL + ACC), inv.vrs(F)
         for i, t in enumerate(times):
-            inv.fmu.setReal(vr_in, [*p(t), *[0.0] * 8])
+            inv.fmu.setReal(vr_in, [*pose_at(t), *[0.0] * 8])
             out[i] = inv.fmu.getReal(vr_out)
     return out
 
@@ -169,7 +166,7 @@ def run_case(plant_fmu, mode, solver, Fh):
             raise RuntimeError(f"{Path(plant_fmu).name} does not declare canInterpolateInputs: "
                                "first-order input interpolation is not available")
         t, Y = run(fmu, 0.0, H, N, inputs(mode, Fh), POSE)
-    return CaseResult(t, Y, np.array([p(ti) for ti in t]))
+    return CaseResult(t, Y, np.array([pose_at(ti) for ti in t]))
 
 
 def run_all(plant_fmu, Fh, log=None, errors=None):
@@ -210,6 +207,7 @@ def write_csv(runs, path):
 
 
 def plot_errors(runs, path):
+    plt = pyplot()
     fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
     for (m, s), r in runs.items():
         style = "-" if s == "CVODE" else "--"
@@ -260,7 +258,7 @@ def write_results(runs, Fh, inverse_fmu, out_dir):
 
 # --- command line ---------------------------------------------------------------------------
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m pkm4puu.autotest",
+    ap = argparse.ArgumentParser(prog="python -m pkm4puu autotest",
                                  description="The paper's auto-test (section 5.1) through the FMUs: inverse FMU "
                                  "-> F1..F4 -> plant FMU, open loop, 1 ms communication step, 2 s.")
     add_common_args(ap)
