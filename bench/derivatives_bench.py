@@ -45,8 +45,8 @@ import numpy as np
 import pinocchio as pin
 
 from pkm4puu import capi, motions
-from pkm4puu.validation.cli import add_build_arg, machine_description
-from pkm4puu.locate import BENCH_PROGRAM, build_dir, build_path
+from pkm4puu.validation.cli import add_build_arg, find_build, machine_description, prefixed_log
+from pkm4puu.locate import BENCH_PROGRAM, build_path
 from pkm4puu.validation.references.pinocchio_derivatives import PinocchioReducedDerivatives
 
 T_STATE = 1.0  # s into the auto-test
@@ -153,14 +153,9 @@ def main(argv=None):
     args = ap.parse_args(argv)
     if args.rounds < 1 or args.calls < 1:
         ap.error("--rounds and --calls must be >= 1")
-
-    def log(msg):
-        print(f"{prog}: {msg}", file=sys.stderr, flush=True)
-
-    try:
-        build = build_dir(args.build)
-    except FileNotFoundError as e:
-        log(f"error: {e}")
+    log = prefixed_log(prog)
+    build = find_build(args.build, log)
+    if build is None:
         return 1
     lib_path = capi.library_path(build)
     if not lib_path.is_file():

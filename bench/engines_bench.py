@@ -59,8 +59,8 @@ import mujoco.rollout
 import pinocchio as pin
 
 from pkm4puu import motions, spec
-from pkm4puu.validation.cli import add_build_arg, machine_description
-from pkm4puu.locate import BENCH_PROGRAM, COMPARISON_BENCH_PROGRAM, build_dir, build_path
+from pkm4puu.validation.cli import add_build_arg, find_build, machine_description, prefixed_log
+from pkm4puu.locate import BENCH_PROGRAM, COMPARISON_BENCH_PROGRAM, build_path
 from pkm4puu.validation.references import mujoco_model
 from pkm4puu.validation.engine_comparison import deviation, pinocchio_reference
 from pkm4puu.validation.references.pinocchio_model import PinocchioPKM
@@ -277,14 +277,9 @@ def main(argv=None):
                     help="timed batches of 1 simulated second per case and round (default 5)")
     ap.add_argument("--markdown", type=Path, help="also write the table, in Markdown, to this file")
     args = ap.parse_args(argv)
-
-    def log(msg):
-        print(f"{prog}: {msg}", file=sys.stderr, flush=True)
-
-    try:
-        build = build_dir(args.build)
-    except FileNotFoundError as e:
-        log(f"error: {e}")
+    log = prefixed_log(prog)
+    build = find_build(args.build, log)
+    if build is None:
         return 1
 
     mj, pb = MuJoCoBench(), PinocchioBench()

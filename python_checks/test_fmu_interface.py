@@ -15,14 +15,15 @@ MASSES = ["m_slider", "m_rod"] + indexed_names("I_rod", 3) + ["m_platform", "Izz
 
 PLANT = {
     "input": indexed_names("F", 4) + WRENCH,
-    "output": POSE + VEL + indexed_names("rho", 4) + indexed_names("drho", 4) + indexed_names("theta1", 4) + indexed_names("theta2", 4)
-    + indexed_names("lambda", 12) + ["constraint_residual", "jacobian_condition"],
+    "output": POSE + VEL + indexed_names("rho", 4) + indexed_names("drho", 4) + indexed_names("theta1", 4)
+    + indexed_names("theta2", 4) + indexed_names("lambda", 12) + ["constraint_residual", "jacobian_condition"],
     "parameter": GEOMETRY + MASSES + ["x0", "y0", "z0", "phi0", "dx0", "dy0", "dz0", "dphi0",
                                       "solver", "rk4_step", "rtol", "atol"],
 }
 INVERSE = {
     "input": POSE + VEL + ACC + WRENCH,
-    "output": indexed_names("F", 4) + indexed_names("rho", 4) + indexed_names("drho", 4) + indexed_names("lambda", 12),
+    "output": indexed_names("F", 4) + indexed_names("rho", 4) + indexed_names("drho", 4)
+    + indexed_names("lambda", 12),
     "parameter": GEOMETRY + MASSES,
 }
 

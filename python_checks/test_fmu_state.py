@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 
 from pkm4puu.fmu import Fmu
-from pkm4puu.interface import indexed_names, F, POSE, VEL
+from pkm4puu.interface import DRHO, F, POSE, RHO, THETA1, THETA2, VEL, indexed_names
 from pkm4puu.spec import STATIC_FORCE_P0
 
 H = 1e-3
 T_SAVE, T_END = 1.0, 1.5
-OUT = (POSE + VEL + indexed_names("rho", 4) + indexed_names("drho", 4) + indexed_names("theta1", 4) + indexed_names("theta2", 4)
+OUT = (POSE + VEL + RHO + DRHO + THETA1 + THETA2
        + indexed_names("lambda", 12) + ["constraint_residual", "jacobian_condition"])
 SOLVERS = {"CVODE": {"solver": 0, "rtol": 1e-9}, "RK4": {"solver": 1, "rk4_step": 5e-4}}
 

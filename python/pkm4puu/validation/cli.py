@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 from ..fmu import find_fmu
-from ..locate import BUILD_ENV, DEFAULT_BUILD
+from ..locate import BUILD_ENV, DEFAULT_BUILD, build_dir
 
 
 class Log:
@@ -23,6 +23,13 @@ class Log:
 
     def __call__(self, msg):
         print(f"{self.prog} [{time.perf_counter() - self.t0:6.1f} s]: {msg}", file=sys.stderr, flush=True)
+
+
+def prefixed_log(prog):
+    """log(message): "<prog>: <message>" on stderr (without Log's elapsed time)."""
+    def log(msg):
+        print(f"{prog}: {msg}", file=sys.stderr, flush=True)
+    return log
 
 
 def machine_description():
@@ -56,6 +63,16 @@ def add_out_arg(ap, files="CSV, PNG and GIF files"):
 def add_common_args(ap):
     add_build_arg(ap)
     add_out_arg(ap)
+
+
+def find_build(build, log):
+    """The build directory (locate.build_dir(build): --build, else
+    $PKM_BUILD_DIR, else ./build), or None after logging why there is none."""
+    try:
+        return build_dir(build)
+    except FileNotFoundError as e:
+        log(f"error: {e}")
+        return None
 
 
 def find_fmus(build, log, models=("PKM4PUU", "PKM4PUU_Inverse")):

@@ -58,9 +58,9 @@ import pinocchio as pin
 from scipy.integrate import solve_ivp
 
 from .. import capi as pkm_capi, motions, spec
-from ..locate import build_dir, fmu_path
+from ..locate import fmu_path
 from .references import mujoco_model
-from .cli import add_build_arg, add_out_arg
+from .cli import add_build_arg, add_out_arg, find_build, prefixed_log
 from .plots import pyplot, save_figure
 from .references.pinocchio_model import PinocchioPKM
 
@@ -747,20 +747,16 @@ def check(r):
 # --- command line ---------------------------------------------------------------------------------------------
 def main(argv=None):
     prog = "engines"
-    ap = argparse.ArgumentParser(prog="python -m pkm4puu engines", description="Validation against Pinocchio and MuJoCo models of the "
-                                 "same mechanism (inverse dynamics along the auto-test, the comparison test).")
+    ap = argparse.ArgumentParser(prog="python -m pkm4puu engines",
+                                 description="Validation against Pinocchio and MuJoCo models of the same mechanism "
+                                 "(inverse dynamics along the auto-test, the comparison test).")
     add_build_arg(ap, "libpkm.so and the FMUs")
     add_out_arg(ap, "CSV and PNG files")
     ap.add_argument("--no-sweep", action="store_true", help="skip the table of MuJoCo constraint settings")
     args = ap.parse_args(argv)
-
-    def log(msg):
-        print(f"{prog}: {msg}", file=sys.stderr, flush=True)
-
-    try:
-        build = build_dir(args.build)
-    except FileNotFoundError as e:
-        log(f"error: {e}")
+    log = prefixed_log(prog)
+    build = find_build(args.build, log)
+    if build is None:
         return 1
     plant, inverse = fmu_path("PKM4PUU", 2, build), fmu_path("PKM4PUU_Inverse", 2, build)
     for path in (plant, inverse, pkm_capi.library_path(build)):
