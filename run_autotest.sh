@@ -7,6 +7,6 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")"
 ./scripts/build.sh
 build/bin/pkm_autotest --out results
-.venv/bin/python -m pkm4puu.plot_cpp_autotest results
-.venv/bin/python -m pkm4puu.autotest --build build --out results
-.venv/bin/python -m pkm4puu.comparison --build build --out results
+.venv/bin/python -m pkm4puu plot-autotest results
+.venv/bin/python -m pkm4puu autotest --build build --out results
+.venv/bin/python -m pkm4puu comparison --build build --out results

@@ -7,7 +7,7 @@ step, through
                  FMU through the C harness (build/bench/pkm_fmu_bench compare,
                  plain C: no Python in any timed loop);
   MuJoCo         mj_step, RK4, 1 ms, the stiffest connect constraints
-                 (pkm4puu.references.mujoco_model), timed in
+                 (pkm4puu.validation.references.mujoco_model), timed in
                  mujoco.rollout (MuJoCo's own C loop) and, for context, in a
                  Python loop of mj_step (its Python overhead per step is
                  printed);
@@ -59,11 +59,11 @@ import mujoco.rollout
 import pinocchio as pin
 
 from pkm4puu import motions, spec
-from pkm4puu.cli import machine_description
-from pkm4puu.fmu import REPO
-from pkm4puu.references import mujoco_model
-from pkm4puu.references.engine_comparison import deviation, pinocchio_reference
-from pkm4puu.references.pinocchio_model import PinocchioPKM
+from pkm4puu.validation.cli import add_build_arg, find_build, machine_description, prefixed_log
+from pkm4puu.locate import BENCH_PROGRAM, FMU_BENCH_PROGRAM, build_path
+from pkm4puu.validation.references import mujoco_model
+from pkm4puu.validation.engine_comparison import deviation, pinocchio_reference
+from pkm4puu.validation.references.pinocchio_model import PinocchioPKM
 
 H = 1e-3
 STEPS_TIMED = 1000  # one simulated second
@@ -79,7 +79,7 @@ def _rows_from_q(Q):
 # --- this project, through the C harness ---------------------------------------------------------------
 def run_c_harness(build, batches, log, keep_runs=True):
     """One run of the C harness: {case: {"what", "median", "min", "max_c", "run"}}, and its stdout."""
-    exe = build / "bench" / "pkm_fmu_bench"
+    exe = build_path(FMU_BENCH_PROGRAM, build)
     if not exe.is_file():
         raise FileNotFoundError(f"{exe} not found: build the project first (cmake --build {build})")
     with tempfile.TemporaryDirectory() as tmp:
@@ -233,7 +233,7 @@ def derivatives_comparison(build, median):
     print(f"derivatives, Pinocchio: constraintDynamics {1e6 * t_cd:.1f} us, with "
           f"computeConstraintDynamicsDerivatives {1e6 * t_dd:.1f} us per call (16 coordinates, 4 constraints, "
           f"from Python): {t_dd / t_cd:.2f}x")
-    exe = build / "bench" / "pkm_bench"
+    exe = build_path(BENCH_PROGRAM, build)
     if not exe.exists():
         print(f"derivatives, this project: {exe} not built")
         return
@@ -269,8 +269,7 @@ LABELS = {  # harness case: (label, how the forces reach the integrator)
 def main(argv=None):
     prog = "engines_bench"
     ap = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
-    ap.add_argument("--build", type=Path, default=REPO / "build",
-                    help="build directory holding bench/pkm_fmu_bench (default: %(default)s)")
+    add_build_arg(ap, FMU_BENCH_PROGRAM)
     ap.add_argument("--rounds", type=int, default=5,
                     help="rounds; each times every case, interleaved, so that a burst of load on a shared "
                          "machine spreads over all of them (default 5)")
@@ -278,10 +277,10 @@ def main(argv=None):
                     help="timed batches of 1 simulated second per case and round (default 5)")
     ap.add_argument("--markdown", type=Path, help="also write the table, in Markdown, to this file")
     args = ap.parse_args(argv)
-    build = args.build.resolve()
-
-    def log(msg):
-        print(f"{prog}: {msg}", file=sys.stderr, flush=True)
+    log = prefixed_log(prog)
+    build = find_build(args.build, log)
+    if build is None:
+        return 1
 
     mj, pb = MuJoCoBench(), PinocchioBench()
     times = {}  # case -> list of per-round medians; best[case] = min over everything

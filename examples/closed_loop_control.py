@@ -45,10 +45,10 @@ import sys
 import matplotlib
 import numpy as np
 
-from pkm4puu.cli import add_common_args, run_program
+from pkm4puu.validation.cli import add_common_args, run_program
 from pkm4puu.closed_loop import run_closed_loop
-from pkm4puu.plots import save_figure
-from pkm4puu.drawing import write_run_csv
+from pkm4puu.validation.plots import save_figure
+from pkm4puu.validation.drawing import write_run_csv
 from pkm4puu.interface import RK4, START_P0
 from pkm4puu.spec import STEP as H, T_MOVE
 

@@ -48,8 +48,8 @@ from pathlib import Path
 import numpy as np
 
 import pkm4puu
-from pkm4puu.cli import add_common_args, start, write_outputs
-from pkm4puu.plots import save_figure
+from pkm4puu.validation.cli import add_common_args, start, write_outputs
+from pkm4puu.validation.plots import save_figure
 from pkm4puu.fmu import Fmu
 from pkm4puu.interface import ACC, F, POSE, RK4, START_P0, VEL
 from pkm4puu.motions import motion

@@ -33,17 +33,17 @@ from dataclasses import dataclass
 import matplotlib
 import numpy as np
 
-from pkm4puu.cli import add_common_args, run_program
-from pkm4puu.plots import save_figure
+from pkm4puu.validation.cli import add_common_args, run_program
+from pkm4puu.validation.plots import save_figure
 from pkm4puu.fmu import Fmu
-from pkm4puu.interface import ACC, arr, DRHO, F, POSE, RHO, VEL
+from pkm4puu.interface import ACC, indexed_names, DRHO, F, POSE, RHO, VEL
 from pkm4puu.motions import motion
 from pkm4puu.spec import STEP as H, T_MOVE
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-TAU = arr("tau", 4)
+TAU = indexed_names("tau", 4)
 
 # --- the machine ---------------------------------------------------------------------------
 # Lead 4 mm (the spec's default; an 8 mm x 4 mm mini ball screw). Rotor

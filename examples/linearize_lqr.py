@@ -52,14 +52,14 @@ import matplotlib
 import numpy as np
 import scipy.linalg as sla
 
-from pkm4puu.cli import add_common_args, run_program
-from pkm4puu.plots import save_figure
+from pkm4puu.validation.cli import add_common_args, run_program
+from pkm4puu.validation.plots import save_figure
 from pkm4puu.closed_loop import run_closed_loop
 from pkm4puu.fmu import Fmu
 from pkm4puu.interface import F, POSE, RK4, VEL, start_pose
 from pkm4puu.linearization import INPUTS, ModelExchange
 from pkm4puu.motions import autotest_motion
-from pkm4puu.references.pinocchio_derivatives import PinocchioReducedDerivatives
+from pkm4puu.validation.references.pinocchio_derivatives import PinocchioReducedDerivatives
 from pkm4puu import spec
 from pkm4puu.spec import STEP as H, T_MOVE
 

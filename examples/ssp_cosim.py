@@ -29,7 +29,7 @@ the midpoint of the plant's next step, and the SSP's initial values (seen
 during libcosim's initialisation, which transfers them before the first step)
 are the motion at h/2. The plant then holds over every step [t_k, t_k + h] the
 force F(t_k + h/2): exactly the midpoint-held case of
-pkm4puu.autotest, whose max pose error over the 2 s is O(h^2):
+pkm4puu.validation.autotest, whose max pose error over the 2 s is O(h^2):
 ~1.1e-8 m with CVODE. With no lead (inputs at t_k) the plant would hold
 F(t_k - h) over [t_k, t_k + h], a lag of 3h/2: an O(h) error of ~3e-5 m.
 
@@ -51,11 +51,11 @@ from xml.sax.saxutils import quoteattr
 import matplotlib
 import numpy as np
 
-from pkm4puu.cli import add_common_args, start, write_outputs
+from pkm4puu.validation.cli import add_common_args, start, write_outputs
 from pkm4puu.closed_loop import PoseErrors
-from pkm4puu.plots import save_figure
+from pkm4puu.validation.plots import save_figure
 from pkm4puu.interface import ACC, F, POSE, START_P0, VEL
-from pkm4puu.motions import motion, p
+from pkm4puu.motions import motion, pose_at
 from pkm4puu.spec import STEP as H, T_MOVE
 
 matplotlib.use("Agg")
@@ -66,7 +66,7 @@ H_NS = 1_000_000  # libcosim counts time in integer nanoseconds: 1 ms
 N_STEPS = round(T_MOVE / H)
 LEAD = 1.5  # steps: the inverse FMU's inputs lead the plant by 3h/2 (see the module's doc)
 SOLVERS = {"cvode": 0, "rk4": 1}
-# What test_examples_ssp.py requires: the bound pkm4puu.autotest
+# What test_examples_ssp.py requires: the bound pkm4puu.validation.autotest
 # holds the midpoint-held case to (the libcosim run is that case), and
 # agreement with that fmpy run to rounding.
 TOL_POS = 5e-8  # m
@@ -171,7 +171,7 @@ def write_ssp(plant_fmu, inverse_fmu, path, solver="cvode", lead=LEAD):
 @dataclass
 class SspRun(PoseErrors):
     """Communication times t (s), the plant's pose (x, y, z, phi) there and
-    the prescribed pose pose_d; pos_err (m) and phi_err (rad) as in pkm4puu.autotest."""
+    the prescribed pose pose_d; pos_err (m) and phi_err (rad) as in pkm4puu.validation.autotest."""
     t: np.ndarray
     pose: np.ndarray
     pose_d: np.ndarray
@@ -221,7 +221,7 @@ def run_ssp(ssp_path, lead=LEAD, n_steps=N_STEPS, log=None):
     now = execution.status().current_time
     if now != n_steps * H_NS:
         raise RuntimeError(f"libcosim stopped at {now} ns, not {n_steps * H_NS} ns")
-    return SspRun(t, poses, np.array([p(ti) for ti in t]))
+    return SspRun(t, poses, np.array([pose_at(ti) for ti in t]))
 
 
 def write_csv(runs, path):

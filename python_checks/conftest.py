@@ -1,18 +1,28 @@
-"""Shared fixtures: where the FMUs are and where results go.
+"""Shared fixtures: where the repository, the FMUs and the C API are and
+where results go.
 
-The FMUs are taken from $PKM_BUILD_DIR (default <repo>/build, see
-pkm4puu.build_dir). A missing FMU is a failure, not a skip: these checks
+The checks know the repository (it is where they are) and the package does
+not: the build directory is $PKM_BUILD_DIR, else <repo>/build, which is set
+as PKM_BUILD_DIR for everything the checks run (pkm4puu.locate.build_dir,
+the example programs). A missing FMU is a failure, not a skip: these checks
 exist to test the built FMUs.
 """
+import os
 from pathlib import Path
 
 import pytest
 
-from pkm4puu.fmu import REPO, build_dir
+from pkm4puu import locate
+
+REPO = Path(__file__).resolve().parents[1]
+os.environ[locate.BUILD_ENV] = str(Path(os.environ.get(locate.BUILD_ENV) or REPO / "build").resolve())
+BUILD = locate.build_dir()
+# The C API's header, whose structs capi's binding must match.
+PKM_HEADER = REPO / "src" / "pkm4puu" / "pkm.h"
 
 
 def _require_fmu(name: str) -> Path:
-    path = build_dir() / name
+    path = locate.build_path(name, BUILD)
     if not path.is_file():
         pytest.fail(
             f"{path} does not exist: build the FMUs first with ./run_tests.sh "
@@ -33,9 +43,15 @@ def _built(name: str, what: str):
 
 plant_fmu = _built("PKM4PUU.fmu", "the forward-dynamics plant")
 inverse_fmu = _built("PKM4PUU_Inverse.fmu", "the algebraic inverse dynamics")
-pkm_library = _built("lib/libpkm.so", "the plain C API (pkm.h)")
-plant_fmu3 = _built("fmi3/PKM4PUU.fmu", "the plant as FMI 3.0 (Co-Simulation and Model Exchange)")
-inverse_fmu3 = _built("fmi3/PKM4PUU_Inverse.fmu", "the inverse dynamics as FMI 3.0")
+pkm_library = _built(locate.LIBRARY, "the plain C API (pkm.h)")
+plant_fmu3 = _built(f"{locate.FMI3_DIR}/PKM4PUU.fmu", "the plant as FMI 3.0 (Co-Simulation and Model Exchange)")
+inverse_fmu3 = _built(f"{locate.FMI3_DIR}/PKM4PUU_Inverse.fmu", "the inverse dynamics as FMI 3.0")
+
+
+@pytest.fixture(scope="session")
+def pkm_header() -> Path:
+    """The C API's header pkm.h in the source tree."""
+    return PKM_HEADER
 
 
 @pytest.fixture(scope="session")
@@ -49,4 +65,5 @@ def results_dir() -> Path:
 def dist_fmus() -> dict:
     """dist/fmi<v>/<id>.fmu: one archive per FMU and FMI version holding every
     platform and the source code (cmake/Platforms.cmake), keyed (version, id)."""
-    return {(v, i): _require_fmu(f"dist/fmi{v}/{i}.fmu") for v in (2, 3) for i in ("PKM4PUU", "PKM4PUU_Inverse")}
+    return {(v, i): _require_fmu(str(locate.dist_fmu_path(i, v, BUILD).relative_to(BUILD)))
+            for v in (2, 3) for i in ("PKM4PUU", "PKM4PUU_Inverse")}

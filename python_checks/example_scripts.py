@@ -2,9 +2,8 @@
 that their tests can call their functions (they are scripts, not a package)."""
 import importlib.util
 import sys
-from pathlib import Path
 
-from pkm4puu.fmu import REPO
+from conftest import REPO
 
 
 def load_example(name):

@@ -38,8 +38,8 @@ import pytest
 from differences import richardson
 from pkm4puu import capi as pkm_capi, motions, spec
 from pkm4puu.linearization import ModelExchange
-from pkm4puu.references.pinocchio_derivatives import PinocchioReducedDerivatives
-from pkm4puu.references.pinocchio_model import PinocchioPKM
+from pkm4puu.validation.references.pinocchio_derivatives import PinocchioReducedDerivatives
+from pkm4puu.validation.references.pinocchio_model import PinocchioPKM
 
 TOL = 1e-6  # the bound, relative per column (see above)
 TOL_SANITY = 1e-7  # Pinocchio's assembly against differences of its own ydot
@@ -110,7 +110,7 @@ def capi_derivatives(pkm_library):
     lib = pkm_capi.load(pkm_library)
     out = {}
     for case, machine in CASES.items():
-        with pkm_capi.Model(lib, machine=machine) as m:
+        with pkm_capi.Plant(lib, machine=machine) as m:
             out[case] = {name: m.forward_derivatives(y_of(s), U) for name, s in STATES.items()}
     return out
 
@@ -213,7 +213,7 @@ def test_inverse_derivatives_invert_pinocchio_forward_ones(pkm_library, pinocchi
     lib = pkm_capi.load(pkm_library)
     g = gear(CASES[case])
     worst = 0.0
-    with pkm_capi.Model(lib, machine=CASES[case]) as m:
+    with pkm_capi.Plant(lib, machine=CASES[case]) as m:
         for name, (pose, rate) in STATES.items():
             ydot, A, B = ref[name]
             F, dF = m.inverse_derivatives(pose, rate, ydot[4:], U[4:8])

@@ -35,12 +35,14 @@ import math
 import numpy as np
 import pytest
 
-from pkm4puu.references.engine_comparison import (AUTOTEST_TIMES, CAPI_SOLVERS, EFFECT_FACTOR, MUJOCO_MACHINE_CONSTRAINT, STOP_MARGIN,
-                               TOL_CONSTRAINT, TOL_MACHINE_ID, TOL_MACHINE_PHI, TOL_MACHINE_POS, TOL_PHI, TOL_POS,
-                               TOL_REF_PHI, TOL_REF_POS, capi_inverse_machine, deviation, format_machine_table,
-                               load_capi, machine_cases, machine_run, pinocchio_inverse_machine)
+from pkm4puu.validation.engine_comparison import (AUTOTEST_TIMES, CAPI_SOLVERS, EFFECT_FACTOR,
+                                                  MUJOCO_MACHINE_CONSTRAINT, STOP_MARGIN, TOL_CONSTRAINT,
+                                                  TOL_MACHINE_ID, TOL_MACHINE_PHI, TOL_MACHINE_POS, TOL_PHI, TOL_POS,
+                                                  TOL_REF_PHI, TOL_REF_POS, capi_inverse_machine, deviation,
+                                                  format_machine_table, load_capi, machine_cases, machine_run,
+                                                  pinocchio_inverse_machine)
 from pkm4puu import capi as pkm_capi, spec
-from pkm4puu.references.pinocchio_model import LEG_ROWS, PinocchioPKM
+from pkm4puu.validation.references.pinocchio_model import LEG_ROWS, PinocchioPKM
 
 CASES = machine_cases()
 
@@ -206,7 +208,7 @@ def test_inverse_machine_motor_torques(inverse_capi, inverse_pinocchio):
 def test_holding_forces_match_pinocchio(lib, pose):
     """F_hold (pkm_get_machine_outputs) at rest against Pinocchio's static inverse dynamics with the payload."""
     F_pin = PinocchioPKM(g=spec.G, machine=FULL).inverse_dynamics(pose, np.zeros(4), np.zeros(4))[0]
-    with pkm_capi.Model(lib, machine=FULL.capi_params()) as m:
+    with pkm_capi.Plant(lib, machine=FULL.capi_params()) as m:
         m.init_pose(0.0, pose)
         F_hold = np.array(m.machine_outputs().F_hold)
     d = np.abs(F_hold - F_pin).max()

@@ -27,8 +27,8 @@ import pinocchio as pin
 import pytest
 
 from pkm4puu import motions, spec
-from pkm4puu.references import mujoco_model
-from pkm4puu.references.pinocchio_model import PinocchioPKM
+from pkm4puu.validation.references import mujoco_model
+from pkm4puu.validation.references.pinocchio_model import PinocchioPKM
 
 RNG = np.random.default_rng(20261121)
 
@@ -161,12 +161,12 @@ def test_kkt_equals_pinocchio_constraint_dynamics():
         assert np.abs(pm.jacobian(q) @ a_kkt + pm.bias(q, v)).max() < 1e-12
 
 
-def test_capi_binding_matches_pkm_h():
-    """engines/pkm_capi.py's ctypes structs against src/pkm4puu/pkm.h: the same
-    fields at the same offsets (fields appended to pkm.h later must fit in the
-    binding's reserve)."""
+def test_capi_binding_matches_pkm_h(pkm_header):
+    """pkm4puu.capi's ctypes structs against the C API's header pkm.h: the
+    same fields at the same offsets (fields appended to pkm.h later must fit
+    in the binding's reserve)."""
     from pkm4puu import capi as pkm_capi
-    bad = pkm_capi.binding_mismatches()
+    bad = pkm_capi.binding_mismatches(pkm_header)
     assert not bad, "\n".join(bad)
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pkm4puu.fmu import Fmu
-from pkm4puu.interface import START_P0, arr
+from pkm4puu.interface import START_P0, indexed_names
 from pkm4puu.spec import G, TOTAL_WEIGHT
 from example_scripts import load_example
 
@@ -32,7 +32,7 @@ def test_at_rest_the_motors_hold_the_weight(profile, plant_fmu):
     through the screw, and the four forces sum to the machine's and the
     payload's weight (all actuator axes are vertical)."""
     with Fmu(plant_fmu, start={**START_P0, **M}) as plant:
-        f_hold = plant.get(arr("F_hold", 4))
+        f_hold = plant.get(indexed_names("F_hold", 4))
     np.testing.assert_allclose(profile.tau[0], f_hold * P / (2 * math.pi), rtol=0, atol=1e-14)
     assert profile.F[0].sum() == pytest.approx(TOTAL_WEIGHT + M["payload_mass"] * G, rel=1e-12)
 

@@ -32,7 +32,7 @@ def compensated(ssp_file):
 
 
 def fmpy_midpoint_run(plant_fmu, inverse_fmu):
-    """The midpoint-held auto-test through fmpy (pkm4puu.autotest's
+    """The midpoint-held auto-test through fmpy (pkm4puu.validation.autotest's
     'midpoint' case, CVODE): the plant holds F(t_k + h/2) over [t_k, t_k + h]."""
     with Fmu(inverse_fmu) as inv:
         Fm = inverse_forces(inv, (np.arange(N) + 0.5) * H)
@@ -56,7 +56,7 @@ def test_ssp_archive_structure(ssp_file):
 def test_libcosim_reproduces_the_autotest(compensated, plant_fmu, inverse_fmu):
     """With the inverse FMU's inputs leading by 3h/2 the plant holds
     F(t_k + h/2) over every step: the midpoint-held auto-test, whose bound
-    pkm4puu.autotest sets at 5e-8 m / 5e-8 rad (measured 1.1e-8 m,
+    pkm4puu.validation.autotest sets at 5e-8 m / 5e-8 rad (measured 1.1e-8 m,
     1.4e-8 rad with CVODE). It is the same computation as fmpy's, so the two
     runs agree to rounding: 6e-14 m measured, from the step times, which
     libcosim counts in integer nanoseconds, differing from fmpy's k * 1e-3 in

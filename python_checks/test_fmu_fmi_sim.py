@@ -33,8 +33,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pkm4puu.fmu import build_dir
 from pkm4puu.fmu import Fmu
+from pkm4puu.locate import build_dir
 from pkm4puu.interface import F, POSE
 from pkm4puu.spec import STATIC_FORCE_P0
 

@@ -8,12 +8,12 @@ import numpy as np
 from fmpy import extract
 
 from pkm4puu.fmu import Fmu
-from pkm4puu.interface import arr, F, POSE, VEL
+from pkm4puu.interface import F, POSE, RHO, THETA1, THETA2, VEL, indexed_names
 from pkm4puu.spec import G, M_ROD, M_SLIDER
 
 H = 1e-3
 N = 500  # 0.5 s
-OUT = POSE + VEL + arr("rho", 4) + arr("theta1", 4) + arr("theta2", 4) + arr("lambda", 12)
+OUT = POSE + VEL + RHO + THETA1 + THETA2 + indexed_names("lambda", 12)
 CASES = {"light": {"m_platform": 0.45474}, "heavy": {"m_platform": 0.9}}
 
 

@@ -6,23 +6,24 @@ import math
 import pytest
 from fmpy import read_model_description
 
-from pkm4puu.interface import ACC, arr, POSE, VEL
+from pkm4puu.interface import ACC, indexed_names, POSE, VEL
 from pkm4puu.spec import PARAMETER_DEFAULTS, SOLVER_DEFAULTS
 
-WRENCH = arr("Fe", 3) + ["Me_z"]
-GEOMETRY = ["h", "l", "h_prime", "r_b", "r_Q"] + arr("beta", 4) + arr("gamma", 4)
-MASSES = ["m_slider", "m_rod"] + arr("I_rod", 3) + ["m_platform", "Izz_platform", "g"]
+WRENCH = indexed_names("Fe", 3) + ["Me_z"]
+GEOMETRY = ["h", "l", "h_prime", "r_b", "r_Q"] + indexed_names("beta", 4) + indexed_names("gamma", 4)
+MASSES = ["m_slider", "m_rod"] + indexed_names("I_rod", 3) + ["m_platform", "Izz_platform", "g"]
 
 PLANT = {
-    "input": arr("F", 4) + WRENCH,
-    "output": POSE + VEL + arr("rho", 4) + arr("drho", 4) + arr("theta1", 4) + arr("theta2", 4)
-    + arr("lambda", 12) + ["constraint_residual", "jacobian_condition"],
+    "input": indexed_names("F", 4) + WRENCH,
+    "output": POSE + VEL + indexed_names("rho", 4) + indexed_names("drho", 4) + indexed_names("theta1", 4)
+    + indexed_names("theta2", 4) + indexed_names("lambda", 12) + ["constraint_residual", "jacobian_condition"],
     "parameter": GEOMETRY + MASSES + ["x0", "y0", "z0", "phi0", "dx0", "dy0", "dz0", "dphi0",
                                       "solver", "rk4_step", "rtol", "atol"],
 }
 INVERSE = {
     "input": POSE + VEL + ACC + WRENCH,
-    "output": arr("F", 4) + arr("rho", 4) + arr("drho", 4) + arr("lambda", 12),
+    "output": indexed_names("F", 4) + indexed_names("rho", 4) + indexed_names("drho", 4)
+    + indexed_names("lambda", 12),
     "parameter": GEOMETRY + MASSES,
 }
 

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from pkm4puu.fmu import Fmu, inverse_forces
-from pkm4puu.interface import arr, F, POSE
-from pkm4puu.motions import p
+from pkm4puu.interface import indexed_names, F, POSE
+from pkm4puu.motions import pose_at
 from pkm4puu.spec import G, M_PLATFORM, M_ROD, M_SLIDER, P0, STATIC_FORCE_P0, T_MOVE
 
 SCREW_LEAD = 0.004  # m, the default
@@ -67,7 +67,7 @@ def test_auto_test_chain_with_every_term_on(plant_fmu, machine_forces, ideal_for
     prescribed path within 5e-8 m and rad (the bound of test_fmu_autotest);
     and the terms matter (the ideal machine's forces miss the path)."""
     pose, _ = drive(plant_fmu, machine_forces, solver)
-    ref = np.array([p((k + 1) * H) for k in range(N)])
+    ref = np.array([pose_at((k + 1) * H) for k in range(N)])
     err = np.abs(pose - ref).max(axis=0)
     moved_by_terms = np.abs(machine_forces - ideal_forces).max()
     print(f"\n{solver}: every machine term on, error {err[:3].max():.3g} m, {err[3]:.3g} rad; "
@@ -103,7 +103,7 @@ W = (M_PLATFORM + 4 * M_SLIDER + 4 * M_ROD) * G
 DELTA_MAX = (W + math.sqrt(W**2 + 8 * K_STOP * W * RHO_P0)) / (4 * K_STOP)
 DELTA_STATIC = W / (4 * K_STOP)
 T_DROP, SAMPLE = 0.5, 0.01
-RHO = arr("rho", 4)
+RHO = indexed_names("rho", 4)
 
 
 def drop(plant_fmu, solver, h):
@@ -116,7 +116,7 @@ def drop(plant_fmu, solver, h):
             fmu.do_step(k * h, h)  # a Discard raises
             deepest = min(deepest, fmu.get(RHO).min())
             if (k + 1) % every == 0:
-                samples.append(fmu.get(POSE + ["dz"] + RHO + arr("stop_force", 4) + ENERGY))
+                samples.append(fmu.get(POSE + ["dz"] + RHO + indexed_names("stop_force", 4) + ENERGY))
     return np.array(samples), deepest
 
 
@@ -152,7 +152,7 @@ def test_model_exchange_drop_locates_the_stops_as_events(archive, request, capfd
     where the sliders reach rho_min (an event, logged; the run goes on), and
     the machine comes to rest on the stops as in Co-Simulation."""
     from fmpy import simulate_fmu
-    lower = arr("stop_margin_lower", 4)
+    lower = indexed_names("stop_margin_lower", 4)
     r = simulate_fmu(str(request.getfixturevalue(archive)), fmi_type="ModelExchange", solver="CVode",
                      relative_tolerance=1e-10, stop_time=T_DROP, output_interval=1e-3, debug_logging=True,
                      start_values={**START, **{n: 0.0 for n in F}}, output=lower + RHO + ["dz"])

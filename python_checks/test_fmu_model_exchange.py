@@ -23,8 +23,8 @@ from fmpy import simulate_fmu
 from fmpy.fmi1 import FMICallException
 
 from pkm4puu.fmu import Fmu, inverse_forces, run
-from pkm4puu.interface import arr, F, POSE
-from pkm4puu.motions import p
+from pkm4puu.interface import indexed_names, F, POSE
+from pkm4puu.motions import pose_at
 from pkm4puu.spec import P0, STATIC_FORCE_P0, T_MOVE
 
 H = 1e-3  # s, the interval of the held forces and the communication step
@@ -81,7 +81,7 @@ def test_model_exchange_auto_test_converges_to_co_simulation(archive, request, m
     must shrink at least tenfold when rtol is a hundred times tighter: it is
     the importer's integration error, not a model difference."""
     t_cs, cs = co_simulation
-    ref = np.array([p(t) for t in t_cs])
+    ref = np.array([pose_at(t) for t in t_cs])
     cs_path = np.abs(cs - ref).max(axis=0)
     assert cs_path[:3].max() < TOL_PATH and cs_path[3] < TOL_PATH
     err = {}
@@ -109,8 +109,8 @@ GUARDS = {
     "condition": ({"max_jacobian_condition": 20.0}, {"Me_z": 0.05}),
     "leg": ({"min_leg_measure": 0.48}, {"Fe[1]": 1.0}),
 }
-INDICATORS = ["guard_condition_margin"] + arr("guard_leg_margin", 4)
-THETA2 = arr("theta2", 4)
+INDICATORS = ["guard_condition_margin"] + indexed_names("guard_leg_margin", 4)
+THETA2 = indexed_names("theta2", 4)
 
 
 def guard_measure(case, row):

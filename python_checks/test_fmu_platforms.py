@@ -31,8 +31,9 @@ import numpy as np
 import pytest
 from fmpy.util import add_remoting
 
-from pkm4puu.autotest import SOLVERS, TOL_PHI, TOL_POS, half_step_forces, run_case
+from pkm4puu.validation.autotest import SOLVERS, half_step_forces, run_case
 from pkm4puu.fmu import Fmu
+from test_fmu_autotest import TOL_PHI, TOL_POS  # the auto-test's bounds, as there
 
 PLATFORMS = {2: {"linux64", "win64"}, 3: {"x86_64-linux", "x86_64-windows", "aarch64-linux"}}
 # The Windows binary against linux64, relative to each coordinate's largest

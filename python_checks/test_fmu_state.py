@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 from pkm4puu.fmu import Fmu
-from pkm4puu.interface import arr, F, POSE, VEL
+from pkm4puu.interface import DRHO, F, POSE, RHO, THETA1, THETA2, VEL, indexed_names
 from pkm4puu.spec import STATIC_FORCE_P0
 
 H = 1e-3
 T_SAVE, T_END = 1.0, 1.5
-OUT = (POSE + VEL + arr("rho", 4) + arr("drho", 4) + arr("theta1", 4) + arr("theta2", 4)
-       + arr("lambda", 12) + ["constraint_residual", "jacobian_condition"])
+OUT = (POSE + VEL + RHO + DRHO + THETA1 + THETA2
+       + indexed_names("lambda", 12) + ["constraint_residual", "jacobian_condition"])
 SOLVERS = {"CVODE": {"solver": 0, "rtol": 1e-9}, "RK4": {"solver": 1, "rk4_step": 5e-4}}
 
 

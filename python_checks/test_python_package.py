@@ -1,14 +1,21 @@
 """The Python package pkm4puu (python/pkm4puu): the README's session runs as
 written, and the wrapper opens the FMUs by name, runs them with named inputs
-and outputs, and says clearly what is wrong with a bad request."""
+and outputs, and says clearly what is wrong with a bad request; the library
+imports without matplotlib, finds the build directory from what it is given
+(not from where it is installed), and python -m pkm4puu runs the reports."""
+import os
 import re
+import subprocess
+import sys
 
 import matplotlib
 import numpy as np
 import pytest
 
 import pkm4puu as pkm
-from pkm4puu.fmu import REPO
+from conftest import REPO
+from pkm4puu import locate
+from pkm4puu.__main__ import COMMANDS
 
 MARKER = "The auto-test in a few lines:"
 
@@ -65,3 +72,66 @@ def test_simulate_refuses_a_stop_time_off_the_step_grid(plant_fmu):
             plant.simulate(0.0105, pkm.STEP)
         with pytest.raises(KeyError, match="no variable named 'F5'"):
             plant.simulate(0.001, pkm.STEP, inputs={"F5": 1.0})
+
+
+LIBRARY_MODULES = ["spec", "interface", "motions", "locate", "fmu", "capi", "linearization", "closed_loop"]
+# The reports that run without pinocchio and mujoco import too; matplotlib
+# only comes with a figure.
+REPORT_MODULES = ["validation.autotest", "validation.comparison", "validation.plot_cpp_autotest",
+                  "validation.drawing", "validation.cli"]
+
+
+def test_package_imports_without_matplotlib():
+    """matplotlib is the extra `plots`: the library and the reports' modules
+    import with it hidden (a None entry in sys.modules makes its import fail),
+    and none of them pulls in pinocchio or mujoco either."""
+    names = ["pkm4puu"] + [f"pkm4puu.{m}" for m in LIBRARY_MODULES + REPORT_MODULES]
+    code = ("import sys\n"
+            "sys.modules['matplotlib'] = None\n"
+            f"for name in {names!r}:\n"
+            "    __import__(name)\n"
+            "loaded = [m for m in ('pinocchio', 'mujoco') if m in sys.modules]\n"
+            "assert not loaded, loaded\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+
+
+def test_build_directory_from_argument_environment_or_cwd(tmp_path, monkeypatch):
+    """locate.build_dir: the argument, else $PKM_BUILD_DIR, else ./build, and
+    an error naming both ways when none is there."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv(locate.BUILD_ENV, raising=False)
+    with pytest.raises(FileNotFoundError, match=f"--build DIR.*{locate.BUILD_ENV}"):
+        locate.build_dir()
+    (tmp_path / "build").mkdir()
+    assert locate.build_dir() == tmp_path / "build"
+    monkeypatch.setenv(locate.BUILD_ENV, str(tmp_path / "env"))
+    assert locate.build_dir() == tmp_path / "env"
+    assert locate.build_dir(tmp_path / "arg") == tmp_path / "arg"
+
+
+def run_cli(*args, **kwargs):
+    return subprocess.run([sys.executable, "-m", "pkm4puu", *args], capture_output=True, text=True, **kwargs)
+
+
+def test_command_line_lists_and_dispatches_the_reports():
+    """python -m pkm4puu is the one command line: its help lists every
+    command, each command's help is its program's, and a wrong command
+    fails with the list."""
+    proc = run_cli("--help")
+    assert proc.returncode == 0, proc.stderr
+    for command in COMMANDS:
+        assert command in proc.stdout
+        sub = run_cli(command, "--help")
+        assert sub.returncode == 0 and f"python -m pkm4puu {command}" in sub.stdout, sub.stderr
+    bad = run_cli("no-such-command")
+    assert bad.returncode == 2 and "invalid choice" in bad.stderr
+    assert run_cli().returncode == 2
+
+
+def test_command_line_without_a_build_says_how_to_give_one(tmp_path):
+    env = {k: v for k, v in os.environ.items() if k != locate.BUILD_ENV}
+    proc = run_cli("comparison", cwd=tmp_path, env=env)
+    assert proc.returncode == 1
+    assert "--build DIR" in proc.stderr and locate.BUILD_ENV in proc.stderr, proc.stderr
+    assert not (tmp_path / "results").exists()

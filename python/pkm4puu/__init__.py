@@ -4,19 +4,25 @@
     with pkm.Fmu.open("PKM4PUU", start=pkm.START_P0) as plant:
         r = plant.simulate(1.0, pkm.STEP, inputs={"F[1]": 2.7}, outputs=pkm.POSE)
 
-Modules: spec (MODEL_SPEC's numbers and geometry), motions (the test
-motions), interface (variable names), fmu (the wrapper), autotest and
-comparison (the paper's tests through the FMUs; also `python -m`), plots,
-drawing, cli, closed_loop (the sampled loop the control examples share);
-references.pinocchio_model and references.mujoco_model (the independent
-models, imported on demand: they need pinocchio and mujoco);
-capi (a ctypes binding of the C API, pkm.h).
+The library: spec (MODEL_SPEC's numbers and geometry), motions (the test
+motions), interface (variable names), locate (the build directory and the
+paths in it), fmu (the wrapper), capi (a ctypes binding of the C API,
+pkm.h), linearization (the plant's Jacobians through Model Exchange),
+closed_loop (the sampled loop the control examples share). It needs
+numpy and fmpy only.
+
+The reports (the paper's tests through the FMUs, the engine comparison
+against the independent Pinocchio and MuJoCo models, figures) are in
+pkm4puu.validation and run as `python -m pkm4puu COMMAND`.
 """
-from .fmu import Fmu, Result, build_dir, find_fmu, inverse_forces, run
-from .interface import ACC, DRHO, F, POSE, RHO, RK4, START_P0, THETA1, THETA2, VEL, WRENCH, arr, start_pose
-from .motions import autotest_motion, blend, comparison_forces, motion, p, pd, pdd
+from .fmu import Fmu, Result, find_fmu, inverse_forces, run
+from .interface import (ACC, DRHO, F, POSE, RHO, RK4, START_P0, THETA1, THETA2, VEL, WRENCH, indexed_names,
+                        start_pose)
+from .locate import build_dir
+from .motions import acceleration_at, autotest_motion, blend, comparison_forces, motion, pose_at, velocity_at
 from .spec import P0, P1, STATIC_FORCE_P0, STEP, T_MOVE
 
 __all__ = ["Fmu", "Result", "build_dir", "find_fmu", "inverse_forces", "run", "ACC", "DRHO", "F", "POSE", "RHO",
-           "RK4", "START_P0", "THETA1", "THETA2", "VEL", "WRENCH", "arr", "start_pose", "autotest_motion", "blend",
-           "comparison_forces", "motion", "p", "pd", "pdd", "P0", "P1", "STATIC_FORCE_P0", "STEP", "T_MOVE"]
+           "RK4", "START_P0", "THETA1", "THETA2", "VEL", "WRENCH", "indexed_names", "start_pose", "autotest_motion",
+           "blend", "comparison_forces", "motion", "pose_at", "velocity_at", "acceleration_at", "P0", "P1",
+           "STATIC_FORCE_P0", "STEP", "T_MOVE"]

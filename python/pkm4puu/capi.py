@@ -1,9 +1,9 @@
-"""ctypes binding of this project's C API (src/pkm4puu/pkm.h), for the
-engine comparisons. The library is <build>/lib/libpkm.so; the build
-directory is $PKM_BUILD_DIR (default <repo>/build), as for the FMU checks.
+"""ctypes binding of this project's C API (pkm.h), for the engine
+comparisons. The library is locate.LIBRARY in the build directory (the
+`build` argument, else $PKM_BUILD_DIR, else ./build: see locate).
 
     lib = load()                      # or load(path)
-    with Model(lib) as m:             # spec defaults; Model(lib, g=0.0) etc.
+    with Plant(lib) as m:             # spec defaults; Plant(lib, g=0.0) etc.
         m.set_solver(solver=PKM_SOLVER_CVODE, rtol=1e-12, atol=1e-14)
         m.init_pose(0.0, [0, 0, 0.05, 0])
         m.advance_fn(1.0, lambda t: (F, wrench))
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .fmu import REPO, build_dir
+from .locate import LIBRARY, build_path
 
 PKM_OK = 0
 PKM_SOLVER_CVODE, PKM_SOLVER_RK4 = 0, 1
@@ -83,7 +83,8 @@ TORQUE_FN = ct.CFUNCTYPE(None, ct.c_void_p, ct.c_double, ct.POINTER(ct.c_double)
 
 
 def library_path(build=None):
-    return (Path(build).resolve() if build else build_dir()) / "lib" / "libpkm.so"
+    """libpkm.so in the build directory (locate.build_path)."""
+    return build_path(LIBRARY, build)
 
 
 def load(path=None):
@@ -146,9 +147,9 @@ class PkmError(RuntimeError):
     pass
 
 
-class Model:
+class Plant:
     """One pkm_model handle. Keyword arguments override the default parameters
-    (pkm_default_params), e.g. Model(lib, g=0.0). machine: a dict of
+    (pkm_default_params), e.g. Plant(lib, g=0.0). machine: a dict of
     pkm_machine_params fields overriding pkm_default_machine_params (the
     model is then made by pkm_create_machine), e.g. {"rotor_inertia": 1e-7}."""
 
@@ -301,9 +302,10 @@ class Model:
 _C_TYPES = {"double": (8, 8), "int": (4, 4), "unsigned": (4, 4)}
 
 
-def header_structs(path=REPO / "src" / "pkm4puu" / "pkm.h"):
+def header_structs(path):
     """{struct name: [(field name, offset, size)]} for pkm.h's plain structs of
-    doubles and ints (C layout rules for x86_64), and their sizes."""
+    doubles and ints (C layout rules for x86_64), and their sizes; `path` is
+    the header pkm.h (in the source tree, which this package does not know)."""
     import re
     text = re.sub(r"/\*.*?\*/", " ", Path(path).read_text(), flags=re.S)
     out = {}
@@ -326,8 +328,9 @@ def header_structs(path=REPO / "src" / "pkm4puu" / "pkm.h"):
     return out
 
 
-def binding_mismatches(path=REPO / "src" / "pkm4puu" / "pkm.h"):
-    """Differences between this binding's structs and pkm.h's (empty: they agree).
+def binding_mismatches(path):
+    """Differences between this binding's structs and those of the header
+    pkm.h at `path` (empty: they agree).
     pkm.h may have appended fields, as long as they fit in the reserve."""
     structs = header_structs(path)
     bad = []

@@ -6,9 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .drawing import RUN_COLUMNS
 from .fmu import Fmu
-from .interface import ACC, DRHO, F, POSE, RHO, VEL
+from .interface import ACC, DRHO, F, POSE, RHO, RUN_COLUMNS, VEL
 from .motions import motion
 from .spec import STEP as H, T_MOVE
 
@@ -16,7 +15,7 @@ from .spec import STEP as H, T_MOVE
 class PoseErrors:
     """For a run with the plant's `pose` and the prescribed `pose_d` (n, 4):
     pos_err = |(x, y, z) - prescribed| (m) and phi_err = |phi - prescribed|
-    (rad) at each time, as pkm4puu.autotest measures them."""
+    (rad) at each time, as pkm4puu.validation.autotest measures them."""
 
     @property
     def pos_err(self):

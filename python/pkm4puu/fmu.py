@@ -8,10 +8,9 @@ interface's names.
 """
 from __future__ import annotations
 
-import os
 import shutil
 from pathlib import Path
-from typing import Callable, Mapping, Sequence, Union
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 from fmpy import extract, read_model_description
@@ -19,30 +18,25 @@ from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
 from .interface import ACC, F, POSE, VEL
+from .locate import BUILD_ENV, PathLike, fmu_path
 from .motions import autotest_motion
 
-REPO = Path(__file__).resolve().parents[2]
 MODELS = ("PKM4PUU", "PKM4PUU_Inverse")
 
 
-def build_dir() -> Path:
-    """Where the FMUs are built: $PKM_BUILD_DIR, else the repository's build/."""
-    return Path(os.environ.get("PKM_BUILD_DIR", REPO / "build")).resolve()
-
-
-def find_fmu(model: str = "PKM4PUU", fmi: int = 2, build: Union[str, Path, None] = None) -> Path:
+def find_fmu(model: str = "PKM4PUU", fmi: int = 2, build: PathLike = None) -> Path:
     """The archive of `model` (PKM4PUU, the plant, or PKM4PUU_Inverse) for FMI
-    version `fmi` (2 or 3) in `build` (default: build_dir()); FileNotFoundError
-    saying how to build it when it is not there."""
+    version `fmi` (2 or 3) in `build` (default: locate.build_dir());
+    FileNotFoundError saying how to build it when it is not there."""
     if model not in MODELS:
         raise ValueError(f"unknown model {model!r}: one of {', '.join(MODELS)}")
     if fmi not in (2, 3):
         raise ValueError(f"fmi must be 2 or 3, not {fmi!r}")
-    root = Path(build) if build is not None else build_dir()
-    path = root / ("fmi3" if fmi == 3 else "") / f"{model}.fmu"
+    path = fmu_path(model, fmi, build)
     if not path.is_file():
         raise FileNotFoundError(f"{path} does not exist: build the FMUs first (./scripts/build.sh builds them "
-                                f"into build/), or set PKM_BUILD_DIR to the directory that holds them")
+                                f"into build/), and pass the directory that holds them (--build DIR) or set "
+                                f"{BUILD_ENV} to it")
     return path
 
 

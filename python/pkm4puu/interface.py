@@ -3,20 +3,23 @@ start values the tests and examples use most."""
 from .spec import P0, STEP
 
 
-def arr(name, n):
-    """FMI array names, 1-based: arr('F', 4) -> ['F[1]', ..., 'F[4]']."""
+def indexed_names(name, n):
+    """The names of an FMI array's elements, 1-based: indexed_names('F', 4)
+    -> ['F[1]', ..., 'F[4]']."""
     return [f"{name}[{i}]" for i in range(1, n + 1)]
 
 
 POSE = ["x", "y", "z", "phi"]
 VEL = ["dx", "dy", "dz", "dphi"]
 ACC = ["ddx", "ddy", "ddz", "ddphi"]
-F = arr("F", 4)
-WRENCH = arr("Fe", 3) + ["Me_z"]
-RHO = arr("rho", 4)
-DRHO = arr("drho", 4)
-THETA1 = arr("theta1", 4)
-THETA2 = arr("theta2", 4)
+F = indexed_names("F", 4)
+WRENCH = indexed_names("Fe", 3) + ["Me_z"]
+RHO = indexed_names("rho", 4)
+DRHO = indexed_names("drho", 4)
+THETA1 = indexed_names("theta1", 4)
+THETA2 = indexed_names("theta2", 4)
+# The columns of a run's CSV (pkm4puu.validation.drawing.write_run_csv).
+RUN_COLUMNS = POSE + RHO + THETA1 + THETA2
 
 
 def start_pose(pose):

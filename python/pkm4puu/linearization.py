@@ -18,10 +18,10 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Model
 
-from .interface import F, POSE, VEL, WRENCH, arr
+from .interface import F, POSE, VEL, WRENCH, indexed_names
 
 STATES = POSE + VEL
-INPUTS = F + WRENCH + arr("tau", 4)
+INPUTS = F + WRENCH + indexed_names("tau", 4)
 
 
 class ModelExchange:

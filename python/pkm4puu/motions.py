@@ -29,18 +29,18 @@ def autotest_motion(t, T=T_MOVE):
     return P0 + d * s, d * ds / T, d * dds / T**2
 
 
-def p(t):
-    """Prescribed pose (x, y, z, phi) at time t."""
+def pose_at(t):
+    """The auto-test's prescribed pose (x, y, z, phi) at time t."""
     return autotest_motion(t)[0]
 
 
-def pd(t):
-    """Prescribed velocity at time t."""
+def velocity_at(t):
+    """The auto-test's prescribed velocity at time t."""
     return autotest_motion(t)[1]
 
 
-def pdd(t):
-    """Prescribed acceleration at time t."""
+def acceleration_at(t):
+    """The auto-test's prescribed acceleration at time t."""
     return autotest_motion(t)[2]
 
 

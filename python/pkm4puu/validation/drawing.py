@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .interface import POSE, RHO, THETA1, THETA2
-from .spec import BETA, H, H_PRIME, L, base_point, platform_point, rz
+from ..interface import RUN_COLUMNS
+from ..spec import BETA, H, H_PRIME, L, base_point, platform_point, rz
 
 
 # --- the mechanism's points ---------------------------------------------------------
@@ -41,8 +41,6 @@ def mechanism_points(row):
 
 
 # --- the CSV of a run -------------------------------------------------------------------
-RUN_COLUMNS = POSE + RHO + THETA1 + THETA2
-
 
 def write_run_csv(path, t, Y, columns=RUN_COLUMNS):
     """t (n,) and Y (n, len(columns)) as a CSV with a header t_s, columns..."""

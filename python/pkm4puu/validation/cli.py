@@ -1,5 +1,7 @@
 """What the command-line programs share (the examples and `python -m
-pkm4puu.autotest`): progress on stderr, the --build/--out arguments,
+pkm4puu autotest` and the other reports): progress on stderr, the
+--build/--out arguments (the build directory as locate.build_dir finds it,
+the output in ./results of the current directory by default),
 finding the FMUs with a message that says how to build them, an example's
 main (run_program) and writing the output files."""
 import os
@@ -8,7 +10,8 @@ import sys
 import time
 from pathlib import Path
 
-from .fmu import REPO, find_fmu
+from ..fmu import find_fmu
+from ..locate import BUILD_ENV, DEFAULT_BUILD, build_dir
 
 
 class Log:
@@ -20,6 +23,13 @@ class Log:
 
     def __call__(self, msg):
         print(f"{self.prog} [{time.perf_counter() - self.t0:6.1f} s]: {msg}", file=sys.stderr, flush=True)
+
+
+def prefixed_log(prog):
+    """log(message): "<prog>: <message>" on stderr (without Log's elapsed time)."""
+    def log(msg):
+        print(f"{prog}: {msg}", file=sys.stderr, flush=True)
+    return log
 
 
 def machine_description():
@@ -35,11 +45,34 @@ def machine_description():
     return f"{platform.system()} {platform.machine()}, {cpu}, {os.cpu_count()} cores"
 
 
+DEFAULT_OUT = Path("results")  # relative to the current directory
+BUILD_HELP = f"(default: ${BUILD_ENV}, else ./{DEFAULT_BUILD})"
+
+
+def add_build_arg(ap, holding="PKM4PUU.fmu and PKM4PUU_Inverse.fmu"):
+    """--build DIR; None when not given, for locate.build_dir to decide."""
+    ap.add_argument("--build", type=Path, default=None, metavar="DIR",
+                    help=f"build directory holding {holding} {BUILD_HELP}")
+
+
+def add_out_arg(ap, files="CSV, PNG and GIF files"):
+    ap.add_argument("--out", type=Path, default=DEFAULT_OUT, metavar="DIR",
+                    help=f"directory for the {files} (default: ./%(default)s)")
+
+
 def add_common_args(ap):
-    ap.add_argument("--build", type=Path, default=REPO / "build",
-                    help="directory holding PKM4PUU.fmu and PKM4PUU_Inverse.fmu (default: %(default)s)")
-    ap.add_argument("--out", type=Path, default=REPO / "results",
-                    help="directory for the CSV, PNG and GIF files (default: %(default)s)")
+    add_build_arg(ap)
+    add_out_arg(ap)
+
+
+def find_build(build, log):
+    """The build directory (locate.build_dir(build): --build, else
+    $PKM_BUILD_DIR, else ./build), or None after logging why there is none."""
+    try:
+        return build_dir(build)
+    except FileNotFoundError as e:
+        log(f"error: {e}")
+        return None
 
 
 def find_fmus(build, log, models=("PKM4PUU", "PKM4PUU_Inverse")):
@@ -48,7 +81,7 @@ def find_fmus(build, log, models=("PKM4PUU", "PKM4PUU_Inverse")):
     try:
         return [find_fmu(m, 2, build) for m in models]
     except FileNotFoundError as e:
-        log(f"error: {e}, or pass --build DIR")
+        log(f"error: {e}")
         return None
 
 

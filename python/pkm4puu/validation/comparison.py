@@ -11,7 +11,8 @@ and with RK4, prints the table of the quantities below and writes to --out DIR:
   comparison_pose.png        platform pose over time (the paper's Figs. 9-10)
   comparison_delta_rho1.png  displacement of actuator 1 (the paper's Fig. 11)
 
-The quantities (each bounded by test_fmu_comparison.py):
+The quantities (each bounded by test_fmu_comparison.py, which holds the
+bounds and hands them to the table for display, Bounds):
 - max ||C(q)||, the loop-closure residual the FMU reports;
 - the drift of the machine's vertical centre of mass: with g = 0 the only
   vertical forces are the actuator forces and F1 + F4 = 0, so from rest it
@@ -19,45 +20,46 @@ The quantities (each bounded by test_fmu_comparison.py):
 - CVODE vs RK4: two different integrators must agree;
 - max |delta rho1|: the motion must be non-trivial.
 
-usage: python -m pkm4puu.comparison [--build DIR] [--out DIR]
+usage: python -m pkm4puu comparison [--build DIR] [--out DIR]
 """
 import argparse
 import csv
 import math
 import sys
 from pathlib import Path
+from typing import NamedTuple
 
-import matplotlib
 import numpy as np
 
 from .cli import add_common_args, case_table, finish, run_cases, start
-from .fmu import Fmu, run
-from .interface import F, POSE, START_P0, arr
-from .motions import comparison_forces
-from .spec import CMP_AMPLITUDE, CMP_DURATION, L as L_ROD, M_PLATFORM, M_ROD, M_SLIDER, STEP
-from .plots import save_figure
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+from ..fmu import Fmu, run
+from ..interface import F, POSE, START_P0, indexed_names
+from ..motions import comparison_forces
+from ..spec import CMP_AMPLITUDE, CMP_DURATION, L as L_ROD, M_PLATFORM, M_ROD, M_SLIDER, STEP
+from .plots import pyplot, save_figure
 
 H = STEP
 N = round(CMP_DURATION / H)
-TOL_POS = 1e-8  # m, CVODE vs RK4; also the integration accuracy trusted below
-TOL_PHI = 1e-7  # rad
-# The two bounds below are written out in test_fmu_comparison.py's assertions;
-# here they only label the table.
-TOL_CONSTRAINT = 1e-12  # m, max ||C(q)||
-MIN_DELTA_RHO1 = 1e-5  # m, below this the forces barely moved the machine
-OUT = POSE + arr("rho", 4) + arr("theta2", 4) + ["constraint_residual"]
+OUT = POSE + indexed_names("rho", 4) + indexed_names("theta2", 4) + ["constraint_residual"]
 START = {"g": 0.0, **START_P0}
 # Integrators. RK4 at 1 ms is the paper's. CVODE's rtol bounds only the local
 # error of each internal step, relative to |y| (~0.05 m, and phi swings to
 # ~0.15 rad here); the FMU restarts CVODE at every 1 ms step, so over 1500
 # steps of undamped motion these local errors add up to a global error of the
-# order of TOL_POS at the default rtol = 1e-8. Agreement within TOL_POS only
+# order of 1e-8 m at the default rtol = 1e-8: the checks' bound on the
+# solvers' agreement (test_fmu_comparison.py). Agreement within it only
 # means something when each integrator is well inside it, so CVODE runs at
 # rtol = 1e-10 (atol scaled alike, 1e-12).
 SOLVERS = {"CVODE": {"solver": 0, "rtol": 1e-10, "atol": 1e-12}, "RK4": {"solver": 1, "rk4_step": 1e-3}}
+
+
+class Bounds(NamedTuple):
+    """The bounds a caller holds the runs to (the checks:
+    test_fmu_comparison.py), shown in the table; the report itself holds none."""
+    position: float  # m, CVODE vs RK4 and the vertical centre of mass's drift
+    phi: float  # rad, CVODE vs RK4
+    constraint: float  # m, max ||C(q)||
+    min_delta_rho1: float  # m, the least max |delta rho1| of a non-trivial motion
 
 
 def midpoint_held(fmu, k, t):
@@ -114,25 +116,29 @@ def vertical_com_drift(r):
 
 def solver_difference(a, b):
     """(largest |a - b| over x, y, z, rho1..rho4 (m), largest |a - b| of phi (rad))."""
-    d_pos = max(np.abs(a[n] - b[n]).max() for n in ["x", "y", "z"] + arr("rho", 4))
+    d_pos = max(np.abs(a[n] - b[n]).max() for n in ["x", "y", "z"] + indexed_names("rho", 4))
     d_phi = np.abs(a["phi"] - b["phi"]).max()
     return d_pos, d_phi
 
 
-def format_table(runs, errors=None):
-    """The table of max errors per solver and of CVODE vs RK4, with the bounds."""
+def format_table(runs, errors=None, bounds=None):
+    """The table of max errors per solver and of CVODE vs RK4; with `bounds`
+    (Bounds), the bound on each."""
     head = [f"FMU comparison test (paper section 5.2): plant FMU, g = 0, F1 = -F4 = {CMP_AMPLITUDE:g} N "
             f"sin(2 pi t / {CMP_DURATION:g} s), F2 = F3 = 0, {H * 1e3:g} ms communication step, {CMP_DURATION:g} s",
             f"{'solver':<6} {'max ||C(q)|| (m)':>17} {'vertical COM drift (m)':>23} {'max |delta rho1| (m)':>21}"]
     lines = case_table(head, SOLVERS, runs, errors, lambda name: f"{name:<6}",
                        lambda name, r: f"{max_constraint_residual(r):17.3e} {vertical_com_drift(r):23.3e} "
                                        f"{max_delta_rho1(r):21.4e}")
-    lines.append(f"{'bound':<6} {'<= ' + format(TOL_CONSTRAINT, 'g'):>17} {'<= ' + format(TOL_POS, 'g'):>23} "
-                 f"{'> ' + format(MIN_DELTA_RHO1, 'g'):>21}")
+    if bounds is not None:
+        lines.append(f"{'bound':<6} {'<= ' + format(bounds.constraint, 'g'):>17} "
+                     f"{'<= ' + format(bounds.position, 'g'):>23} {'> ' + format(bounds.min_delta_rho1, 'g'):>21}")
     if "CVODE" in runs and "RK4" in runs:
         d_pos, d_phi = solver_difference(runs["CVODE"], runs["RK4"])
-        lines.append(f"CVODE vs RK4: max |delta position| {d_pos:.3e} m (bound {TOL_POS:g} m), "
-                     f"max |delta phi| {d_phi:.3e} rad (bound {TOL_PHI:g} rad)")
+        pos_bound, phi_bound = ((f" (bound {bounds.position:g} m)", f" (bound {bounds.phi:g} rad)")
+                                if bounds is not None else ("", ""))
+        lines.append(f"CVODE vs RK4: max |delta position| {d_pos:.3e} m{pos_bound}, "
+                     f"max |delta phi| {d_phi:.3e} rad{phi_bound}")
     return "\n".join(lines)
 
 
@@ -146,7 +152,7 @@ def write_results(runs, out_dir):
     r = runs["CVODE"]
     t = r["t"]
     d_rho1 = delta_rho1(r)
-    cols = ["x", "y", "z", "phi"] + arr("rho", 4)
+    cols = ["x", "y", "z", "phi"] + indexed_names("rho", 4)
     csv_path = out_dir / "comparison.csv"
     with open(csv_path, "w", newline="") as f:
         w = csv.writer(f)
@@ -154,6 +160,7 @@ def write_results(runs, out_dir):
         for i in range(len(t)):
             w.writerow([f"{t[i]:.6f}"] + [f"{r[c][i]:.12e}" for c in cols] + [f"{d_rho1[i]:.12e}"])
 
+    plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(9, 6), sharex=True)
     for ax, name, scale, unit in zip(axes.flat, POSE, (1e3, 1e3, 1e3, 180 / math.pi), ("mm", "mm", "mm", "deg")):
         ax.plot(t, scale * r[name])
@@ -179,7 +186,7 @@ def write_results(runs, out_dir):
 
 # --- command line ---------------------------------------------------------------------------
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m pkm4puu.comparison",
+    ap = argparse.ArgumentParser(prog="python -m pkm4puu comparison",
                                  description="The paper's comparison test (section 5.2) through the plant FMU, "
                                  "with CVODE and with RK4.")
     add_common_args(ap)

@@ -13,10 +13,11 @@ the accuracy; three ways are compared:
     See first_order_slope below for which slope and why.
 (c) zero-order hold of F(t): the held force lags the true one by half a step
     on average, so every step's impulse is off by -h^2/2 dF/dt: an O(h) error,
-    ~ (h/2) x velocity ~ 1e-5 m here. It is reported, not bounded.
+    ~ (h/2) x velocity ~ 1e-5 m here.
 
-This module holds the runner and the writers; the checks are in
-test_fmu_autotest.py. Run as a module it is part of the main job
+This module holds the runner and the writers; the checks, and the bounds
+they hold (a) and (b) to, are in test_fmu_autotest.py, which hands them to
+the table and the error plot (Bounds) for display. Run as a module it is part of the main job
 (run_autotest.sh): it runs every (input mode, solver) case, prints the table
 of max errors and writes to --out DIR:
 
@@ -26,39 +27,41 @@ of max errors and writes to --out DIR:
                             (midpoint input, CVODE)
   fmu_autotest_forces.png   F1..F4 from the inverse FMU
 
-usage: python -m pkm4puu.autotest [--build DIR] [--out DIR]
+usage: python -m pkm4puu autotest [--build DIR] [--out DIR]
 """
 import argparse
 import csv
 import sys
 from pathlib import Path
+from typing import NamedTuple
 
-import matplotlib
 import numpy as np
 
 from . import plots
 from .cli import add_common_args, case_table, finish, run_cases, start
-from .fmu import Fmu, inverse_forces, run
-from .interface import ACC, F, POSE, START_P0, VEL
-from .motions import p
-from .spec import STEP as H, T_MOVE
-from .plots import save_figure
+from ..fmu import Fmu, inverse_forces, run
+from ..interface import ACC, F, POSE, START_P0, VEL
+from ..motions import pose_at
+from ..spec import STEP as H, T_MOVE
+from .plots import pyplot, save_figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 
 N = round(T_MOVE / H)
-# Bounds that test_fmu_autotest.py asserts for the BOUNDED_MODES; the ZOH mode
-# is only required to be worse than the midpoint hold.
-TOL_POS = 5e-8  # m
-TOL_PHI = 5e-8  # rad
 SOLVERS = {"CVODE": {"solver": 0}, "RK4": {"solver": 1, "rk4_step": 1e-3}}
 MODES = ("midpoint", "first_order", "zoh")
-BOUNDED_MODES = ("midpoint", "first_order")
 CASES = [(m, s) for m in MODES for s in SOLVERS]  # (input mode, solver), in the table's order
 START = START_P0
 # The case shown in fmu_autotest_pose.png.
 POSE_PLOT_CASE = ("midpoint", "CVODE")
+
+
+class Bounds(NamedTuple):
+    """Bounds on the max errors of the input `modes` that a caller holds the
+    runs to (the checks: test_fmu_autotest.py), shown in the table and the
+    error plot; the report itself holds no bounds."""
+    position: float  # m
+    phi: float  # rad
+    modes: tuple
 
 
 class CaseResult:
@@ -98,7 +101,7 @@ def static_forces(inverse_fmu, times):
     with Fmu(inverse_fmu) as inv:
         vr_in, vr_out = inv.vrs(POSE + VEL + ACC), inv.vrs(F)
         for i, t in enumerate(times):
-            inv.fmu.setReal(vr_in, [*p(t), *[0.0] * 8])
+            inv.fmu.setReal(vr_in, [*pose_at(t), *[0.0] * 8])
             out[i] = inv.fmu.getReal(vr_out)
     return out
 
@@ -121,7 +124,8 @@ def first_order_slope(F0, Fm, F1):
     With RK4 the input then adds next to nothing to the integrator's own
     error; with CVODE at its default rtol = 1e-8, CVODE's own error dominates.
     The secant, by the estimate above, doubles the midpoint hold's error and
-    would leave CVODE at its defaults with little margin to TOL_POS.
+    would leave CVODE at its defaults with little margin to the checks'
+    position bound (test_fmu_autotest.py).
     """
     return (4.0 * Fm + F1 - 5.0 * F0) / (3.0 * H)
 
@@ -169,7 +173,7 @@ def run_case(plant_fmu, mode, solver, Fh):
             raise RuntimeError(f"{Path(plant_fmu).name} does not declare canInterpolateInputs: "
                                "first-order input interpolation is not available")
         t, Y = run(fmu, 0.0, H, N, inputs(mode, Fh), POSE)
-    return CaseResult(t, Y, np.array([p(ti) for ti in t]))
+    return CaseResult(t, Y, np.array([pose_at(ti) for ti in t]))
 
 
 def run_all(plant_fmu, Fh, log=None, errors=None):
@@ -184,16 +188,21 @@ def run_all(plant_fmu, Fh, log=None, errors=None):
                      lambda r: f", max position error {r.pos_err.max():.3e} m, max phi error {r.phi_err.max():.3e} rad")
 
 
-def format_table(runs, errors=None):
-    """The table of max errors, one row per case, with the bound each case is held to."""
+def format_table(runs, errors=None, bounds=None):
+    """The table of max errors, one row per case; with `bounds` (Bounds), the
+    bound each case is held to."""
     def row(case, r):
-        bound = (f"<= {TOL_POS:g} m, <= {TOL_PHI:g} rad" if case[0] in BOUNDED_MODES
+        errors = f"{r.pos_err.max():13.3e} {r.phi_err.max():11.3e}"
+        if bounds is None:
+            return errors
+        bound = (f"<= {bounds.position:g} m, <= {bounds.phi:g} rad" if case[0] in bounds.modes
                  else "above the midpoint hold's (O(h) lag)")
-        return f"{r.pos_err.max():13.3e} {r.phi_err.max():11.3e}  {bound}"
+        return f"{errors}  {bound}"
 
     head = [f"FMU auto-test (paper section 5.1): inverse FMU -> F1..F4 -> plant FMU, open loop, "
             f"{H * 1e3:g} ms communication step, {T_MOVE:g} s: max errors",
-            f"{'input mode':<12} {'solver':<6} {'position (m)':>13} {'phi (rad)':>11}  test bound"]
+            f"{'input mode':<12} {'solver':<6} {'position (m)':>13} {'phi (rad)':>11}"
+            + ("  test bound" if bounds is not None else "")]
     return "\n".join(case_table(head, CASES, runs, errors, lambda case: "{:<12} {:<6}".format(*case), row))
 
 
@@ -209,7 +218,10 @@ def write_csv(runs, path):
             w.writerow([f"{ti:.6f}"] + [f"{v[i]:.6e}" for k in keys for v in (runs[k].pos_err, runs[k].phi_err)])
 
 
-def plot_errors(runs, path):
+def plot_errors(runs, path, bounds=None):
+    """Position and phi error of every case over time; with `bounds`
+    (Bounds), a line at each."""
+    plt = pyplot()
     fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
     for (m, s), r in runs.items():
         style = "-" if s == "CVODE" else "--"
@@ -219,8 +231,9 @@ def plot_errors(runs, path):
     axes[1].set_ylabel("|phi - phi_prescribed| (rad)")
     axes[1].set_xlabel("time (s)")
     axes[0].set_title("Auto-test through the FMUs, open loop, 1 ms communication step")
-    for ax, tol, unit in ((axes[0], TOL_POS, "m"), (axes[1], TOL_PHI, "rad")):
-        ax.axhline(tol, color="k", lw=0.8, ls=":", label=f"test bound {tol:g} {unit}")
+    for ax, tol, unit in ((axes[0], bounds and bounds.position, "m"), (axes[1], bounds and bounds.phi, "rad")):
+        if bounds is not None:
+            ax.axhline(tol, color="k", lw=0.8, ls=":", label=f"test bound {tol:g} {unit}")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7, ncol=3)
     save_figure(fig, path)
@@ -243,16 +256,17 @@ def plot_forces(Fh, F_static, path):
                                "Auto-test: actuator forces from the inverse FMU (PKM4PUU_Inverse)", path)
 
 
-def write_results(runs, Fh, inverse_fmu, out_dir):
-    """Writes fmu_autotest.csv, fmu_autotest_errors.png, fmu_autotest_pose.png
-    and fmu_autotest_forces.png into out_dir (created if missing; files are
-    overwritten). Returns their paths in that order."""
+def write_results(runs, Fh, inverse_fmu, out_dir, bounds=None):
+    """Writes fmu_autotest.csv, fmu_autotest_errors.png (with `bounds`, see
+    plot_errors), fmu_autotest_pose.png and fmu_autotest_forces.png into
+    out_dir (created if missing; files are overwritten). Returns their paths
+    in that order."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     paths = [out_dir / n for n in ("fmu_autotest.csv", "fmu_autotest_errors.png",
                                    "fmu_autotest_pose.png", "fmu_autotest_forces.png")]
     write_csv(runs, paths[0])
-    plot_errors(runs, paths[1])
+    plot_errors(runs, paths[1], bounds)
     plot_pose(runs, paths[2])
     plot_forces(Fh, static_forces(inverse_fmu, half_step_times()), paths[3])
     return paths
@@ -260,7 +274,7 @@ def write_results(runs, Fh, inverse_fmu, out_dir):
 
 # --- command line ---------------------------------------------------------------------------
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m pkm4puu.autotest",
+    ap = argparse.ArgumentParser(prog="python -m pkm4puu autotest",
                                  description="The paper's auto-test (section 5.1) through the FMUs: inverse FMU "
                                  "-> F1..F4 -> plant FMU, open loop, 1 ms communication step, 2 s.")
     add_common_args(ap)

@@ -1,28 +1,35 @@
 """The auto-test's two standard figures, shared by the C++ core's plots
 (plot_cpp_autotest.py) and the FMU run's (autotest.py): actuator forces with
 their dynamic part (in the spirit of the paper's Fig. 5) and prescribed
-versus simulated platform motion (Fig. 6)."""
+versus simulated platform motion (Fig. 6).
+
+matplotlib is the package's optional extra `plots`: it is imported on the
+first figure (pyplot()), not with the package."""
 import math
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+
+def pyplot():
+    """matplotlib.pyplot on the non-interactive Agg backend, imported now."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
 
 
 def save_figure(fig, path, dpi=120):
     """Lays out, writes and closes a figure."""
     fig.tight_layout()
     fig.savefig(path, dpi=dpi)
-    plt.close(fig)
+    pyplot().close(fig)
 
 
 def plot_forces(t, F, F_static, title, path):
     """F1..F4 (columns of F, N) over t and, below, F minus the forces that
     would hold the same pose at rest (mN)."""
     F, F_static = np.asarray(F), np.asarray(F_static)
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
+    fig, axes = pyplot().subplots(2, 1, figsize=(8, 6.5), sharex=True)
     for i in range(4):
         axes[0].plot(t, F[:, i], label=f"$F_{i + 1}$")
         axes[1].plot(t, 1e3 * (F[:, i] - F_static[:, i]), label=f"$F_{i + 1} - F_{{{i + 1},static}}$")
@@ -40,7 +47,7 @@ def plot_forces(t, F, F_static, title, path):
 def plot_pose(t, ref, sim, sim_label, title, path):
     """Prescribed (ref) and simulated (sim) x, y, z, phi: arrays of shape (n, 4)."""
     ref, sim = np.asarray(ref), np.asarray(sim)
-    fig, axes = plt.subplots(2, 2, figsize=(9, 6.5), sharex=True)
+    fig, axes = pyplot().subplots(2, 2, figsize=(9, 6.5), sharex=True)
     specs = [(0, 1e3, "x (mm)"), (1, 1e3, "y (mm)"), (2, 1e3, "z (mm)"), (3, 180 / math.pi, "phi (deg)")]
     for ax, (j, scale, label) in zip(axes.flat, specs):
         ax.plot(t, scale * ref[:, j], "k-", lw=3, alpha=0.35, label="prescribed p'(t)")

@@ -43,7 +43,7 @@ What is compared:
   (pkm_inverse_dynamics_machine against Pinocchio's RNEA with armature,
   payload and friction).
 
-usage: python -m pkm4puu.references.engine_comparison [--build DIR] [--out DIR]
+usage: python -m pkm4puu engines [--build DIR] [--out DIR] [--no-sweep]
 """
 import argparse
 import csv
@@ -52,21 +52,17 @@ import sys
 import time
 from pathlib import Path
 
-import matplotlib
 import numpy as np
 import mujoco
 import pinocchio as pin
 from scipy.integrate import solve_ivp
 
-from pkm4puu import capi as pkm_capi, motions, spec
-from pkm4puu.references import mujoco_model
-from pkm4puu.references.pinocchio_model import PinocchioPKM
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from pkm4puu.fmu import REPO  # noqa: E402
-from pkm4puu.plots import save_figure  # noqa: E402
+from .. import capi as pkm_capi, motions, spec
+from ..locate import fmu_path
+from .references import mujoco_model
+from .cli import add_build_arg, add_out_arg, find_build, prefixed_log
+from .plots import pyplot, save_figure
+from .references.pinocchio_model import PinocchioPKM
 
 H = 1e-3  # s, output grid and communication step
 N = round(spec.CMP_DURATION / H)
@@ -193,7 +189,7 @@ def pinocchio_inverse(times=AUTOTEST_TIMES):
 
 # --- this project -----------------------------------------------------------------------------------
 def load_capi(build=None):
-    """libpkm.so of the build directory (default $PKM_BUILD_DIR, else build/)."""
+    """libpkm.so of the build directory (`build`, else as locate.build_dir finds it)."""
     path = pkm_capi.library_path(build)
     if not path.is_file():
         raise FileNotFoundError(f"{path} does not exist: build first (./run_tests.sh), or set PKM_BUILD_DIR")
@@ -202,7 +198,7 @@ def load_capi(build=None):
 
 def capi_inverse(lib, times=AUTOTEST_TIMES):
     F, lam = np.empty((len(times), 4)), np.empty((len(times), 12))
-    with pkm_capi.Model(lib) as m:
+    with pkm_capi.Plant(lib) as m:
         for k, t in enumerate(times):
             r = m.inverse_dynamics(*motions.autotest_motion(t))
             F[k], lam[k] = r.F, r.lambda_
@@ -210,7 +206,7 @@ def capi_inverse(lib, times=AUTOTEST_TIMES):
 
 
 def fmu_inverse(inverse_fmu, times=AUTOTEST_TIMES):
-    from pkm4puu.fmu import Fmu, inverse_forces
+    from ..fmu import Fmu, inverse_forces
     with Fmu(inverse_fmu) as inv:
         return inverse_forces(inv, times)
 
@@ -232,7 +228,7 @@ def capi_run(lib, settings, machine=None, g=0.0, forces=motions.comparison_force
         return forces(t)
 
     t0 = time.perf_counter()
-    with pkm_capi.Model(lib, machine=None if machine is None else machine.capi_params(), g=g) as m:
+    with pkm_capi.Plant(lib, machine=None if machine is None else machine.capi_params(), g=g) as m:
         m.set_solver(**settings)
         m.init_pose(0.0, spec.P0)
         for k, t in enumerate(TIMES):
@@ -260,7 +256,7 @@ def capi_run(lib, settings, machine=None, g=0.0, forces=motions.comparison_force
 def fmu_runs(plant_fmu):
     """The comparison test through the plant FMU (fmu_comparison's runner:
     1 ms communication step, midpoint-held forces), CVODE and RK4."""
-    from pkm4puu import comparison as fmu_comparison
+    from . import comparison as fmu_comparison
     out = {}
     for name in fmu_comparison.SOLVERS:
         t0 = time.perf_counter()
@@ -449,7 +445,7 @@ def capi_inverse_machine(lib, machine, times=AUTOTEST_TIMES):
     pkm_inverse_dynamics_machine."""
     F, tau, lam = np.empty((len(times), 4)), np.empty((len(times), 4)), np.empty((len(times), 12))
     flags = np.empty(len(times), dtype=int)
-    with pkm_capi.Model(lib, machine=machine.capi_params()) as m:
+    with pkm_capi.Plant(lib, machine=machine.capi_params()) as m:
         for k, t in enumerate(times):
             r = m.inverse_dynamics_machine(*motions.autotest_motion(t))
             F[k], tau[k], lam[k], flags[k] = r.F, r.tau, r.lambda_, r.beyond_stops
@@ -634,6 +630,7 @@ def write_results(r, out_dir):
     paths.append(csv_path)
 
     # Figs. 9-10: platform pose. Engines solid, this model dashed.
+    plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(10, 6.5), sharex=True)
     for ax, name, scale, unit in zip(axes.flat, ("x", "y", "z", "phi"), (1e3, 1e3, 1e3, 180 / math.pi),
                                      ("mm", "mm", "mm", "deg")):
@@ -749,26 +746,25 @@ def check(r):
 
 # --- command line ---------------------------------------------------------------------------------------------
 def main(argv=None):
-    prog = "engine_comparison"
-    ap = argparse.ArgumentParser(prog=prog, description="Validation against Pinocchio and MuJoCo models of the "
-                                 "same mechanism (inverse dynamics along the auto-test, the comparison test).")
-    ap.add_argument("--build", type=Path, default=REPO / "build",
-                    help="build directory holding lib/libpkm.so and the FMUs (default: %(default)s)")
-    ap.add_argument("--out", type=Path, default=REPO / "results",
-                    help="directory for the CSV and PNG files (default: %(default)s)")
+    prog = "engines"
+    ap = argparse.ArgumentParser(prog="python -m pkm4puu engines",
+                                 description="Validation against Pinocchio and MuJoCo models of the same mechanism "
+                                 "(inverse dynamics along the auto-test, the comparison test).")
+    add_build_arg(ap, "libpkm.so and the FMUs")
+    add_out_arg(ap, "CSV and PNG files")
     ap.add_argument("--no-sweep", action="store_true", help="skip the table of MuJoCo constraint settings")
     args = ap.parse_args(argv)
-
-    def log(msg):
-        print(f"{prog}: {msg}", file=sys.stderr, flush=True)
-
-    plant, inverse = args.build / "PKM4PUU.fmu", args.build / "PKM4PUU_Inverse.fmu"
-    for path in (plant, inverse, pkm_capi.library_path(args.build)):
+    log = prefixed_log(prog)
+    build = find_build(args.build, log)
+    if build is None:
+        return 1
+    plant, inverse = fmu_path("PKM4PUU", 2, build), fmu_path("PKM4PUU_Inverse", 2, build)
+    for path in (plant, inverse, pkm_capi.library_path(build)):
         if not path.is_file():
             log(f"error: {path} not found: build first (./scripts/build.sh builds into build/) or pass --build DIR")
             return 1
     print(f"engines: pinocchio {pin.__version__}, mujoco {mujoco.__version__}", flush=True)
-    r = run_all(args.build, plant, inverse, log=log)
+    r = run_all(build, plant, inverse, log=log)
     sweep = None
     if not args.no_sweep:
         log("MuJoCo constraint settings")

@@ -3,18 +3,15 @@
 pkm_autotest: actuator forces (in the spirit of the paper's Fig. 5), the
 prescribed and simulated platform motion (Fig. 6) and the round-trip error.
 
-usage: python -m pkm4puu.plot_cpp_autotest RESULTS_DIR
+usage: python -m pkm4puu plot-autotest RESULTS_DIR
 """
+import argparse
 import sys
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from .plots import plot_forces, plot_pose, save_figure  # noqa: E402
+from .plots import plot_forces, plot_pose, pyplot, save_figure
 
 
 def load(path):
@@ -31,6 +28,7 @@ def pose_columns(d, suffix):
 
 
 def plot_errors(runs, out):
+    plt = pyplot()
     fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     for label, d in runs:
         t = d["t_s"]
@@ -49,11 +47,12 @@ def plot_errors(runs, out):
     save_figure(fig, out)
 
 
-def main():
-    if len(sys.argv) != 2:
-        print(__doc__, file=sys.stderr)
-        return 2
-    res = Path(sys.argv[1])
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="python -m pkm4puu plot-autotest",
+                                 description="Plots of the C++ auto-test (pkm_autotest --out RESULTS_DIR) from its "
+                                 "autotest_*.csv files, written beside them.")
+    ap.add_argument("results", type=Path, metavar="RESULTS_DIR", help="the directory holding autotest_*.csv")
+    res = ap.parse_args(argv).results
     runs = []
     for name, label in (("rk4", "RK4, h = 1 ms"), ("cvode", "CVODE Adams, rtol 1e-12")):
         path = res / f"autotest_{name}.csv"
