@@ -34,22 +34,13 @@ const char* fmi3_type_name(VarType t);
 /// variable's element index (arrays), 0 for scalars.
 using Ref = void* (*)(ModelData& data, int index);
 
-/// What a computed variable depends on, for ModelStructure (bit set), and
-/// for an input what kind of known it is. The continuous states split into
-/// a position half (pose) and a rate half (velocity); inputs are position-,
-/// rate- or force-like (kOnInputs). A computed variable depends on every
-/// state and input whose kind it names.
-enum Depends : std::uint8_t {
-  kDependsNothing = 0,
-  kOnPositions = 1u << 0,  // position states and pose inputs
-  kOnRates = 1u << 1,      // rate states and velocity inputs
-  kOnInputs = 1u << 2,     // force-like inputs (forces, wrenches, accelerations)
-  kOnOwnState = 1u << 3,   // outputs that are a state: that state only
-  kOnHeight = 1u << 4,     // the vertical position (state or input): the machine is otherwise invariant to it
-  kOnHeightRate = 1u << 5, // its rate: only the slider velocities follow it
-  kOnWrench = 1u << 6,     // the external wrench inputs (a kind of kOnInputs)
-  kOnEnergy = 1u << 7,     // running-integral states (energy audit): nothing else depends on them
-};
+/// What a computed variable depends on, for ModelStructure: a bit set of
+/// kinds that the model defines for its states and inputs (`kind`); a
+/// computed variable depends on every state and input whose kind shares a
+/// bit with its `depends`. One bit is the layer's own: kOnOwnState, an
+/// output that is a state depends on that state only.
+constexpr std::uint8_t kDependsNothing = 0;
+constexpr std::uint8_t kOnOwnState = 1u << 3;
 
 /// Computed variables without a group of their own: every group computes them.
 constexpr std::uint8_t kAllGroups = 0xFF;
@@ -71,11 +62,11 @@ struct Variable {
   Ref derivative;   // first derivative of a continuous Real input (CS input interpolation), nullptr if none
   double min;       // -inf = no min attribute
   double max;       // +inf = no max attribute
-  std::uint8_t depends;  // Depends bits (outputs, locals)
+  std::uint8_t depends;  // kind bits (outputs, locals); kOnOwnState: that state only
   int state_of;     // der(x) rows: index of the state x in the model's states; -1 otherwise
   int state;        // rows that are continuous states: their index in the states; -1 otherwise
   int indicator = -1;  // rows that are event indicators (Model Exchange): their index; -1 otherwise
-  std::uint8_t kind = kDependsNothing;  // inputs and states: which Depends bit names them
+  std::uint8_t kind = kDependsNothing;  // inputs and states: the model's kind bits that name them
   double nominal = 1.0;  // continuous states: their scale (nominal attribute, GetNominalsOfContinuousStates)
   // Computed variables: the output group (a bit) that computes them, so that
   // a get pays only for what it reads (ModelData::update_outputs).
@@ -99,11 +90,9 @@ constexpr double kNoMin = -std::numeric_limits<double>::infinity();
 constexpr double kNoMax = std::numeric_limits<double>::infinity();
 
 /// Table rows of the usual kinds.
-/// A continuous Real input; `kind` says what it is for ModelStructure
-/// (kOnInputs: a force-like input; kOnPositions, kOnRates: a pose or velocity).
+/// A continuous Real input; `kind` says what it is for ModelStructure.
 constexpr Variable real_input(std::uint32_t vr, const char* name, double start, const char* unit,
-                              const char* description, Ref value, int index, Ref derivative,
-                              std::uint8_t kind = kOnInputs) {
+                              const char* description, Ref value, int index, Ref derivative, std::uint8_t kind) {
   return {vr,    name,  VarType::Real, Causality::Input, Variability::Continuous, Initial::None, start, unit,
           description, value, index, derivative, kNoMin, kNoMax, kDependsNothing, -1, -1, -1, kind};
 }
@@ -113,8 +102,7 @@ constexpr Variable real_output(std::uint32_t vr, const char* name, const char* u
   return {vr,    name,  VarType::Real, Causality::Output, Variability::Continuous, Initial::Calculated, 0.0, unit,
           description, value, index, nullptr, kNoMin, kNoMax, depends, -1, -1, -1, kDependsNothing, 1.0, group};
 }
-/// A Real output that is continuous state number `state` (pose, velocity)
-/// of the given kind (kOnPositions, kOnHeight or kOnRates).
+/// A Real output that is continuous state number `state` of the given kind.
 constexpr Variable state_output(std::uint32_t vr, const char* name, const char* unit, const char* description,
                                 Ref value, int index, int state, std::uint8_t kind, double nominal,
                                 std::uint8_t group = kAllGroups) {

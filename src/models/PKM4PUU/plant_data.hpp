@@ -1,0 +1,165 @@
+#pragma once
+// PKM4PUU.fmu: forward dynamics of the 4-PUU robot (the plant), over
+// pkm::Plant: the instance data and the hooks of the generic FMI layer
+// (fmi/model_data.hpp). Variables, names and units: variables.cpp.
+//
+// Immutable: the table below and the ModelDefinition (shared by every
+// instance); pkm::Model, built once per instance at the end of
+// initialisation and owned by the instance's pkm::Plant.
+// Per instance (PlantData): parameter values, inputs and their first
+// derivatives, the output cache and the Plant (integrated state).
+//
+// Time stepping: every fmi2DoStep integrates with inputs
+// u(t) = u + du (t - t_step_start) (du from fmi2SetRealInputDerivatives,
+// reset to 0 whenever u is set). After a step the inputs hold their
+// extrapolated values u + du h, the inputs at the new time. CVODE continues
+// its history across the communication point (Plant::advance with
+// continuous = true: no restart) when the inputs did not jump there
+// (inputs_continue): every input at the step start equals its value at the
+// end of the previous step within kInputJump (relative: rounding) -- inputs
+// held constant, or a ramp whose values and slopes the master sets each
+// step (a change of slope is a kink, which CVODE's error test resolves).
+// A value that differs is a jump, and CVODE restarts at the step start:
+// integrating across a jump from the old history costs accuracy (the
+// docs' "CVODE across communication points" measures how much).
+// FMU states: CVODE's history is not part of a saved state. The next step
+// after a GetFMUState restarts, as the first step after a SetFMUState does
+// (PlantData::state_saved), so a restored run continues bit for bit like
+// the original one (RK4 keeps no history: nothing changes for it).
+//
+// Outputs are computed lazily by group (the state's copies, the legs, the
+// dynamics, the machine, the health measures: kGroup* below), each on the
+// first get that reads it after anything changed, so that a controller
+// reading the pose and the sliders does not pay for the multipliers. The
+// accelerations, hence lambda, depend on the inputs at the current time.
+//
+// Model Exchange: the continuous states are the pose and its velocity (the
+// outputs x..dphi) and the energy audit's two running integrals
+// (actuator_work, dissipated_energy); the importer's integrator sets them and
+// the time, the legs are reconstructed from the pose (closed form), so the
+// states never leave the constraint manifold. The event indicators are the
+// singularity guards (pkm::guard_indicators), whose crossing terminates the
+// simulation with a logged reason as a discarded step does in
+// Co-Simulation, and the end stops (rho_i - rho_min, rho_max - rho_i), whose
+// crossings are events logged under logEvents.
+#include <cstdint>
+#include <memory>
+
+#include "models/common/dependencies.hpp"
+#include "models/common/mechanism_parameters.hpp"
+#include "pkm4puu/sim/plant.hpp"
+
+namespace pkm_fmi {
+// The plant FMU's instance data and its hooks (plant_data.cpp); its
+// variable table: variables.cpp.
+namespace pkm4puu_model {
+
+
+constexpr pkm::SolverSettings kDefaultSolver{};
+constexpr int kStates = 10;  // pose, velocity, actuator_work, dissipated_energy
+constexpr int kIndicators = pkm::kGuardIndicators + pkm::kStopIndicators;
+constexpr int kInputs = 12;  // F[1..4], Fe[1..3], Me_z, tau[1..4]
+// MODEL_SPEC "A check anyone can derive": each actuator's share of the
+// weight at the default initial pose, the start value of F[1..4] (so that a
+// plant nothing drives stays where it is).
+constexpr double kHoldingForce = 2.655616050;
+// An input jumps at a communication point when it differs from its value at
+// the end of the previous step by more than this, relative to 1 + |value|
+// (in N, N*m): far above the rounding of a master that evaluates a ramp
+// a + b t where the FMU extrapolated u + b h (a few 1e-16), far below any
+// jump that matters (a jump of 1e-12 N moves the platform by ~1e-16 m in a
+// millisecond).
+constexpr double kInputJump = 1e-12;
+
+// The output groups (Variable::group): a get computes only the groups it
+// reads, each once until the state, time or inputs change.
+enum : std::uint8_t {
+  kGroupState = 1u << 0,     // pose, velocity, energy integrals, der(pose): copies of the state
+  kGroupJoints = 1u << 1,    // drho, theta1, theta2: the legs in closed form
+  kGroupDynamics = 1u << 2,  // accelerations and multipliers: the full forward dynamics
+  kGroupMachine = 1u << 3,   // end stops, holding forces, energies and their rates
+  kGroupHealth = 1u << 4,    // loop-closure residual, Jacobian condition, guard indicators
+  kGroupSliders = 1u << 5,   // rho: the closed form without angles (what a joint-space controller reads)
+};
+
+struct PlantData final : MechanismData {
+  // Parameters beyond the mechanism's: initial state and solver settings.
+  double pose0[4] = {0.0, 0.0, 0.05, 0.0};
+  double vel0[4] = {0.0, 0.0, 0.0, 0.0};
+  std::int32_t solver = static_cast<std::int32_t>(kDefaultSolver.solver);
+  double rk4_step = kDefaultSolver.rk4_step;
+  double rtol = kDefaultSolver.rtol;
+  double atol = kDefaultSolver.atol;
+  std::int32_t cvode_method = static_cast<std::int32_t>(kDefaultSolver.cvode_method);
+  std::int32_t formulation = static_cast<std::int32_t>(kDefaultSolver.formulation);
+  // Inputs u = [F1..F4, Fe1..Fe3, Me_z, tau1..tau4] at the current time, and du/dt.
+  double u[kInputs] = {kHoldingForce, kHoldingForce, kHoldingForce, kHoldingForce};
+  double du[kInputs] = {};
+  // Outputs (computed by update_outputs).
+  double pose[4] = {}, vel[4] = {};
+  double rho[4] = {}, drho[4] = {}, theta1[4] = {}, theta2[4] = {};
+  double lambda[12] = {};
+  double residual = 0.0, condition = 0.0;
+  double F_hold[4] = {}, stop_force[4] = {};
+  double kinetic = 0.0, potential = 0.0;
+  double energy[2] = {};  // actuator_work, dissipated_energy (states)
+  double dy[kStates] = {};  // der(x) .. der(dphi), der(actuator_work), der(dissipated_energy)
+  double z[kIndicators] = {};  // the event indicators: guards, then end stops
+  // Model Exchange: the stops passed at the last event (end_stops.hpp's
+  // contact mode), to log contacts and releases.
+  unsigned logged_stops = 0;
+  // Co-Simulation: end-stop events located so far (logged per step).
+  long contact_events = 0;
+  // Co-Simulation: the inputs at the end of the last step and whether CVODE
+  // may continue from there (no restart, failure or saved state since).
+  double u_end[kInputs] = {};
+  bool may_continue = false;
+  // The simulated machine (nullptr before initialisation).
+  std::unique_ptr<pkm::Plant> plant;
+
+  void reset() override {
+    plant.reset();
+    may_continue = false;
+  }
+  void state_saved() override { may_continue = false; }
+  /// Whether every input continues its value at the end of the last step (kInputJump).
+  bool inputs_continue() const;
+  Status exit_initialization(Context& ctx) override;
+  Status do_step(Context& ctx, double t, double h, double& t_reached) override;
+  Status check_step(Context& ctx, double h) const override;
+  Status update_outputs(Context& ctx, unsigned groups) override;
+  void save(StateWriter& w) const override;
+  bool load(StateReader& r, Context& ctx) override;
+
+  void set_time(double t) override {
+    if (plant) plant->set_time(t);
+  }
+  Status get_states(Context& ctx, double x[]) override;
+  Status set_states(Context& ctx, const double x[]) override;
+  Status get_derivatives(Context& ctx, double dx[]) override;
+  Status get_event_indicators(Context& ctx, double z[]) override;
+  Status event_update(Context& ctx, bool& terminate) override;
+  Status partial_derivatives(Context& ctx, const Variable* const unknowns[], std::size_t nu,
+                             const Variable* const knowns[], std::size_t nk, double J[]) override;
+
+  /// The absolute time of the plant (its own time is the time since startTime), for messages.
+  double absolute_time(const Context& ctx) const { return ctx.start_time + plant->time(); }
+  /// The model and solver settings of the current parameters (Error, logged, if unusable).
+  Status configuration(Context& ctx, const char* function, pkm::Model& model, pkm::SolverSettings& s) const;
+  /// A Plant for the current parameters (not yet initialised).
+  Status make_plant(Context& ctx, const char* function, std::unique_ptr<pkm::Plant>& out) const;
+  /// Whether the plant exists and was built from these parameters and settings.
+  bool built_from(const pkm::Model& model, const pkm::SolverSettings& s) const;
+  /// make_plant, then the consistent initial state from x0..phi0, dx0..dphi0.
+  Status build(Context& ctx, const char* function);
+  /// The plant, built from the current parameters in initialisation mode.
+  Status ready(Context& ctx, const char* function);
+  pkm::LinearInputs inputs(double t0) const;
+  /// The stops passed now (end_stops.hpp's contact mode; bit k: indicator k < 0).
+  unsigned stops_passed_now() const;
+  /// Logs (logEvents) each stop passed or left since the last call.
+  void log_stop_changes(Context& ctx, unsigned now, const char* where);
+};
+
+}  // namespace pkm4puu_model
+}  // namespace pkm_fmi
