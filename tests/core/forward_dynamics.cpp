@@ -80,7 +80,7 @@ namespace {
 std::vector<ReducedDynamics::LegLanes> lane_kernels() {
   using K = ReducedDynamics::LegLanes;
   std::vector<K> k = {K::Best, K::Scalar, K::Generic};
-  if (ReducedDynamics::lanes_available(K::Avx)) k.push_back(K::Avx);
+  if (lanes_available(K::Avx)) k.push_back(K::Avx);
   return k;
 }
 
@@ -156,7 +156,7 @@ TEST(ForwardDynamics, HotPathIsBitIdenticalToTheReducedTermsWithTheLegs) {
 }
 
 TEST(ForwardDynamics, ActuatorPositionsAreTheLegInverseKinematicsBitForBit) {
-  // actuator_positions (ReducedDynamics::leg_positions: the derivative's
+  // actuator_positions (lane_actuator_positions: the derivative's
   // legs' inverse kinematics, four lanes) against leg_inverse_kinematics leg
   // by leg: the same rho bits, and off the workspace the same status with
   // rho untouched, for every variant of the lanes. Poses within the
@@ -178,7 +178,7 @@ TEST(ForwardDynamics, ActuatorPositionsAreTheLegInverseKinematicsBitForBit) {
     if (expected != Status::Ok) ++failing;
     for (const auto kernel : kernels) {
       Vec4 rho = Vec4::Constant(7.0);
-      ASSERT_EQ(ReducedDynamics::leg_positions(m, pc, rho, kernel), expected)
+      ASSERT_EQ(lane_actuator_positions(m, pc, rho, kernel), expected)
           << "kernel " << static_cast<int>(kernel) << " seed " << seed;
       if (expected != Status::Ok) {
         EXPECT_EQ(rho, Vec4::Constant(7.0));  // untouched on failure

@@ -12,6 +12,7 @@
 
 #include <array>
 
+#include "pkm4puu/dynamics/leg_lanes.hpp"
 #include "pkm4puu/kinematics/leg_kinematics.hpp"
 
 namespace pkm {
@@ -45,15 +46,7 @@ class ReducedDynamics {
   /// for every leg).
   void reduced_system(const Model& m, const Wrench& we, Mat4& Mr, Vec4& rhs) const;
 
-  /// The variants of the legs' lanes (lanes.hpp): the same template, the
-  /// same bits; tests run each of them explicitly.
-  enum class LegLanes {
-    Best,     // Avx where m.avx (x86-64 GCC/Clang off Windows), else Generic
-    Scalar,   // one leg at a time (the same template for double)
-    Generic,  // the baseline instruction set (SSE2 pairs on x86-64, NEON on aarch64)
-    Avx,      // AVX; Status::InvalidArgument where unavailable
-  };
-  static bool lanes_available(LegLanes kind);
+  using LegLanes = pkm::LegLanes;  // leg_lanes.hpp
   /// The integrators' hot path (state_derivative): the platform's
   /// accelerations pdd without keeping the legs' terms (solve() needs them,
   /// solve_platform does not). The same arithmetic as prepare_leg,
@@ -68,13 +61,6 @@ class ReducedDynamics {
   static Status platform_derivative(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
                                     unsigned stops, Vec4* rho, Vec4* rhod, Pose& pdd,
                                     LegLanes kind = LegLanes::Best);
-  /// The actuator positions rho_1..4 (actuator_positions without the
-  /// finiteness check): the legs' inverse kinematics of platform_derivative,
-  /// four lanes, the same bits as leg_inverse_kinematics leg by leg. On
-  /// failure Status::Unreachable (the first failing leg's, as leg by leg),
-  /// rho untouched; InvalidArgument for an unavailable variant.
-  static Status leg_positions(const Model& m, const PlatformConfig& pc, Vec4& rho,
-                              LegLanes kind = LegLanes::Best);
 
   struct Leg {
     LegConfig c;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "pkm4puu/base/types.hpp"
 #include "pkm4puu/model/params.hpp"
 
 namespace pkm {
