@@ -33,7 +33,7 @@ gives the median of the rounds' medians and the best batch. The C harness
 also runs two one-call C API cases (the simulated second as a single
 pkm_advance_fn: RK4 at 1 ms, and CVODE rtol 1e-12 taking its own steps).
 
-Issue 16 item 3: two control-tick cases of the plant FMU (step + the 12
+two control-tick cases of the plant FMU (step + the 12
 controller outputs: RK4 with midpoint-held forces, and CVODE at its default
 tolerances with the forces as a continuous ramp, value and slope each tick)
 are printed against their targets (15x and 10x MuJoCo's mj_step). Both sides
@@ -351,7 +351,7 @@ def main(argv=None):
         print(f"target (>= 10x faster than MuJoCo): {LABELS[key][0]}: {ratio:.1f}x "
               f"(best batches: {best['mujoco_rollout'] / best[key]:.1f}x): {'met' if ratio >= 10.0 else 'NOT met'}; "
               f"max ||C|| {c_cases[key]['max_c']:.1e} m")
-    # Issue 16 item 3: a control tick of the plant FMU (step + the 12 controller outputs) against mj_step, both
+    # a control tick of the plant FMU (step + the 12 controller outputs) against mj_step, both
     # timed in a C loop (the C harness; mujoco.rollout), so neither carries Python's per-call overhead.
     for how, t in (("median", median), ("best batches", best)):
         per_step_c, per_step_py = t["mujoco_rollout"] / STEPS_TIMED, t["mujoco_loop"] / STEPS_TIMED

@@ -67,7 +67,7 @@ const Formulation kFormulations[kForms] = {Formulation::LegPartitioned, Formulat
 const char* const kFormNames[kForms] = {"LegPartitioned", "NullSpaceQR", "Augmented"};
 
 const char* ok_mark(double value, double target) { return value <= target ? "ok" : "OVER"; }
-// One LegPartitioned state derivative (issue 16), s.
+// One LegPartitioned state derivative, s.
 constexpr double kDerivativeTarget = 0.25e-6;
 
 void rule() {
@@ -297,7 +297,7 @@ StateDerivativeFigures state_derivative_section(Bench& b) {
   return sd;
 }
 
-// ----------------------------------------- 1b. analytic derivatives (issue 13)
+// ----------------------------------------- 1b. analytic derivatives
 // The full Jacobian of the state derivative, A (8x8) and B (8x12), and the
 // inverse dynamics' dF/d(p, pd, pdd, we), each against its own value
 // measured here in the same run: one state_derivative (LegPartitioned,
@@ -770,7 +770,7 @@ void ratios_section(const StateDerivativeFigures& sd, double jac_ratio, const In
               static_cast<double>(a.cvd_rt.rhs) / 8000.0);
   std::printf("   CVODE run_autotest / RK4 run_autotest: 1e-12 %.2f, 1e-8 %.2f\n",
               a.cvt_rt.fig.median / a.rk4_rt.fig.median, a.cvd_rt.fig.median / a.rk4_rt.fig.median);
-  std::printf("   targets: state derivative <= %g us (issue 16): %s (%s);  2-s RK4 forward run <= 10 ms: %s (%s)\n",
+  std::printf("   targets: state derivative <= %g us: %s (%s);  2-s RK4 forward run <= 10 ms: %s (%s)\n",
               kDerivativeTarget * 1e6, ok_mark(sd0, kDerivativeTarget), fmt_time(sd0).c_str(), ok_mark(a.rk4_fwd.fig.median, 10e-3),
               fmt_time(a.rk4_fwd.fig.median).c_str());
   rule();

@@ -1,6 +1,6 @@
 // pkm_tick_bench: the work of one 1-ms communication step of the core's
 // Plant, CVODE restarted at every step against CVODE continued across the
-// steps (issue 16 item 2), beside RK4. Prints a table; not a test.
+// steps, beside RK4. Prints a table; not a test.
 //
 // Scenario: the home pose, 1 s of 1-ms steps, F[1..4] at the static holding
 // force (inverse dynamics at rest) plus a perturbation on F[1], given per

@@ -1,4 +1,4 @@
-# Every platform (issue 14): the FMU binaries cross-built for Windows x64
+# Every platform: the FMU binaries cross-built for Windows x64
 # (mingw-w64) and Linux aarch64 (gcc), each in a sub-build of this project
 # under ${CMAKE_BINARY_DIR}/platforms/<target> with the toolchain files of
 # cmake/toolchains/, against a static CVODE built for the target from

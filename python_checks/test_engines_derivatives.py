@@ -1,7 +1,7 @@
 """This project's analytic derivatives of the reduced forward dynamics,
 A = dydot/dy (y = pose and rates) and B = dydot/du (u = F[1..4], Fe[1..3],
 Me_z, tau[1..4]), against Pinocchio's analytic derivatives on the independent
-model (issue 13, item 4).
+model.
 
 The reference (pkm4puu/references/pinocchio_derivatives.py says exactly what
 is taken from Pinocchio and what is assembled): Pinocchio's

@@ -1,7 +1,6 @@
 """The machine around the mechanism (MODEL_SPEC "The machine around the
-mechanism") checked against independent engines (issue 12, item 3's first
-check): rotor inertia, viscous friction, Coulomb friction and an off-centre
-payload, each alone and all together, on the spec's comparison test
+mechanism") checked against independent engines: rotor inertia, viscous
+friction, Coulomb friction and an off-centre payload, each alone and all together, on the spec's comparison test
 (1.5 s from rest at P0, F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s), F2 = F3 = 0).
 The runners and the machine's numbers are in engine_comparison.py
 (machine_cases), the engine models in engines/.

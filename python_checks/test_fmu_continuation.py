@@ -1,4 +1,4 @@
-"""CVODE continued across communication points (issue 16 item 2).
+"""CVODE continued across communication points.
 
 With CVODE the plant FMU keeps the integrator's history from one fmi2DoStep
 to the next when the inputs continue (held constant, or given with their

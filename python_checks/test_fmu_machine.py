@@ -1,5 +1,5 @@
-"""The machine around the mechanism through the FMUs (issue 12, item 3;
-MODEL_SPEC "The machine around the mechanism"): the auto-test chain with every
+"""The machine around the mechanism through the FMUs (MODEL_SPEC "The machine
+around the mechanism"): the auto-test chain with every
 term on, the plant's energy audit, and a drop onto the end stops.
 
 Every term on: a rotor on each ball screw whose reflected mass J (2 pi/p)^2

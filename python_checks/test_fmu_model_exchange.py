@@ -31,7 +31,7 @@ H = 1e-3  # s, the interval of the held forces and the communication step
 N = round(T_MOVE / H)
 START = {"x0": P0[0], "y0": P0[1], "z0": P0[2], "phi0": P0[3]}
 WRENCH = ["Fe[1]", "Fe[2]", "Fe[3]", "Me_z"]
-TOL = 1e-8  # m and rad: Model Exchange against Co-Simulation (issue 11)
+TOL = 1e-8  # m and rad: Model Exchange against Co-Simulation
 TOL_PATH = 5e-8  # m and rad: either against the prescribed path (test_fmu_autotest)
 
 
@@ -77,7 +77,7 @@ def model_exchange(path, forces, rtol):
 def test_model_exchange_auto_test_converges_to_co_simulation(archive, request, midpoint_forces, co_simulation):
     """fmpy's CVode (absolute tolerance rtol x the declared nominals) restarts
     at each of the 2,000 input events. At rtol 1e-10 it must reproduce the
-    Co-Simulation result to 1e-8 m / 1e-8 rad (issue 11), and the difference
+    Co-Simulation result to 1e-8 m / 1e-8 rad, and the difference
     must shrink at least tenfold when rtol is a hundred times tighter: it is
     the importer's integration error, not a model difference."""
     t_cs, cs = co_simulation

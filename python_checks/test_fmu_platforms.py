@@ -1,4 +1,4 @@
-"""Every platform in one archive per FMU (cmake/Platforms.cmake, issue 14):
+"""Every platform in one archive per FMU (cmake/Platforms.cmake):
 
 - the merged archives hold the binaries of every platform and the sources,
   and fmpy validates them;

@@ -1,4 +1,4 @@
-/* fmu_allocations: no heap allocation in a control tick (issue 16 item 4).
+/* fmu_allocations: no heap allocation in a control tick.
  *
  * The plant FMU (PKM4PUU.so) driven through raw FMI 2.0 Co-Simulation calls
  * while a malloc interposer (alloc_interposer.c) counts every heap

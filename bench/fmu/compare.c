@@ -28,7 +28,7 @@
  *                   the FMU restarts it every communication step)
  *   fmu_rk4_ctrl12  fmu_rk4 reading the 12 controller outputs (x, y, z, phi,
  *                   their rates, rho[1..4]) instead of the pose: a control
- *                   tick (issue 16 item 3, against MuJoCo's RK4)
+ *                   tick
  *   fmu_cvode_ramp_ctrl12  CVODE at its defaults, the forces as a continuous
  *                   ramp: each tick fmi2SetReal(F at t_k) and
  *                   fmi2SetRealInputDerivatives(slope (F(t_k+1) - F(t_k))/h),

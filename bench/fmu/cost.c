@@ -1,4 +1,4 @@
-/* pkm_fmu_bench cost: the plant FMU's cost in one table (issue 16 item 5),
+/* pkm_fmu_bench cost: the plant FMU's cost in one table,
  * through the FMU binary (no Python in any timed loop):
  *
  *   - wall time per simulated second against the communication step h

@@ -12,7 +12,7 @@
  *   (b) (a) + fmi2GetReal(x, y, z, phi)
  *   (c) (a) + fmi2GetReal of a controller's 12 outputs (pose, rates, rho[1..4])
  *   (d) (b) + fmi2GetReal(every Real output)
- * and what (c) adds to (a), in percent (issue 16's target: at most 10 % with RK4).
+ * and what (c) adds to (a), in percent (target: at most 10 % with RK4).
  * A batch is 1 s of simulated time (1000 steps) from the home pose (the FMU
  * state saved after initialisation is restored before each batch, outside
  * the timed region, so every batch integrates the same second); one

@@ -39,6 +39,38 @@ void section(std::ofstream& out, const pkm_fmi::ModelDefinition& def, pkm_fmi::C
   out << "</table>\n";
 }
 
+/// What the variable table says about the interfaces: the continuous states
+/// and event indicators that Model Exchange integrates and locates.
+void interfaces(std::ofstream& out, const pkm_fmi::ModelDefinition& def) {
+  out << "<h2>Interfaces</h2>\n<p>FMI 2.0 and FMI 3.0, each with Co-Simulation and Model Exchange. Model "
+         "Exchange has "
+      << def.n_states << " continuous state" << (def.n_states == 1 ? "" : "s") << " and " << def.n_event_indicators
+      << " event indicator" << (def.n_event_indicators == 1 ? "" : "s") << ".</p>\n";
+  if (def.n_states > 0) {
+    out << "<table>\n<tr><th>state</th><th>unit</th><th>nominal</th><th>description</th></tr>\n";
+    for (std::size_t k = 0; k < def.n_states; ++k)
+      for (std::size_t i = 0; i < def.n_variables; ++i) {
+        const pkm_fmi::Variable& v = def.variables[i];
+        if (v.state != static_cast<int>(k)) continue;
+        out << "<tr><td><code>" << pkm_fmi::xml_escape(v.name) << "</code></td><td>" << pkm_fmi::xml_escape(v.unit)
+            << "</td><td>" << pkm_fmi::exact_text(v.nominal) << "</td><td>" << pkm_fmi::xml_escape(v.description)
+            << "</td></tr>\n";
+      }
+    out << "</table>\n";
+  }
+  if (def.n_event_indicators > 0) {
+    out << "<table>\n<tr><th>event indicator</th><th>unit</th><th>description</th></tr>\n";
+    for (std::size_t k = 0; k < def.n_event_indicators; ++k)
+      for (std::size_t i = 0; i < def.n_variables; ++i) {
+        const pkm_fmi::Variable& v = def.variables[i];
+        if (v.indicator != static_cast<int>(k)) continue;
+        out << "<tr><td><code>" << pkm_fmi::xml_escape(v.name) << "</code></td><td>" << pkm_fmi::xml_escape(v.unit)
+            << "</td><td>" << pkm_fmi::xml_escape(v.description) << "</td></tr>\n";
+      }
+    out << "</table>\n";
+  }
+}
+
 /// The model descriptions of both FMI versions into <dir>/fmi<v>/<id>.xml.
 int write_model_descriptions(const char* prog, const pkm_fmi::ModelDefinition& def, const std::string& dir) {
   for (int version : {2, 3}) {
@@ -93,6 +125,7 @@ int main(int argc, char** argv) {
          "<td><code>fmpy compile</code> on Linux x86-64: the auto-test as the binary</td></tr>\n"
          "</table>\n<p>Every platform is in the archives of <code>build/dist/</code>; "
          "<code>build/*.fmu</code> hold the build machine's binary only.</p>\n";
+  interfaces(out, *def);
   section(out, *def, pkm_fmi::Causality::Input, "Inputs");
   section(out, *def, pkm_fmi::Causality::Output, "Outputs");
   section(out, *def, pkm_fmi::Causality::Parameter, "Parameters");

@@ -40,7 +40,7 @@ constexpr double kH = 1e-3;           // s, the communication step
 constexpr int kSteps = 2000;          // the 2-s motion
 constexpr double kTolPos = 5e-8;      // m   (python_checks/fmu_autotest.py TOL_POS)
 constexpr double kTolPhi = 5e-8;      // rad (python_checks/fmu_autotest.py TOL_PHI)
-constexpr double kPlatformRtolRk4 = 1e-12;  // issue 14: the cross-built binaries against linux64
+constexpr double kPlatformRtolRk4 = 1e-12;  // the cross-built binaries against linux64
 const char* const kPose[4] = {"x", "y", "z", "phi"};
 
 struct Solver {

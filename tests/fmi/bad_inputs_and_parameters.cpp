@@ -185,7 +185,7 @@ TEST(HardeningParameters, OutOfRangeParametersFailInitialisationAndResetRecovers
       {"cvode_method", 7, "cvode_method = 7 must be 0 (Adams) or 1 (BDF)", true},
       {"formulation", 3, "formulation = 3 must be 0", true},
       {"formulation", -2, "formulation = -2 must be 0", true},
-      // Issue 17.3: values no step can use, refused when set.
+      // Values no step can use, refused when set.
       {"rk4_step", 1e-9, "rk4_step"},
       {"rk4_step", 1e-10, "rk4_step"},
       {"rk4_step", 1e-300, "rk4_step"},

@@ -181,7 +181,7 @@ TEST_F(FmuState, ForeignOrBrokenFmuStates) {
       });
 }
 
-// Issue 17.6: states with a valid checksum and absurd content. The layout
+// States with a valid checksum and absurd content. The layout
 // (fmu_state.cpp): a 32-byte header; mode (4), three flags (3), startTime,
 // stopTime, time, last successful time, time since start (8 each) from byte
 // 39; the count (4) and the stored variables (8 each) from byte 83; then the input

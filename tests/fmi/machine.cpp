@@ -1,7 +1,6 @@
 // The plant FMU behaves like the machine when nothing is set (MODEL_SPEC
 // "The machine around the mechanism"), and its log stays quiet: with logging
-// on and no category named only warnings, errors and events are written
-// (issue 12, item 4).
+// on and no category named only warnings, errors and events are written.
 #include <string>
 
 #include "fmu_loader.hpp"

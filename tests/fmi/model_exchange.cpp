@@ -4,7 +4,7 @@
 // set through fmi2SetReal), as MODEL_SPEC "Auto-test" and the paper do.
 // The in-process auto-test (pkm::run_autotest, RK4 at 1 ms) integrates the
 // same ODE with the same method, so the two trajectories must agree to
-// rounding (bound 1e-10 m and rad, issue 11): a Model Exchange state,
+// rounding (bound 1e-10 m and rad): a Model Exchange state,
 // derivative or time handled differently from the core would show here.
 #include <array>
 #include <cmath>

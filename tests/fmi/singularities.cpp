@@ -276,7 +276,7 @@ SpecGuards spec_guards(double x, double y, double phi) {
   return g;
 }
 
-// Issue 17.1: leg 2's rod turns horizontal at x = 0.0231306807897694 m
+// Leg 2's rod turns horizontal at x = 0.0231306807897694 m
 // (y = 0, z = 0.05 m, phi = 0); with dx = 0.01 m/s the inverse FMU used to
 // answer fmi2OK with forces of -1.1e19 N. Approaching that pose along x,
 // every answer must follow the guards as computed from the spec: OK with

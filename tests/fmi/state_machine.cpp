@@ -384,7 +384,7 @@ TEST_F(StateMachine, NullAndForeignComponentsAreErrorsWithoutACrash) {
 #ifndef _WIN32  // the FMI 3.0 functions are looked up with dlsym
 // Both libraries are built from the same sources: an instance made by one
 // has the right tag for the other, only its model definition differs. Each
-// library must serve its own model's instances only (issue 17.5), and the
+// library must serve its own model's instances only, and the
 // FMI 3.0 entry points only instances made by fmi3Instantiate*.
 TEST_F(StateMachine, InstancesOfTheOtherModelOrFmiVersionAreErrors) {
   FmuLibrary& inverse = inverse_library();

@@ -235,7 +235,7 @@ TEST_F(Stepping, AStepWhoseEndOverflowsIsAnError) {
             "yes: every variable bit-identical, time unchanged");
 }
 
-// Issue 17.7: at t = 1e15 a 1 ms step rounds away (the spacing of doubles
+// At t = 1e15 a 1 ms step rounds away (the spacing of doubles
 // there is 0.125 s): answering OK would advance nothing.
 TEST_F(Stepping, AStepThatVanishesInTPlusHIsAnError) {
   PlantFmu p;
@@ -253,7 +253,7 @@ TEST_F(Stepping, AStepThatVanishesInTPlusHIsAnError) {
             "yes: every variable bit-identical; a later step of 1 s succeeds");
 }
 
-// Issue 17.7: at startTime 1e9 s, t + 1 ms rounds to a multiple of 0.12 us;
+// At startTime 1e9 s, t + 1 ms rounds to a multiple of 0.12 us;
 // the model used to integrate (t + h) - t, 7e-5 s lost over 1 s. It
 // integrates the time since start: the motion is that of a start at 0.
 TEST_F(Stepping, TheMotionDoesNotDependOnTheStartTime) {

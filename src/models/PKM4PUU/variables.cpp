@@ -187,17 +187,17 @@ const ModelDefinition kDefinition{
     "wrench on the platform; outputs are the platform pose and velocity, the joint coordinates of the legs, the "
     "Lagrange multipliers, the constraint residual and the condition number of the actuator Jacobian. The legs "
     "work elbow-down (the platform hangs below the rods).</p>"
-    "<p><b>Co-Simulation:</b> each communication step is integrated by CVODE (default; restarted at every step, "
-    "so results depend only on the state and inputs at the step start) or by fixed-step RK4. With FMI 2.0 the "
-    "inputs can be interpolated linearly within a step (fmi2SetRealInputDerivatives, order 1). A step that cannot "
-    "be completed, or that ends near a leg singularity (min_leg_measure) or a parallel singularity "
-    "(max_jacobian_condition), returns Discard with the last good state kept at the last successful time and "
-    "terminated = true. <b>Model Exchange:</b> the continuous states are x, y, z, phi, dx, dy, dz, dphi; the legs "
-    "are reconstructed from them in closed form, so the loop closures hold exactly whatever the importer's "
-    "integrator does. The five event indicators are the singularity guards (1/cond - 1/max_jacobian_condition, "
-    "and |cos theta2 sin theta2| - min_leg_measure per leg); crossing one ends the simulation with a logged "
-    "reason. A pose that no leg can reach is refused by SetContinuousStates with Discard. FMU states can be "
-    "saved, restored and serialised.</p>",
+    "<p><b>Co-Simulation:</b> each communication step is integrated by CVODE (default) or by fixed-step RK4, "
+    "with the end stops' contacts located as events inside the step. CVODE continues its history across "
+    "communication points while the inputs continue smoothly, and restarts where they jump, after a failed step "
+    "and after a restored FMU state. With FMI 2.0 the inputs can be interpolated linearly within a step "
+    "(fmi2SetRealInputDerivatives, order 1). A step that cannot be completed, or that ends near a leg "
+    "singularity (min_leg_measure) or a parallel singularity (max_jacobian_condition), returns Discard with the "
+    "last good state kept. <b>Model Exchange:</b> the legs are reconstructed in closed form from the continuous "
+    "states, so the loop closures hold exactly whatever the importer's integrator does. The event indicators "
+    "are the singularity guards, whose crossing ends the simulation with a logged reason, and the end stops, "
+    "whose crossings are events logged under logEvents. A pose that no leg can reach is refused by "
+    "SetContinuousStates with Discard. FMU states can be saved, restored and serialised.</p>",
     kVariables,
     std::size(kVariables),
     /*n_states=*/kStates,

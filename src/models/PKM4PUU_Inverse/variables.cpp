@@ -100,12 +100,11 @@ const ModelDefinition kDefinition{
     "Given the platform pose, velocity and acceleration and an external wrench, it solves the position, "
     "velocity and acceleration problems of the legs (Eqs. 2-9, elbow-down) and then Eqs. 10-11 for the "
     "Lagrange multipliers and the four actuator forces. The outputs are algebraic functions of the inputs at "
-    "the current time (direct feedthrough): in Co-Simulation a step only advances time; in Model Exchange it has "
-    "no states and no event indicators.</p>"
+    "the current time (direct feedthrough): in Co-Simulation a step only advances time.</p>"
     "<p>An unreachable pose makes the get of an output return Error with a message; no output is written "
     "then. A pose beyond a singularity guard (min_leg_measure, max_jacobian_condition, as in the plant) makes "
-    "it return Discard with the reason logged and the outputs of the last pose within the guards. At rest at the home pose (0, 0, 0.05 m, 0) with g = 9.81 m/s2 each actuator carries "
-    "2.655616050 N.</p>",
+    "it return Discard with the reason logged and the outputs of the last pose within the guards. At rest at "
+    "the home pose (0, 0, 0.05 m, 0) with g = 9.81 m/s2 each actuator carries 2.655616050 N.</p>",
     kVariables,
     std::size(kVariables),
     /*n_states=*/0,
