@@ -39,6 +39,25 @@ void section(std::ofstream& out, const pkm_fmi::ModelDefinition& def, pkm_fmi::C
   out << "</table>\n";
 }
 
+/// A table of the variables that `index_of` numbers 0..n-1 (states,
+/// event indicators), in that order; `nominal` adds the nominal column.
+template <class IndexOf>
+void numbered_table(std::ofstream& out, const pkm_fmi::ModelDefinition& def, std::size_t n, const char* what,
+                    bool nominal, IndexOf index_of) {
+  out << "<table>\n<tr><th>" << what << "</th><th>unit</th>" << (nominal ? "<th>nominal</th>" : "")
+      << "<th>description</th></tr>\n";
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t i = 0; i < def.n_variables; ++i) {
+      const pkm_fmi::Variable& v = def.variables[i];
+      if (index_of(v) != static_cast<int>(k)) continue;
+      out << "<tr><td><code>" << pkm_fmi::xml_escape(v.name) << "</code></td><td>" << pkm_fmi::xml_escape(v.unit)
+          << "</td><td>";
+      if (nominal) out << pkm_fmi::exact_text(v.nominal) << "</td><td>";
+      out << pkm_fmi::xml_escape(v.description) << "</td></tr>\n";
+    }
+  out << "</table>\n";
+}
+
 /// What the variable table says about the interfaces: the continuous states
 /// and event indicators that Model Exchange integrates and locates.
 void interfaces(std::ofstream& out, const pkm_fmi::ModelDefinition& def) {
@@ -46,29 +65,11 @@ void interfaces(std::ofstream& out, const pkm_fmi::ModelDefinition& def) {
          "Exchange has "
       << def.n_states << " continuous state" << (def.n_states == 1 ? "" : "s") << " and " << def.n_event_indicators
       << " event indicator" << (def.n_event_indicators == 1 ? "" : "s") << ".</p>\n";
-  if (def.n_states > 0) {
-    out << "<table>\n<tr><th>state</th><th>unit</th><th>nominal</th><th>description</th></tr>\n";
-    for (std::size_t k = 0; k < def.n_states; ++k)
-      for (std::size_t i = 0; i < def.n_variables; ++i) {
-        const pkm_fmi::Variable& v = def.variables[i];
-        if (v.state != static_cast<int>(k)) continue;
-        out << "<tr><td><code>" << pkm_fmi::xml_escape(v.name) << "</code></td><td>" << pkm_fmi::xml_escape(v.unit)
-            << "</td><td>" << pkm_fmi::exact_text(v.nominal) << "</td><td>" << pkm_fmi::xml_escape(v.description)
-            << "</td></tr>\n";
-      }
-    out << "</table>\n";
-  }
-  if (def.n_event_indicators > 0) {
-    out << "<table>\n<tr><th>event indicator</th><th>unit</th><th>description</th></tr>\n";
-    for (std::size_t k = 0; k < def.n_event_indicators; ++k)
-      for (std::size_t i = 0; i < def.n_variables; ++i) {
-        const pkm_fmi::Variable& v = def.variables[i];
-        if (v.indicator != static_cast<int>(k)) continue;
-        out << "<tr><td><code>" << pkm_fmi::xml_escape(v.name) << "</code></td><td>" << pkm_fmi::xml_escape(v.unit)
-            << "</td><td>" << pkm_fmi::xml_escape(v.description) << "</td></tr>\n";
-      }
-    out << "</table>\n";
-  }
+  if (def.n_states > 0)
+    numbered_table(out, def, def.n_states, "state", true, [](const pkm_fmi::Variable& v) { return v.state; });
+  if (def.n_event_indicators > 0)
+    numbered_table(out, def, def.n_event_indicators, "event indicator", false,
+                   [](const pkm_fmi::Variable& v) { return v.indicator; });
 }
 
 /// The model descriptions of both FMI versions into <dir>/fmi<v>/<id>.xml.
