@@ -46,8 +46,8 @@ BUILD_DESCRIPTION = """<?xml version="1.0" encoding="UTF-8"?>
 <fmiBuildDescription fmiVersion="3.0">
   <BuildConfiguration modelIdentifier="{id}" description="C++17; no dependency (Eigen inside, RK4 only: solver = 1)">
     <SourceFileSet language="C++17">
-      <IncludeDirectory name="."/>
 {files}
+      <IncludeDirectory name="."/>
     </SourceFileSet>
   </BuildConfiguration>
 </fmiBuildDescription>
