@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 # The FMUs: the FMI 2.0 and 3.0 headers, the FMU shared objects and their
 # .fmu archives.
 #

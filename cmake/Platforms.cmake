@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 # Every platform: the FMU binaries cross-built for Windows x64
 # (mingw-w64) and Linux aarch64 (gcc), each in a sub-build of this project
 # under ${CMAKE_BINARY_DIR}/platforms/<target> with the toolchain files of

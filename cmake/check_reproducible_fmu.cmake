@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 # ctest fmu_archive_reproducible_*: the archive is rebuilt from freshly
 # written inputs (the model description copied anew, the documentation page
 # written again by the doc tool, the binary copied: new files, new

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Merges one FMU's builds for every platform into one archive, and adds its
 source code: the Reference-FMUs way of shipping an FMU (one archive, a
 binaries/<platform>/ folder per platform, sources/ to build for any other).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Writes an FMU archive (zip) that depends only on the files' contents:
 entries in the order given, each dated SOURCE_DATE_EPOCH (the commit's date
 when the build passes it; 1980-01-01 otherwise), permissions 0644 (0755 for

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The Python package pkm4puu (python/pkm4puu): the README's session runs as
 written, and the wrapper opens the FMUs by name, runs them with named inputs
 and outputs, and says clearly what is wrong with a bad request; the library

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """pkm4puu: the 4-PUU Schönflies robot's FMUs from Python.
 
     import pkm4puu as pkm

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The C API over the core (pkm.h). Converts arrays and status codes; holds
 // no mathematics of its own.
 #include "pkm4puu/pkm.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Build tool, compiled per FMU with PKM_FMI_DEFINITION naming its model:
 // writes the files an archive ships from the model's variable table, so
 // that they always describe the binary.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // modelDescription.xml of a model, generated from its variable table: FMI
 // 2.0 (Co-Simulation and Model Exchange in one file) and FMI 3.0. The
 // committed copies under modelDescription/ are these files; a test fails

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /*
  * pkm.h - plain C API of the 4-PUU Schoenflies-motion parallel robot model
  * (MODEL_SPEC.md). No C++ types; an opaque handle per simulated machine.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The plain C API (pkm.h): creation and parameter errors, pose errors,
 // forward and inverse dynamics through it, state save/restore, and that a
 // failed call loses nothing.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The interface as the variable tables declare it (src/models/<id>), from which
 // every modelDescription.xml is generated (the ctest
 // model_descriptions_up_to_date checks that the committed files are those):
