@@ -299,6 +299,8 @@ void pkm_destroy(pkm_model* m) { delete m; }
 
 const char* pkm_last_error(const pkm_model* m) { return m ? m->error.c_str() : "NULL handle"; }
 
+const char* pkm_version(void) { return PKM_VERSION_STRING; }
+
 const char* pkm_status_string(pkm_status s) { return pkm::status_name(static_cast<Status>(s)); }
 
 pkm_status pkm_set_solver(pkm_model* m, const pkm_solver_settings* c) {
