@@ -80,10 +80,8 @@ def check(fmu, version, texts):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--build", required=True)
-    ap.add_argument("--version", required=True)
-    ap.add_argument("--licenses", required=True)
-    ap.add_argument("--license", required=True)
+    for option in ("--build", "--version", "--licenses", "--license"):
+        ap.add_argument(option, required=True)
     ap.add_argument("fmus", nargs="*")
     a = ap.parse_args()
     build = Path(a.build)
