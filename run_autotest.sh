@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # The main job: builds everything, runs the paper's auto-test into results/,
 # then plots the results; then runs the auto-test (section 5.1) and the
 # comparison test (section 5.2) through the FMUs built in build/, which print

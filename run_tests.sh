@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # The test command: builds everything, runs the C++ tests (ctest), then the
 # Python checks (pytest) when python_checks/ holds any test_*.py file.
 #

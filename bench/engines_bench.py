@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Speed against independent multibody engines, side by side in one run (a
 benchmark, not a test): one simulated second of the spec's comparison test
 (g = 0, F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s), from rest at P0) at a 1 ms

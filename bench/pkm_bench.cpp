@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // pkm_bench: timing figures of the 4-PUU core. It prints a table; it is not
 // a test (no pass/fail exit code for the timings; targets are shown for
 // context only).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // pkm_tick_bench: the work of one 1-ms communication step of the core's
 // Plant, CVODE restarted at every step against CVODE continued across the
 // steps, beside RK4. Prints a table; not a test.

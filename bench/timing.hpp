@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The timing of pkm_bench: per-call figures of short calls (batches of N
 // calls, N calibrated) and of whole runs, each the median and the minimum of
 // up to 31 batches; std::chrono::steady_clock.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 # The FMUs: the FMI 2.0 and 3.0 headers, the FMU shared objects and their
 # .fmu archives.
 #
@@ -67,6 +68,49 @@ else()
     set(PKM_SOURCE_DATE_EPOCH 315532800)
   endif()
 endif()
+# The commit being built, appended to generationTool in the archives' model
+# descriptions (cmake/pack_fmu.py), with generationDateAndTime from
+# PKM_SOURCE_DATE_EPOCH. Both are read at configure time, and the build
+# configures again when HEAD or its branch moves (a new commit). Empty
+# outside git.
+execute_process(COMMAND git -C "${PROJECT_SOURCE_DIR}" rev-parse --short=12 HEAD
+                OUTPUT_VARIABLE PKM_GIT_COMMIT OUTPUT_STRIP_TRAILING_WHITESPACE
+                RESULT_VARIABLE _pkm_git_rc ERROR_QUIET)
+if(NOT _pkm_git_rc EQUAL 0)
+  set(PKM_GIT_COMMIT "")
+else()
+  execute_process(COMMAND git -C "${PROJECT_SOURCE_DIR}" symbolic-ref -q HEAD
+                  OUTPUT_VARIABLE _pkm_branch OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
+  foreach(_ref HEAD ${_pkm_branch})
+    execute_process(COMMAND git -C "${PROJECT_SOURCE_DIR}" rev-parse --path-format=absolute --git-path ${_ref}
+                    OUTPUT_VARIABLE _pkm_ref_file OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
+    if(EXISTS "${_pkm_ref_file}")
+      set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${_pkm_ref_file}")
+    endif()
+  endforeach()
+endif()
+
+# The licences in every archive's documentation/licenses/: the project's
+# (LICENSE.txt) and the notices of what the host's binary links
+# (third_party/licenses/): SUNDIALS (static), Eigen (compiled templates), the
+# GCC runtime (libstdc++ and libgcc linked statically, GCC Runtime Library
+# Exception) and, for mingw-w64 builds, its runtime and winpthreads.
+# cmake/check_fmu_archives.py knows the same rule per platform folder.
+set(PKM_LICENSES_DIR "${PROJECT_SOURCE_DIR}/third_party/licenses")
+set(PKM_FMU_LICENSES "${PKM_LICENSES_DIR}/SUNDIALS.txt" "${PKM_LICENSES_DIR}/Eigen.txt")
+if(CMAKE_SYSTEM_NAME STREQUAL "Linux" OR MINGW)
+  list(APPEND PKM_FMU_LICENSES "${PKM_LICENSES_DIR}/GCC-runtime-exception.txt")
+endif()
+if(MINGW)
+  list(APPEND PKM_FMU_LICENSES "${PKM_LICENSES_DIR}/mingw-w64.txt")
+endif()
+set(_pkm_license_names documentation/licenses/LICENSE.txt)
+foreach(_f IN LISTS PKM_FMU_LICENSES)
+  get_filename_component(_n "${_f}" NAME)
+  list(APPEND _pkm_license_names "documentation/licenses/${_n}")
+endforeach()
+list(SORT _pkm_license_names)  # the order check_reproducible_fmu.cmake packs them in
+
 # Packing an archive takes Python's standard library (cmake/pack_fmu.py);
 # without any Python the binaries are still built.
 if(PKM_FMU_PYTHON)
@@ -88,8 +132,8 @@ set(PKM_PACK_FMU "${CMAKE_CURRENT_LIST_DIR}/pack_fmu.py")
 #                   documentation page from the table;
 #   <id>            the binary (PREFIX "", only the fmi2* and fmi3* functions
 #                   exported, the C++ runtime linked statically);
-#   ${CMAKE_BINARY_DIR}/<id>.fmu       FMI 2.0 (Co-Simulation and Model Exchange)
-#   ${CMAKE_BINARY_DIR}/fmi3/<id>.fmu  FMI 3.0 (Co-Simulation and Model Exchange)
+#   ${PROJECT_BINARY_DIR}/<id>.fmu       FMI 2.0 (Co-Simulation and Model Exchange)
+#   ${PROJECT_BINARY_DIR}/fmi3/<id>.fmu  FMI 3.0 (Co-Simulation and Model Exchange)
 # Each archive ships the committed model description <id>/fmi<v>/modelDescription.xml.
 # Targets <id>_fmu and <id>_fmu3 (part of ALL). Sets <id>_FMU_DIR,
 # <id>_FMU_FILE, <id>_FMU3_DIR and <id>_FMU3_FILE in the caller's scope and
@@ -108,9 +152,9 @@ function(pkm_add_fmu id)
 
   add_executable(${id}_files ${PROJECT_SOURCE_DIR}/src/fmi/fmu_files.cpp)
   target_compile_definitions(${id}_files PRIVATE PKM_FMI_DEFINITION=${F_DEFINITION})
-  target_link_libraries(${id}_files PRIVATE pkm_model_${id} pkm::sundials pkm::options)
+  target_link_libraries(${id}_files PRIVATE pkm_model_${id} pkm_version pkm::sundials pkm::options)
   pkm_without_lto(${id}_files)
-  set(generated_md "${CMAKE_BINARY_DIR}/modelDescription")
+  set(generated_md "${PROJECT_BINARY_DIR}/modelDescription")
   add_custom_command(
     OUTPUT "${generated_md}/fmi2/${id}.xml" "${generated_md}/fmi3/${id}.xml"
     COMMAND ${CMAKE_COMMAND} -E make_directory "${generated_md}/fmi2" "${generated_md}/fmi3"
@@ -140,8 +184,8 @@ function(pkm_add_fmu id)
   set_target_properties(${id} PROPERTIES
     PREFIX ""
     OUTPUT_NAME "${id}"
-    LIBRARY_OUTPUT_DIRECTORY "${CMAKE_BINARY_DIR}/fmu-binaries"
-    RUNTIME_OUTPUT_DIRECTORY "${CMAKE_BINARY_DIR}/fmu-binaries"
+    LIBRARY_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/fmu-binaries"
+    RUNTIME_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/fmu-binaries"
     C_VISIBILITY_PRESET hidden
     CXX_VISIBILITY_PRESET hidden
     VISIBILITY_INLINES_HIDDEN ON
@@ -170,13 +214,13 @@ function(pkm_add_fmu id)
       break()
     endif()
     if(version EQUAL 2)
-      set(stage "${CMAKE_BINARY_DIR}/fmu/${id}")
-      set(fmu "${CMAKE_BINARY_DIR}/${id}.fmu")
+      set(stage "${PROJECT_BINARY_DIR}/fmu/${id}")
+      set(fmu "${PROJECT_BINARY_DIR}/${id}.fmu")
       set(platform "${PKM_FMU_PLATFORM}")
       set(target ${id}_fmu)
     else()
-      set(stage "${CMAKE_BINARY_DIR}/fmu3/${id}")
-      set(fmu "${CMAKE_BINARY_DIR}/fmi3/${id}.fmu")
+      set(stage "${PROJECT_BINARY_DIR}/fmu3/${id}")
+      set(fmu "${PROJECT_BINARY_DIR}/fmi3/${id}.fmu")
       set(platform "${PKM_FMU3_PLATFORM}")
       set(target ${id}_fmu3)
     endif()
@@ -184,15 +228,18 @@ function(pkm_add_fmu id)
     add_custom_command(
       OUTPUT "${fmu}"
       COMMAND ${CMAKE_COMMAND} -E rm -rf "${stage}" "${fmu}"
-      COMMAND ${CMAKE_COMMAND} -E make_directory "${stage}/binaries/${platform}" "${stage}/documentation"
-              "${CMAKE_BINARY_DIR}/fmi3"
+      COMMAND ${CMAKE_COMMAND} -E make_directory "${stage}/binaries/${platform}" "${stage}/documentation/licenses"
+              "${PROJECT_BINARY_DIR}/fmi3"
+      COMMAND ${CMAKE_COMMAND} -E copy "${PROJECT_SOURCE_DIR}/LICENSE" "${stage}/documentation/licenses/LICENSE.txt"
+      COMMAND ${CMAKE_COMMAND} -E copy ${PKM_FMU_LICENSES} "${stage}/documentation/licenses"
       COMMAND ${CMAKE_COMMAND} -E copy "${md}" "${stage}/modelDescription.xml"
       COMMAND ${CMAKE_COMMAND} -E copy "$<TARGET_FILE:${id}>" "${stage}/binaries/${platform}/${binary_name}"
       COMMAND ${id}_files ${id} "${stage}/documentation/index.html"
       COMMAND ${CMAKE_COMMAND} -E env SOURCE_DATE_EPOCH=${PKM_SOURCE_DATE_EPOCH}
-              "${_pkm_pack_python}" "${PKM_PACK_FMU}" "${fmu}" "${stage}"
+              "${_pkm_pack_python}" "${PKM_PACK_FMU}" --commit "${PKM_GIT_COMMIT}" "${fmu}" "${stage}"
               modelDescription.xml "binaries/${platform}/${binary_name}" documentation/index.html
-      DEPENDS ${id} "${md}" ${id}_files "${PKM_PACK_FMU}"
+              ${_pkm_license_names}
+      DEPENDS ${id} "${md}" ${id}_files "${PKM_PACK_FMU}" "${PROJECT_SOURCE_DIR}/LICENSE" ${PKM_FMU_LICENSES}
       COMMENT "Packaging ${fmu} (FMI ${version}.0)"
       VERBATIM)
     add_custom_target(${target} ALL DEPENDS "${fmu}")
@@ -200,7 +247,8 @@ function(pkm_add_fmu id)
       add_test(NAME fmu_archive_reproducible_fmi${version}_${id}
                COMMAND ${CMAKE_COMMAND} -DFMU=${fmu} -DSTAGE=${stage} -DID=${id} -DDOC_TOOL=$<TARGET_FILE:${id}_files>
                        -DPYTHON=${_pkm_pack_python} -DPACK=${PKM_PACK_FMU} -DEPOCH=${PKM_SOURCE_DATE_EPOCH}
-                       -DWORK=${CMAKE_BINARY_DIR}/reproducible/fmi${version}_${id}
+                       -DCOMMIT=${PKM_GIT_COMMIT}
+                       -DWORK=${PROJECT_BINARY_DIR}/reproducible/fmi${version}_${id}
                        -P ${CMAKE_CURRENT_FUNCTION_LIST_DIR}/check_reproducible_fmu.cmake)
       add_test(NAME model_descriptions_up_to_date_fmi${version}_${id}
                COMMAND ${CMAKE_COMMAND} -E compare_files "${generated_md}/fmi${version}/${id}.xml" "${md}")

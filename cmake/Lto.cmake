@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 # Link-time optimisation where the speed ships: the FMU binaries, libpkm,
 # the auto-test app and the benchmarks. The libraries they share with the
 # tests (pkm_core, pkm_capi, pkm_fmi_models, pkm_autotest_lib) are compiled

@@ -1,6 +1,7 @@
+# SPDX-License-Identifier: BSD-2-Clause
 # Every platform: the FMU binaries cross-built for Windows x64
 # (mingw-w64) and Linux aarch64 (gcc), each in a sub-build of this project
-# under ${CMAKE_BINARY_DIR}/platforms/<target> with the toolchain files of
+# under ${PROJECT_BINARY_DIR}/platforms/<target> with the toolchain files of
 # cmake/toolchains/, against a static CVODE built for the target from
 # Debian's source package (scripts/cross_sundials.sh, cached in
 # platforms/sundials-<target>); the FMI tests run there under wine and
@@ -27,7 +28,7 @@ foreach(_tool x86_64-w64-mingw32-g++-posix wine aarch64-linux-gnu-g++ qemu-aarch
 endforeach()
 include(ExternalProject)
 
-set(PKM_PLATFORMS_DIR "${CMAKE_BINARY_DIR}/platforms")
+set(PKM_PLATFORMS_DIR "${PROJECT_BINARY_DIR}/platforms")
 set(_pkm_previous)
 set(_pkm_wine_env WINEDEBUG=-all WINEDLLOVERRIDES=mscoree,mshtml=)
 
@@ -111,12 +112,14 @@ file(GLOB_RECURSE _headers "${_src}/pkm4puu/*.hpp" "${_src}/fmi/*.hpp" "${_src}/
 list(APPEND _headers "${_src}/fmi/fmi2_functions.cpp" "${_src}/fmi/fmi3_functions.cpp")
 get_target_property(_eigen_inc Eigen3::Eigen INTERFACE_INCLUDE_DIRECTORIES)
 list(GET _eigen_inc 0 _eigen_inc)
-set(_eigen_license /usr/share/doc/libeigen3-dev/copyright)
 set(_header_args --source-root "${_src}")
 foreach(_f IN LISTS _headers)
   list(APPEND _header_args --header "${_f}")
 endforeach()
-list(APPEND _header_args --eigen "${_eigen_inc}" --eigen-license "${_eigen_license}")
+# The notices beyond the host's (cmake/Fmu.cmake): mingw-w64's runtime in the
+# Windows binaries, Eigen in sources/.
+list(APPEND _header_args --eigen "${_eigen_inc}" --commit "${PKM_GIT_COMMIT}"
+     --license "${PKM_LICENSES_DIR}/mingw-w64.txt" --license "${PKM_LICENSES_DIR}/Eigen.txt")
 
 set(_merged)
 get_property(_models GLOBAL PROPERTY PKM_FMU_MODELS)
@@ -147,19 +150,19 @@ foreach(_id IN LISTS _models)
     endforeach()
     # The host's staged FMU and its archive (cmake/Fmu.cmake).
     if(_v EQUAL 2)
-      set(_native "${CMAKE_BINARY_DIR}/fmu/${_id}")
-      set(_native_fmu "${CMAKE_BINARY_DIR}/${_id}.fmu")
+      set(_native "${PROJECT_BINARY_DIR}/fmu/${_id}")
+      set(_native_fmu "${PROJECT_BINARY_DIR}/${_id}.fmu")
     else()
-      set(_native "${CMAKE_BINARY_DIR}/fmu3/${_id}")
-      set(_native_fmu "${CMAKE_BINARY_DIR}/fmi3/${_id}.fmu")
+      set(_native "${PROJECT_BINARY_DIR}/fmu3/${_id}")
+      set(_native_fmu "${PROJECT_BINARY_DIR}/fmi3/${_id}.fmu")
     endif()
-    set(_out "${CMAKE_BINARY_DIR}/dist/fmi${_v}/${_id}.fmu")
+    set(_out "${PROJECT_BINARY_DIR}/dist/fmi${_v}/${_id}.fmu")
     add_custom_command(
       OUTPUT "${_out}"
-      COMMAND ${CMAKE_COMMAND} -E make_directory "${CMAKE_BINARY_DIR}/dist/fmi${_v}"
+      COMMAND ${CMAKE_COMMAND} -E make_directory "${PROJECT_BINARY_DIR}/dist/fmi${_v}"
       COMMAND ${CMAKE_COMMAND} -E env SOURCE_DATE_EPOCH=${PKM_SOURCE_DATE_EPOCH}
               "${PKM_FMU_PYTHON}" "${PROJECT_SOURCE_DIR}/cmake/merge_fmu.py" --out "${_out}"
-              --stage "${CMAKE_BINARY_DIR}/dist/stage/fmi${_v}/${_id}" --native-stage "${_native}"
+              --stage "${PROJECT_BINARY_DIR}/dist/stage/fmi${_v}/${_id}" --native-stage "${_native}"
               --fmi-version ${_v} --id ${_id} --definition ${_def} ${_bins} ${_src_args}
       DEPENDS "${_native_fmu}" ${PKM_win64_BINARIES} ${PKM_aarch64_BINARIES} ${_sources} ${_headers}
               "${PROJECT_SOURCE_DIR}/cmake/merge_fmu.py" "${PKM_PACK_FMU}"

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 # SUNDIALS from Debian's libsundials-dev, linked statically so that nothing
 # built here (in particular the FMU binaries) needs SUNDIALS at run time.
 # Defines the imported target pkm::sundials.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 cmake_minimum_required(VERSION 3.18)
 # ctest platform_win64_binaries_imports_and_exports: each Windows DLL
 # imports only DLLs that every Windows has (KERNEL32, msvcrt: libstdc++,

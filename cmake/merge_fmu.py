@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Merges one FMU's builds for every platform into one archive, and adds its
 source code: the Reference-FMUs way of shipping an FMU (one archive, a
 binaries/<platform>/ folder per platform, sources/ to build for any other).
@@ -5,7 +6,7 @@ binaries/<platform>/ folder per platform, sources/ to build for any other).
 usage: merge_fmu.py --out FMU --stage DIR --native-stage DIR --fmi-version {2,3}
                     --id ID --definition FUNC [--binary PLATFORM=FILE]...
                     [--source-root DIR] [--source FILE]... [--header FILE]...
-                    [--eigen DIR] [--eigen-license FILE]
+                    [--eigen DIR] [--license FILE]... [--commit COMMIT]
 
 --native-stage  the host build's staged FMU (modelDescription.xml,
                 binaries/<host platform>/, documentation/): taken as it is.
@@ -17,8 +18,11 @@ usage: merge_fmu.py --out FMU --stage DIR --native-stage DIR --fmi-version {2,3}
 --header        a file the sources include (sources/<path>; a .cpp
                 included by a generated wrapper goes here too).
 --eigen         the Eigen headers (the folder holding Eigen/), copied to
-                sources/Eigen/ (MPL 2.0; its licence goes to
-                documentation/licenses/).
+                sources/Eigen/ (MPL 2.0; its notice comes with --license).
+--license       a notice for documentation/licenses/ that the added binaries
+                or sources need beyond the native stage's (mingw-w64's
+                runtime for the Windows binaries, Eigen for sources/).
+--commit        the commit, for the model description's stamp (pack_fmu.py).
 
 The source build compiles the listed files plus two generated wrappers,
 <ID>_fmi2_functions.cpp and <ID>_fmi3_functions.cpp, which define
@@ -81,7 +85,8 @@ def main():
     ap.add_argument("--source", action="append", default=[])
     ap.add_argument("--header", action="append", default=[])
     ap.add_argument("--eigen")
-    ap.add_argument("--eigen-license")
+    ap.add_argument("--license", action="append", default=[])
+    ap.add_argument("--commit", default="")
     a = ap.parse_args()
 
     stage, native = Path(a.stage), Path(a.native_stage)
@@ -113,10 +118,6 @@ def main():
             compiled.append(name)
         if a.eigen:
             shutil.copytree(Path(a.eigen) / "Eigen", src / "Eigen")
-        if a.eigen_license:
-            lic = stage / "documentation" / "licenses"
-            lic.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(a.eigen_license, lic / "Eigen.txt")
         md = stage / "modelDescription.xml"
         if a.fmi_version == "2":
             md.write_text(add_source_files_fmi2(md.read_text(), compiled))
@@ -124,9 +125,14 @@ def main():
             files = "\n".join(f'      <SourceFile name="{f}"/>' for f in compiled)
             (src / "buildDescription.xml").write_text(BUILD_DESCRIPTION.format(id=a.id, files=files))
 
+    lic = stage / "documentation" / "licenses"
+    lic.mkdir(parents=True, exist_ok=True)
+    for path in a.license:
+        shutil.copyfile(path, lic / Path(path).name)
+
     names = sorted(str(p.relative_to(stage)).replace(os.sep, "/") for p in stage.rglob("*") if p.is_file())
     names.remove("modelDescription.xml")
-    pack_fmu.main(["pack_fmu.py", a.out, str(stage), "modelDescription.xml", *names])
+    pack_fmu.main(["pack_fmu.py", "--commit", a.commit, a.out, str(stage), "modelDescription.xml", *names])
 
 
 if __name__ == "__main__":

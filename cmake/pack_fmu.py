@@ -1,28 +1,54 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Writes an FMU archive (zip) that depends only on the files' contents:
 entries in the order given, each dated SOURCE_DATE_EPOCH (the commit's date
 when the build passes it; 1980-01-01 otherwise), permissions 0644 (0755 for
 binaries), no extra fields (no atime, ctime, uid or gid), deflated.
 The same commit therefore builds bit-identical archives.
 
-usage: pack_fmu.py OUTPUT STAGE_DIR FILE...   (FILEs relative to STAGE_DIR)
+The archive's modelDescription.xml is the committed one stamped with what
+changes from commit to commit, which the committed file cannot hold:
+generationTool gets " (commit COMMIT)" appended and generationDateAndTime is
+added, the commit's date (SOURCE_DATE_EPOCH), so the stamp is reproducible.
+
+usage: pack_fmu.py [--commit COMMIT] OUTPUT STAGE_DIR FILE...   (FILEs relative to STAGE_DIR)
 """
 import os
+import re
 import sys
 import time
 import zipfile
 
 
+def stamp(xml, commit, epoch):
+    """modelDescription.xml's text with the commit in generationTool and
+    generationDateAndTime after it (unchanged if it has the latter)."""
+    if "generationDateAndTime=" in xml:
+        return xml
+    m = re.search(r'\n([ \t]*)generationTool="([^"]*)"', xml)
+    if not m:
+        sys.exit("pack_fmu: modelDescription.xml has no generationTool attribute on a line of its own")
+    indent, tool = m.group(1), m.group(2) + (f" (commit {commit})" if commit else "")
+    date = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(epoch))
+    return (xml[:m.start()] + f'\n{indent}generationTool="{tool}"\n{indent}generationDateAndTime="{date}"' +
+            xml[m.end():])
+
+
 def main(argv):
+    commit = ""
+    if len(argv) > 2 and argv[1] == "--commit":
+        commit, argv = argv[2], argv[:1] + argv[3:]
     if len(argv) < 4:
         sys.exit(__doc__)
     out, stage, files = argv[1], argv[2], argv[3:]
-    epoch = int(os.environ.get("SOURCE_DATE_EPOCH", "315532800"))  # 1980-01-01, zip's earliest date
-    date_time = time.gmtime(max(epoch, 315532800))[:6]
+    epoch = max(int(os.environ.get("SOURCE_DATE_EPOCH", "315532800")), 315532800)  # 1980-01-01, zip's earliest
+    date_time = time.gmtime(epoch)[:6]
     tmp = out + ".tmp"
     with zipfile.ZipFile(tmp, "w") as z:
         for name in files:
             with open(os.path.join(stage, name), "rb") as f:
                 data = f.read()
+            if name == "modelDescription.xml":
+                data = stamp(data.decode("utf-8"), commit, epoch).encode("utf-8")
             info = zipfile.ZipInfo(name, date_time=date_time)
             info.compress_type = zipfile.ZIP_DEFLATED
             info.create_system = 3  # Unix, so that the permissions below mean something

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The plant FMU in a control loop: a 1 kHz joint-space controller drives
 PKM4PUU.fmu along the spec's auto-test motion (2 s, P0 -> P1) while the plant
 is the machine, not the ideal mechanism: each prismatic joint has viscous and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Batch studies that scale past one machine: a payload x duration sweep of
 the auto-test on Dask (dask.distributed).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Drive sizing from the inverse FMU: along the spec's auto-test (P0 -> P1,
 rest to rest) with a realistic machine, each motor's torque tau_i(t) and
 speed omega_i = 2 pi drho_i / p, drawn as operating points in the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Linearising the plant FMU and an LQR designed on it: the hanging machine's
 modes, and a task-space state feedback against the joint-space PD of
 closed_loop_control.py.

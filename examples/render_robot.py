@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Seeing the robot move: a 3-D drawing of the mechanism (base, the four
 prismatic axes, sliders, rods, the h' offsets and the platform) from a CSV of a
 run, as an animated GIF and as a still of several frames (like the paper's

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Systems integration: the auto-test as an SSP system run by libcosim.
 
 PKM4PUU_autotest.ssp (a zip: SystemStructure.ssd plus both FMUs under

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Coverage-guided fuzzing (libFuzzer, under AddressSanitizer and
 // UndefinedBehaviorSanitizer) of the FMI 2.0 layer: random sequences of FMI
 // calls with random arguments on up to three instances of the two FMUs,

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # Builds the libFuzzer harness fuzz/fmi_fuzzer.cpp with clang under
 # AddressSanitizer + UndefinedBehaviorSanitizer (a separate build directory,
 # -DPKM_FUZZ=ON; the default gcc build is untouched) and runs it.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Shared fixtures: where the repository, the FMUs and the C API are and
 where results go.
 

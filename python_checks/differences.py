@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Difference quotients the derivative checks share (the reference side of a
 comparison: nothing here comes from the code under test)."""
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The example programs under examples/, loaded as modules by file path so
 that their tests can call their functions (they are scripts, not a package)."""
 import importlib.util

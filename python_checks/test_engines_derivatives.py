@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """This project's analytic derivatives of the reduced forward dynamics,
 A = dydot/dy (y = pose and rates) and B = dydot/du (u = F[1..4], Fe[1..3],
 Me_z, tau[1..4]), against Pinocchio's analytic derivatives on the independent

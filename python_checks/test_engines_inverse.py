@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Inverse dynamics against Pinocchio (the issue's first requirement): along
 the spec's auto-test trajectory (MODEL_SPEC "Auto-test", gravity on), at every
 1 ms sample of the 2 s, F1..F4 from this project's C API

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The machine around the mechanism (MODEL_SPEC "The machine around the
 mechanism") checked against independent engines: rotor inertia, viscous
 friction, Coulomb friction and an off-centre payload, each alone and all together, on the spec's comparison test

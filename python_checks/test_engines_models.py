@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The independent engine models (engines/pinocchio_model.py, engines/mujoco_model.py)
 checked against MODEL_SPEC itself, never against this project, so that
 test_engines_inverse.py and test_engines_forward.py compare the project with

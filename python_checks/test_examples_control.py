@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """examples/closed_loop_control.py: the plant FMU with joint friction and an
 off-centre payload in a 1 kHz joint-space PD loop, with the inverse FMU's
 computed-force feed-forward given the plant's friction (compensation), not

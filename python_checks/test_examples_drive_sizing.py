@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """examples/drive_sizing.py: motor torques and speeds from the inverse FMU
 along the auto-test with rotor inertia, friction and a payload."""
 import math

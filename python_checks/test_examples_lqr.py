@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """examples/linearize_lqr.py: the plant FMU linearised at home through fmpy's
 directional derivatives, its modes against the potential's Hessian, an LQR
 designed on A and B, and that LQR against closed_loop_control.py's PD on the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """examples/render_robot.py: the mechanism drawn from a run's CSV. A short
 run is rendered; the frames must change as the platform moves, a static pose
 must render identically twice, and the drawn legs must meet the drawn

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """examples/ssp_cosim.py: the auto-test as an SSP system (inverse.F ->
 plant.F) loaded and run by libcosim (libcosimpy)."""
 import xml.etree.ElementTree as ET

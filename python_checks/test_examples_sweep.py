@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """examples/dask_sweep.py: a payload x duration sweep of the auto-test on
 Dask. A small sweep on a LocalCluster of 2 worker processes must give exactly
 the results of the same runs done serially in this process."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """CVODE continued across communication points.
 
 With CVODE the plant FMU keeps the integrator's history from one fmi2DoStep

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The plant FMU's analytic derivatives through fmpy, as an importer that
 linearises would ask for them: the capability flags fmpy reads, the Model
 Exchange Jacobians A = d der(x)/dx and B = d der(x)/du by

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Every FMI flavour of the plant through fmpy: FMI 2.0 and 3.0, Model
 Exchange and Co-Simulation, from the one binary and the generated model
 descriptions.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The FMI 3.0 FMUs in a second FMI 3.0 importer besides fmpy: fmi-sim, the
 command-line simulator of the Rust `fmi` crates (crates.io/crates/fmi-sim,
 version 0.7.0), with its own XML reader, loader and master loops.

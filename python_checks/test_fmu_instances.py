@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Two plant instances in one process (one loaded shared library) with
 different parameters, stepped interleaved, give exactly the outputs each gives
 when run alone: no state is shared between instances."""

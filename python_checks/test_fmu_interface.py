@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The spec's "FMU interface contract": every listed variable exists under its
 exact name with the listed causality, and the parameter defaults are the
 spec's (Tables II and III, leg placement, gravity, solver settings)."""

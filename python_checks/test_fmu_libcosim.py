@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """A co-simulation master other than fmpy: libcosim (Open Simulation Platform,
 through libcosimpy) loads the plant FMU, runs 1 s with constant actuator
 forces at a 1 ms step, and ends where fmpy's run of the same case ends."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The machine around the mechanism through the FMUs (MODEL_SPEC "The machine
 around the mechanism"): the auto-test chain with every
 term on, the plant's energy audit, and a drop onto the end stops.

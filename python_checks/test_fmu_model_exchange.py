@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Model Exchange through an importer's own integrator (fmpy's CVode), FMI 2.0
 and FMI 3.0: the paper's auto-test against the Co-Simulation FMU, and the
 singularity guards as event indicators that the importer locates.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Every platform in one archive per FMU (cmake/Platforms.cmake):
 
 - the merged archives hold the binaries of every platform and the sources,

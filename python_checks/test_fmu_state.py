@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """FMU state save/restore is exact: a state taken at t = 1 s and restored
 replays 1 s .. 1.5 s bit for bit, in the same instance (get/setFMUstate) and
 in a fresh one (serialize / deSerialize), for the FMI 2.0 and the FMI 3.0

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """fmpy's validator (schema, names, ModelStructure, start values, causality /
 variability, units) finds no problem in either FMU."""
 import pytest

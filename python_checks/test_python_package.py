@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The Python package pkm4puu (python/pkm4puu): the README's session runs as
 written, and the wrapper opens the FMUs by name, runs them with named inputs
 and outputs, and says clearly what is wrong with a bad request; the library
@@ -135,3 +136,25 @@ def test_command_line_without_a_build_says_how_to_give_one(tmp_path):
     assert proc.returncode == 1
     assert "--build DIR" in proc.stderr and locate.BUILD_ENV in proc.stderr, proc.stderr
     assert not (tmp_path / "results").exists()
+
+
+def test_wheel_carries_the_version_and_the_licence(tmp_path):
+    """The wheel built from python/ (setuptools, offline): its metadata's
+    version is pkm4puu.__version__ (one source, _version.py), its licence
+    BSD-2-Clause, and the project's LICENSE is in its .dist-info."""
+    import shutil
+    import zipfile
+    src = tmp_path / "python"  # a copy: setuptools writes build/ and *.egg-info beside pyproject.toml
+    shutil.copytree(REPO / "python", src, ignore=shutil.ignore_patterns("__pycache__", "build", "*.egg-info"))
+    proc = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q",
+                           "-w", str(tmp_path / "dist"), str(src)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    wheel, = (tmp_path / "dist").glob("pkm4puu-*.whl")
+    with zipfile.ZipFile(wheel) as z:
+        names = z.namelist()
+        meta = z.read(next(n for n in names if n.endswith(".dist-info/METADATA"))).decode()
+        licence = next(n for n in names if re.search(r"\.dist-info/(licenses/)?LICENSE$", n))
+        assert z.read(licence) == (REPO / "LICENSE").read_bytes()
+    assert f"\nVersion: {pkm.__version__}\n" in meta
+    assert "\nLicense: BSD-2-Clause\n" in meta
+    assert re.fullmatch(r"\d+\.\d+\.\d+", pkm.__version__)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # Installs what is missing (scripts/setup.sh), then configures and builds
 # everything in build/ (Ninja, Release).
 #   scripts/build.sh [--configure-only] [-D<cmake option>=<value>...]

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # The C++ FMI tests (tests/fmi: state machine, variables, FMU states,
 # stepping, logging, bad inputs and parameters, singularities, threads,
 # Model Exchange, derivatives, the machine, the auto-test chain) against the

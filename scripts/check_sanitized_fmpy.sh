@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # The Python fmpy checks of the FMUs (python_checks/test_fmu_*.py: the
 # auto-test chain, FMU states, the interface, the flavours, the machine, the
 # derivatives, Model Exchange) against FMU binaries built with clang's

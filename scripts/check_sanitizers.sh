@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # The C++ FMI tests (dlopen'd FMU binaries: life cycle, misuse, bad input,
 # singularities, threads, Model Exchange) against FMU binaries and tests
 # built with AddressSanitizer and UndefinedBehaviorSanitizer

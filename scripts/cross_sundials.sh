@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # A static SUNDIALS CVODE for a cross target, built from Debian's source
 # package (`apt-get source sundials`: 6.4.1 on Debian 12, the version the
 # native build links through libsundials-dev) with the project's toolchain

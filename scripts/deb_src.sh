@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # deb-src entries for the mirrors apt already uses.
 #   scripts/deb_src.sh           prints deb822 stanzas (Types: deb-src) made from
 #                                every deb entry: same URIs, Suites, Components, Signed-By

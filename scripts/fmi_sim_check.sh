@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # The FMI 3.0 FMUs in a second FMI 3.0 importer: installs fmi-sim 0.7.0 (the
 # Rust `fmi` crates' simulator) into build/tools/fmi-sim when it is missing,
 # then runs python_checks/test_fmu_fmi_sim.py, which fails rather than skips.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # The platform checks left out of ./run_tests.sh for its time budget: the
 # source-code FMU built with `fmpy compile` (the whole core, ~2 min of one
 # core) must reproduce the binary FMU's auto-test and refuse solver = 0.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 # Sourced by the scripts that load the ASan + UBSan FMU binaries into an
 # uninstrumented process (check_sanitized_fmpy.sh, check_sanitized_fmi_tests.sh):
 # finds clang's AddressSanitizer runtime for LD_PRELOAD (exits 77, skipped,

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-2-Clause
 # Installs what building and testing need, and only what is missing:
 # Debian packages (apt-get) and the Python virtualenv .venv with
 # python_checks/requirements.txt, and this project's package python/pkm4puu.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /* See alloc_interposer.h. */
 #define _GNU_SOURCE
 #include "alloc_interposer.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /* The project's one allocation counter: a malloc interposer, linked into
  * the C test harnesses that drive an FMU binary (tests/fmu_allocations.c,
  * tests/fmu_alloc_faults.c), the core's allocation test

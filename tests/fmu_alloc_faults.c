@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /* fmu_alloc_faults: an exhausted heap inside any FMI call is an Error with a
  * logged reason, never a crash, and touches no other instance.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /* fmu_allocations: no heap allocation in a control tick.
  *
  * The plant FMU (PKM4PUU.so) driven through raw FMI 2.0 Co-Simulation calls

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Records one row of the hardening table (bad input or FMI misuse tried,
 // what the FMU answered, whether the state was kept) and prints it as a
 // Markdown table row prefixed "| " so that `ctest -V -R Hardening` or the

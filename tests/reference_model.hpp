@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Independent reference model of the 4-PUU PKM, written only from
 // MODEL_SPEC.md (not from src/), for checking the main code.
 // Kinematics by literal DH products; kinetic energy from body velocities by

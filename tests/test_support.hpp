@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Shared helpers of the unit tests: random reachable states, finite
 // differences and the reference model's Lagrangian terms (all derived from
 // the spec, never from the code's outputs).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench: what its subcommands (step.c, latency.c, cost.c,
  * compare.c) share beyond harness.h: the options, the loaded plant FMU with
  * its model description, an instance set up for a solver, and the median of

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench compare: the cost of one simulated second of the paper's
  * comparison test (MODEL_SPEC "Comparison test": from rest at P0, g = 0,
  * F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s), F2 = F3 = 0) at a 1 ms step, through

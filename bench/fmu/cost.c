@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench cost: the plant FMU's cost in one table,
  * through the FMU binary (no Python in any timed loop):
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /* What the C harnesses share (pkm_fmu_bench's subcommands, and the C tests
  * tests/fmu_allocations.c and tests/fmu_alloc_faults.c):
  * loading a built FMU binary with dlopen, a logger that stays silent unless

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench latency: the distribution of the control tick's time over
  * 10^6 ticks of the plant FMU, raw FMI 2.0 Co-Simulation, as a
  * real-time controller drives it: every 1 ms, fmi2SetReal(F[1..4]) (with

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench: the plant FMU's benchmarks, one program with a subcommand
  * each (plain C11): the built PKM4PUU.so loaded with dlopen and driven
  * through the raw FMI 2.0 Co-Simulation functions, as a master drives it.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench step: the cost of one 1-ms communication step of the plant
  * FMU, fmi2SetReal(F[1..4]) + fmi2DoStep every step, with four amounts of
  * output read.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 # Linux aarch64 with Debian's gcc/g++-aarch64-linux-gnu, run through
 # qemu-user (qemu-aarch64 with the cross sysroot as its library root).
 # Used by cmake/Platforms.cmake for the aarch64 sub-build.

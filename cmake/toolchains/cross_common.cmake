@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 # What both toolchain files share: where find_* looks.
 #   PKM_CROSS_PREFIX  (cache or environment; ;-list) install prefixes of the
 #                     dependencies built for the target (scripts/cross_sundials.sh).

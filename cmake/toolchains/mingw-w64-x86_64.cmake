@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 # Windows x64 with Debian's mingw-w64 (posix thread model), run through wine.
 # Used by cmake/Platforms.cmake for the Windows sub-build; by hand:
 #   cmake -S . -B build-win64 -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/mingw-w64-x86_64.cmake \

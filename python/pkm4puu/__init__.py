@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """pkm4puu: the 4-PUU Schönflies robot's FMUs from Python.
 
     import pkm4puu as pkm
@@ -15,6 +16,7 @@ The reports (the paper's tests through the FMUs, the engine comparison
 against the independent Pinocchio and MuJoCo models, figures) are in
 pkm4puu.validation and run as `python -m pkm4puu COMMAND`.
 """
+from ._version import __version__
 from .fmu import Fmu, Result, find_fmu, inverse_forces, run
 from .interface import (ACC, DRHO, F, POSE, RHO, RK4, START_P0, THETA1, THETA2, VEL, WRENCH, indexed_names,
                         start_pose)
@@ -22,7 +24,7 @@ from .locate import build_dir
 from .motions import acceleration_at, autotest_motion, blend, comparison_forces, motion, pose_at, velocity_at
 from .spec import P0, P1, STATIC_FORCE_P0, STEP, T_MOVE
 
-__all__ = ["Fmu", "Result", "build_dir", "find_fmu", "inverse_forces", "run", "ACC", "DRHO", "F", "POSE", "RHO",
+__all__ = ["__version__", "Fmu", "Result", "build_dir", "find_fmu", "inverse_forces", "run", "ACC", "DRHO", "F", "POSE", "RHO",
            "RK4", "START_P0", "THETA1", "THETA2", "VEL", "WRENCH", "indexed_names", "start_pose", "autotest_motion",
            "blend", "comparison_forces", "motion", "pose_at", "velocity_at", "acceleration_at", "P0", "P1",
            "STATIC_FORCE_P0", "STEP", "T_MOVE"]

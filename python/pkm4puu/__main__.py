@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The package's one command line: python -m pkm4puu COMMAND [ARGS...].
 
 Each command is a report program of pkm4puu.validation, imported only when

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """ctypes binding of this project's C API (pkm.h), for the engine
 comparisons. The library is locate.LIBRARY in the build directory (the
 `build` argument, else $PKM_BUILD_DIR, else ./build: see locate).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """What the examples that drive the plant FMU along the auto-test share: the
 errors against the prescribed pose, and the sampled closed loop with the
 inverse FMU as the reference (examples/closed_loop_control.py's joint PD,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Opening and driving the project's FMUs from Python: a thin, always
 cleaning-up wrapper around fmpy's FMU2Slave and FMU3Slave that speaks the
 interface's names.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Names of the FMUs' variables (MODEL_SPEC "FMU interface contract") and the
 start values the tests and examples use most."""
 from .spec import P0, STEP

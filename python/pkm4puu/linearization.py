@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The plant's linearisation through its FMI 2.0 Model Exchange interface and
 fmpy, as any importer would get it: A = d der(y)/dy (8 x 8) and
 B = d der(y)/du (8 x 12) by fmi2GetDirectionalDerivative, y the pose and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Where the built artifacts are: the build directory and every path the
 package looks for inside it, each written once here.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The mechanism's numbers, copied once from MODEL_SPEC.md (the project's
 authoritative definition), and the geometry they define: for the checks, the
 independent reference models (Pinocchio, MuJoCo) and the examples. Nothing

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The paper's auto-test (section 5.1, MODEL_SPEC "Auto-test"): inverse
 // dynamics along the rest-to-rest path gives F1..F4(t); forward dynamics
 // driven open loop by those forces, evaluated at the integrator's own

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // pkm_autotest: the paper's auto-test (section 5.1) with the C++ core.
 // Inverse dynamics along the spec's rest-to-rest path gives F1..F4(t);
 // forward dynamics driven by those forces (open loop, evaluated at the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The C API over the core (pkm.h). Converts arrays and status codes; holds
 // no mathematics of its own.
 #include "pkm4puu/pkm.h"
@@ -297,6 +298,8 @@ pkm_status pkm_inverse_derivatives(pkm_model* m, const double pose[4], const dou
 void pkm_destroy(pkm_model* m) { delete m; }
 
 const char* pkm_last_error(const pkm_model* m) { return m ? m->error.c_str() : "NULL handle"; }
+
+const char* pkm_version(void) { return PKM_VERSION_STRING; }
 
 const char* pkm_status_string(pkm_status s) { return pkm::status_name(static_cast<Status>(s)); }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Partial derivatives through FMI: fmi2GetDirectionalDerivative,
 // fmi3GetDirectionalDerivative and fmi3GetAdjointDerivative. The layer
 // checks the call (state, counts, references: in Model Exchange the unknowns

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The FMI 2.0 front end (Co-Simulation and Model Exchange) of one FMU: each
 // exported function checks its handle and forwards to pkm_fmi::Instance.
 // Compiled once per FMU, with PKM_FMI_DEFINITION naming the function that

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /* The FMI functions every FMU binary of this project exports, once: the
    test loader, the benchmark harness and the fuzzer take their lists from
    here, and a test compares them with the binaries' export tables.

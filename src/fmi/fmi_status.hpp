@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // What every FMI flavour shares: the status codes (fmi2Status and
 // fmi3Status have the same values 0..4) and the interface types.
 #pragma once

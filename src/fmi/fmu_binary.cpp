@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // What an FMU binary needs beyond its FMI functions.
 #include <cstddef>  // defines __GLIBCXX__ with libstdc++
 #if defined(PKM_FMI_FREE_EH_POOL) && defined(__GLIBCXX__)

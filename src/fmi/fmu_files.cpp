@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Build tool, compiled per FMU with PKM_FMI_DEFINITION naming its model:
 // writes the files an archive ships from the model's variable table, so
 // that they always describe the binary.
@@ -10,6 +11,7 @@
 #include <string>
 
 #include "fmi/model_description.hpp"
+#include "pkm4puu/version.h"
 
 #ifndef PKM_FMI_DEFINITION
 #error "PKM_FMI_DEFINITION must name the model's definition (a function in namespace pkm_fmi)"
@@ -77,7 +79,7 @@ int write_model_descriptions(const char* prog, const pkm_fmi::ModelDefinition& d
   for (int version : {2, 3}) {
     const std::string path = dir + "/fmi" + std::to_string(version) + "/" + def.identifier + ".xml";
     std::ofstream out(path, std::ios::binary);
-    out << pkm_fmi::model_description_xml(def, version);
+    out << pkm_fmi::model_description_xml(def, version, PKM_VERSION_STRING);
     out.close();
     if (!out) {
       std::fprintf(stderr, "%s: cannot write %s (does the directory exist?)\n", prog, path.c_str());

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "fmi/fmu_state.hpp"
 
 #include <algorithm>

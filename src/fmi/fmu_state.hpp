@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // FMU states: an in-memory state is its serialised form, so that get/set
 // and serialise/deserialise share one code path and one format.
 //

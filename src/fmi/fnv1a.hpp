@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // FNV-1a 64-bit hash: FMU-state checksums and the instantiation token.
 #pragma once
 

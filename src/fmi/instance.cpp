@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "fmi/instance.hpp"
 
 #include <cmath>

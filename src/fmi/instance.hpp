@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // One FMU instance, whatever the FMI version: the state machine, and every
 // FMI function as a method over the model's table and hooks. The thin front
 // ends (fmi2_functions.cpp, fmi3_functions.cpp) translate the C calls.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Messages to the importer's logger callback, filtered by log category.
 //
 // Categories (declared in every modelDescription.xml, in this order):

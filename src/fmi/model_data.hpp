@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The contract between the generic FMI layer and a model (Reference-FMUs'
 // model.h, in C++): the per-instance data the variable table points into,
 // and the hooks the FMI functions call. A model knows nothing of FMI

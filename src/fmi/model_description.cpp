@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "fmi/model_description.hpp"
 
 #include <cmath>
@@ -91,7 +92,15 @@ std::string default_experiment(const ModelDefinition& d) {
          exact_text(d.default_step) + "\"/>\n";
 }
 
-const char* kGenerationTool = "PKM4PUU model-description generator (fmu_src/fmi/model_description.cpp)";
+// The attributes of <fmiModelDescription> both versions share, between
+// description and variableNamingConvention: the project's version, licence
+// and generator. Per-commit values (the commit in generationTool,
+// generationDateAndTime) are added by cmake/pack_fmu.py to the archive's
+// copy only: the committed files stay the same from commit to commit.
+std::string header_attributes(const std::string& version) {
+  return "\n  version=\"" + xml_escape(version.c_str()) + "\"\n  copyright=\"" + kCopyright + "\"\n  license=\"" +
+         kLicense + "\"\n  generationTool=\"PKM4PUU " + xml_escape(version.c_str()) + "\"";
+}
 
 bool is_state(const Variable& v) { return v.state >= 0; }
 
@@ -159,13 +168,13 @@ std::string unknown_dependencies(const ModelDefinition& d, const Variable& v, in
   return a;
 }
 
-std::string fmi2(const ModelDefinition& d) {
+std::string fmi2(const ModelDefinition& d, const std::string& version) {
   std::map<std::uint32_t, int> index;  // value reference -> 1-based ScalarVariable index
   for (std::size_t i = 0; i < d.n_variables; ++i) index[d.variables[i].vr] = static_cast<int>(i + 1);
   std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   x += "<fmiModelDescription\n  fmiVersion=\"2.0\"\n  modelName=\"" + std::string(d.identifier) + "\"\n  guid=\"" +
-       d.guid() + "\"\n  description=\"" + xml_escape(d.title) + "\"\n  generationTool=\"" + kGenerationTool +
-       "\"\n  variableNamingConvention=\"structured\"\n  numberOfEventIndicators=\"" +
+       d.guid() + "\"\n  description=\"" + xml_escape(d.title) + "\"" + header_attributes(version) +
+       "\n  variableNamingConvention=\"structured\"\n  numberOfEventIndicators=\"" +
        std::to_string(d.n_event_indicators) + "\">\n";
   const std::string derivatives2 =
       d.provides_derivatives ? "\n    providesDirectionalDerivative=\"true\"" : "";
@@ -205,12 +214,12 @@ std::string fmi2(const ModelDefinition& d) {
   return x;
 }
 
-std::string fmi3(const ModelDefinition& d) {
+std::string fmi3(const ModelDefinition& d, const std::string& version) {
   const std::map<std::uint32_t, int> none;
   std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   x += "<fmiModelDescription\n  fmiVersion=\"3.0\"\n  modelName=\"" + std::string(d.identifier) +
-       "\"\n  instantiationToken=\"" + d.guid() + "\"\n  description=\"" + xml_escape(d.title) +
-       "\"\n  generationTool=\"" + kGenerationTool + "\"\n  variableNamingConvention=\"structured\">\n";
+       "\"\n  instantiationToken=\"" + d.guid() + "\"\n  description=\"" + xml_escape(d.title) + "\"" +
+       header_attributes(version) + "\n  variableNamingConvention=\"structured\">\n";
   const std::string derivatives3 =
       d.provides_derivatives
           ? "\n    providesDirectionalDerivatives=\"true\"\n    providesAdjointDerivatives=\"true\""
@@ -301,8 +310,8 @@ Dependencies dependencies_of(const ModelDefinition& d, const Variable& v) {
   return deps;
 }
 
-std::string model_description_xml(const ModelDefinition& def, int fmi_version) {
-  return fmi_version == 2 ? fmi2(def) : fmi3(def);
+std::string model_description_xml(const ModelDefinition& def, int fmi_version, const std::string& version) {
+  return fmi_version == 2 ? fmi2(def, version) : fmi3(def, version);
 }
 
 }  // namespace pkm_fmi

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // modelDescription.xml of a model, generated from its variable table: FMI
 // 2.0 (Co-Simulation and Model Exchange in one file) and FMI 3.0. The
 // committed copies under modelDescription/ are these files; a test fails
@@ -11,8 +12,13 @@
 
 namespace pkm_fmi {
 
-/// The model description for FMI version 2 or 3.
-std::string model_description_xml(const ModelDefinition& def, int fmi_version);
+/// The copyright and license attributes of every model description.
+inline constexpr const char* kCopyright = "Copyright (c) 2026 The PKM4PUU authors";
+inline constexpr const char* kLicense = "BSD-2-Clause";
+
+/// The model description for FMI version 2 or 3; `version` is the
+/// project's (PKM_VERSION_STRING of pkm4puu/version.h).
+std::string model_description_xml(const ModelDefinition& def, int fmi_version, const std::string& version);
 
 /// The value references a computed variable depends on (ModelStructure),
 /// in table order, and whether every factor is constant (dependenciesKind).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Model Exchange: the importer integrates the continuous states; the model
 // gives their derivatives and its event indicators.
 #include <cmath>

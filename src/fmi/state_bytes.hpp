@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Little-endian fixed-size fields of a serialised FMU state.
 #pragma once
 

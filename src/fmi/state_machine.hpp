@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Which states each FMI function may be called in (FMI 2.0 and 3.0 state
 // machines, merged: ME and CS states are distinct bits), in one place.
 #pragma once

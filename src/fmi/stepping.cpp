@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Co-Simulation: communication steps, input interpolation, step status.
 #include <algorithm>
 #include <cmath>

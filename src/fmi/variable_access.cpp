@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Get and set through the variable table.
 #include <cmath>
 #include <type_traits>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // One model's interface as a table: every variable of modelDescription.xml
 // (FMI 2.0 and 3.0 are generated from it, model_description.cpp), how to
 // reach its value in an instance's data, and what it depends on

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The two FMUs of the project (MODEL_SPEC "FMU interface contract").
 #pragma once
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
 /*
  * pkm.h - plain C API of the 4-PUU Schoenflies-motion parallel robot model
  * (MODEL_SPEC.md). No C++ types; an opaque handle per simulated machine.
@@ -12,14 +13,25 @@
 
 #include <stddef.h>
 
+#include "pkm4puu/version.h" /* PKM_VERSION_MAJOR/MINOR/PATCH, PKM_VERSION_STRING */
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#if defined(_WIN32)
+/* Exported while building the library (PKM_BUILDING_LIBRARY, set on the
+ * library target only); imported from the DLL by its users on Windows;
+ * nothing for the static library (PKM_STATIC, set for its users). */
+#if defined(PKM_STATIC)
+#define PKM_API
+#elif defined(_WIN32) && defined(PKM_BUILDING_LIBRARY)
 #define PKM_API __declspec(dllexport)
-#else
+#elif defined(_WIN32)
+#define PKM_API __declspec(dllimport)
+#elif defined(PKM_BUILDING_LIBRARY)
 #define PKM_API __attribute__((visibility("default")))
+#else
+#define PKM_API
 #endif
 
 typedef enum {
@@ -101,6 +113,11 @@ PKM_API void pkm_default_solver_settings(pkm_solver_settings* s);
  * message naming the offending parameter is written into err[err_len]. */
 PKM_API pkm_status pkm_create(const pkm_params* p, pkm_model** out, char* err, size_t err_len);
 PKM_API void pkm_destroy(pkm_model* m);
+
+/* The library's version, "MAJOR.MINOR.PATCH": PKM_VERSION_STRING of the
+ * header it was built with (a program built against another header can
+ * compare the two). */
+PKM_API const char* pkm_version(void);
 
 PKM_API const char* pkm_last_error(const pkm_model* m);
 PKM_API const char* pkm_status_string(pkm_status s);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The plain C API (pkm.h): creation and parameter errors, pose errors,
 // forward and inverse dynamics through it, state save/restore, and that a
 // failed call loses nothing.
@@ -25,6 +26,16 @@ struct Handle {
 const double kHome[4] = {0.0, 0.0, 0.05, 0.0};
 
 }  // namespace
+
+// One version: CMake's project() (PKM_PROJECT_VERSION, set by
+// tests/CMakeLists.txt), the header's macros and the library's answer.
+TEST(CApi, VersionIsTheProjectVersionInHeaderAndLibrary) {
+  const std::string numbers = std::to_string(PKM_VERSION_MAJOR) + "." + std::to_string(PKM_VERSION_MINOR) + "." +
+                              std::to_string(PKM_VERSION_PATCH);
+  EXPECT_EQ(numbers, PKM_PROJECT_VERSION);
+  EXPECT_STREQ(PKM_VERSION_STRING, PKM_PROJECT_VERSION);
+  EXPECT_STREQ(pkm_version(), PKM_PROJECT_VERSION);
+}
 
 TEST(CApi, CreateRejectsBadParametersWithAMessage) {
   pkm_params p;

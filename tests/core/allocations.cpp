@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // No heap allocation inside a time step of the core: 1000 state derivatives
 // (each formulation), inverse dynamics solves (warm and cold), the analytic
 // derivatives, and 1000 one-ms RK4 Plant::advance calls after initialisation

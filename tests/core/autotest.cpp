@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The paper's auto-test round trip in process (MODEL_SPEC "Auto-test"):
 // forces from inverse dynamics at the integrator's own stage times, open
 // loop over the full 2 s, reproduce the prescribed path.

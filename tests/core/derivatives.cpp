@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Analytic derivatives of the forward and inverse dynamics
 // (reduced_dynamics_derivatives.hpp, inverse_dynamics_derivatives.hpp)
 // against central differences of the same model's plain functions

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The Lagrangian terms of Eq. 1 against the independent reference model:
 // M as the Hessian of the kinetic energy in qd, V and G from finite
 // differences of the Lagrangian (Eq. 14), plus the spec's static check.

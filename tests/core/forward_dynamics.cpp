@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Forward dynamics: the three formulations agree (Eq. 12, Eq. 13 with a QR
 // basis, Eq. 13 with the leg-partitioned basis), they invert the inverse
 // dynamics, and energy is conserved when nothing does work.

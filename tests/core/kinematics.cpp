@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Kinematics: closed-form inverse kinematics against the spec's golden
 // poses, the servo position/velocity/acceleration problems (Eqs. 2-9), and
 // the analytic Jacobians against finite differences.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Hardening, long run: one hour of simulated time under CVODE (Adams, rtol
 // 1e-12, atol 1e-14, one continuous integration: no restarts) with small
 // sinusoidal actuator forces about the static ones, near the home pose.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The machine around the mechanism (MODEL_SPEC "The machine around the
 // mechanism: drives, friction, end stops, payload"): parameters, the
 // Lagrangian terms of rotors and payload against the independent reference

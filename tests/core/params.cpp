@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Parameters: the spec's defaults in SI, and validation messages that name
 // the offending parameter.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Hardening, bad input: non-finite inputs and parameters, out-of-range
 // parameters, geometry for which the initial pose cannot be assembled, an
 // initial pose outside the elbow-down working mode or beyond the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The FMU binaries and archives as files: the shared libraries they need,
 // the functions they export, and fmpy's validation and simulation of the
 // packaged .fmu files when fmpy is available. Host programs only (ldd, nm,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Directional and adjoint derivatives of the plant FMU, through the dlopen'd
 // binary: in Model Exchange the derivatives and outputs with respect to the
 // states and inputs against Richardson-extrapolated central differences of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // What the tests of the FMU binaries share beyond fmu_loader.hpp: the
 // fixture that checks both binaries loaded, two ways of driving the plant's
 // inputs, and the check of a misuse on a stepping instance (the answer the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The built FMU binaries (PKM4PUU.so / .dll, PKM4PUU_Inverse.so / .dll)
 // loaded as an importer would (dlopen; LoadLibrary on Windows) and driven
 // through the raw FMI 2.0 functions: shared by the tests of tests/fmi/.

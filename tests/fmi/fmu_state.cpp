@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // FMU states of the binaries through the raw FMI 2.0 functions: get/set and
 // serialised states continue bit-identically (CVODE and RK4), in the same
 // and in a fresh instance, for both FMUs; foreign, broken and forged states

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The FMU binaries' logging through the raw FMI 2.0 functions: debug
 // logging filtered by category (FMI 2.0 section 2.1.5), nothing written to
 // stdout or stderr, and messages carrying format characters passed safely.

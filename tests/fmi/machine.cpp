@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The plant FMU behaves like the machine when nothing is set (MODEL_SPEC
 // "The machine around the mechanism"), and its log stays quiet: with logging
 // on and no category named only warnings, errors and events are written.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The interface as the variable tables declare it (src/models/<id>), from which
 // every modelDescription.xml is generated (the ctest
 // model_descriptions_up_to_date checks that the committed files are those):
@@ -20,6 +21,7 @@
 #include "models/models.hpp"
 #include "pkm4puu/model/params.hpp"
 #include "pkm4puu/sim/plant.hpp"
+#include "pkm4puu/version.h"
 
 namespace {
 
@@ -97,11 +99,27 @@ TEST(InterfaceContract, ParameterStartValuesAreTheCoreDefaults) {
   }
 }
 
+TEST(InterfaceContract, HeaderCarriesVersionCopyrightAndLicense) {
+  // The project's version (CMake's project()), the copyright holder and the
+  // SPDX licence; the per-commit attributes are left to the packer.
+  for (const ModelDefinition* d : {&pkm_fmi::pkm4puu_definition(), &pkm_fmi::pkm4puu_inverse_definition()}) {
+    for (int version : {2, 3}) {
+      const std::string xml = pkm_fmi::model_description_xml(*d, version, PKM_VERSION_STRING);
+      const std::string header = xml.substr(0, xml.find('>', xml.find("<fmiModelDescription")));
+      EXPECT_NE(header.find("\n  version=\"" PKM_VERSION_STRING "\""), std::string::npos) << header;
+      EXPECT_NE(header.find("\n  copyright=\"Copyright (c) 2026 The PKM4PUU authors\""), std::string::npos) << header;
+      EXPECT_NE(header.find("\n  license=\"BSD-2-Clause\""), std::string::npos) << header;
+      EXPECT_NE(header.find("\n  generationTool=\"PKM4PUU " PKM_VERSION_STRING "\""), std::string::npos) << header;
+      EXPECT_EQ(header.find("generationDateAndTime"), std::string::npos) << header;
+    }
+  }
+}
+
 TEST(InterfaceContract, EveryUnitHasAnSIBaseUnitDefinition) {
   // The generator aborts on a unit it has no definition for; here the text.
   for (const ModelDefinition* d : {&pkm_fmi::pkm4puu_definition(), &pkm_fmi::pkm4puu_inverse_definition()}) {
     for (int version : {2, 3}) {
-      const std::string xml = pkm_fmi::model_description_xml(*d, version);
+      const std::string xml = pkm_fmi::model_description_xml(*d, version, PKM_VERSION_STRING);
       for (std::size_t i = 0; i < d->n_variables; ++i) {
         const std::string unit = d->variables[i].unit;
         if (unit.empty()) continue;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The plant as FMI 2.0 Model Exchange, driven through the dlopen'd binary by
 // an integrator of the test's own: classic RK4 at h = 1 ms with the auto-test's
 // forces evaluated exactly at each stage time (in-process inverse dynamics,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Hardening, singularities: the plant FMU driven by large constant forces
 // until it really runs into a leg singularity (a rod turning vertical or
 // horizontal) or a parallel singularity (actuator Jacobian condition number

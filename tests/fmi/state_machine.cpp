@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The FMU binaries' state machine, driven through the raw FMI 2.0 functions
 // as an importer would (dlopen): version and platform, instantiation and its
 // checks, calls out of the co-simulation state machine's order before,

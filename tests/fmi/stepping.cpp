@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Communication steps of the FMU binaries through the raw FMI 2.0
 // functions: the static forces hold the home pose (CVODE and RK4), a failed
 // step is discarded with the last good state kept, input derivatives are

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Hardening, threads: eight instances of the plant FMU (and eight of the
 // inverse FMU) advanced concurrently in eight std::threads through the
 // built, dlopen'd binaries give results bit-identical to each instance run

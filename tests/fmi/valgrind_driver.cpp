@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // A small co-simulation master for valgrind memcheck (ctest
 // hardening_valgrind): the paper's full 2-s auto-test through the built
 // FMUs, as python/pkm4puu/autotest.py does it -- PKM4PUU_Inverse.so turns

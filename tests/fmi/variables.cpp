@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The FMU binaries' variables through the raw FMI 2.0 functions: non-finite
 // inputs refused, unknown and mistyped value references, invalid parameters
 // and unreachable start poses failing initialisation, outputs readable in

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The reports that check the built FMUs and C API against the paper and
 against independent models, and what they share; run them as `python -m
 pkm4puu COMMAND` (pkm4puu.__main__). Not the library: the programs here

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """What the command-line programs share (the examples and `python -m
 pkm4puu autotest` and the other reports): progress on stderr, the
 --build/--out arguments (the build directory as locate.build_dir finds it,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The mechanism drawn: its points at one instant from the FMU's outputs, and
 the CSV of a run that examples/render_robot.py draws."""
 import csv

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Validation against independent multibody engines (the paper's section 5.2,
 done with open tools): Pinocchio and MuJoCo models of the same mechanism,
 built from MODEL_SPEC's numbers only (engines/), against this project's C API

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-2-Clause
 """Plots of the auto-test (paper section 5.1) from the CSV files written by
 pkm_autotest: actuator forces (in the spirit of the paper's Fig. 5), the
 prescribed and simulated platform motion (Fig. 6) and the round-trip error.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The auto-test's two standard figures, shared by the C++ core's plots
 (plot_cpp_autotest.py) and the FMU run's (autotest.py): actuator forces with
 their dynamic part (in the spirit of the paper's Fig. 5) and prescribed

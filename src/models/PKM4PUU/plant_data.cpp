@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "models/PKM4PUU/plant_data.hpp"
 
 #include <cmath>

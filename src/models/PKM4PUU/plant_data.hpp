@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #pragma once
 // PKM4PUU.fmu: forward dynamics of the 4-PUU robot (the plant), over
 // pkm::Plant: the instance data and the hooks of the generic FMI layer

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // PKM4PUU.fmu's interface: every variable of its model descriptions, with
 // where its value lives in PlantData (plant_data.hpp) and what it depends on.
 #include <iterator>

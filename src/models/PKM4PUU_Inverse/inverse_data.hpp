@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #pragma once
 // PKM4PUU_Inverse.fmu: inverse dynamics of the 4-PUU robot (computed-force
 // feed-forward), over pkm::inverse_dynamics. An algebraic FMU: its outputs

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // PKM4PUU_Inverse.fmu's interface: every variable of its model descriptions,
 // with where its value lives in InverseData (inverse_data.hpp) and what it
 // depends on.

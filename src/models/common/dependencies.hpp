@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The kinds of states and inputs this project's FMUs declare for their
 // ModelStructure (fmi/variables.hpp: a computed variable depends on every
 // state and input whose kind shares a bit with its `depends`). The

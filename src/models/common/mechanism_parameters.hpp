@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // What both FMUs share: the mechanism's parameters (MODEL_SPEC: Tables II
 // and III, leg placement, gravity) as FMI variables, stored straight in a
 // pkm::Params, and the singularity guards' limits in a pkm::GuardLimits,

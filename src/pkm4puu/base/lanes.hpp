@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Four doubles as lanes: the legs' arithmetic of the derivative's hot path
 // (reduced_dynamics.cpp) written once, for one leg (T = double) or for the
 // four legs at once (T = Pack), with the same operations per lane.

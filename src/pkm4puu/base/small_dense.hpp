@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Dense solvers for the reference formulations of forward_dynamics.cpp
 // (Eq. 12's 28x28 augmented system, Eq. 13's QR null space), written as
 // plain loops over fixed-size matrices. Eigen's PartialPivLU, HouseholderQR

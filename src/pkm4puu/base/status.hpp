@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Result codes of the core. Every fallible function returns one; none throws
 // in a time step. The C API maps them one to one onto pkm_status.
 #pragma once

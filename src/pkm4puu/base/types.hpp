@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Fixed-size Eigen types and index conventions shared by the whole core.
 //
 // Coordinates (MODEL_SPEC "Coordinates"), n = 16:

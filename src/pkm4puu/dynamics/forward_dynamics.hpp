@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Forward dynamics: given (q, qd) on the constraint manifold and the
 // generalised forces f, the accelerations qdd and multipliers lambda of
 //   M qdd + V + G + C_q^T lambda = f,   C_q qdd + gamma = 0.

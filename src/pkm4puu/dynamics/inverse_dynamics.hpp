@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Inverse dynamics (Eqs. 10-11). With q, qd, qdd known from the servo
 // kinematics, Eq. 1 has 16 rows and 16 unknowns: lambda (12) and the
 // actuator forces F (4). The 12 rows of the unactuated coordinates

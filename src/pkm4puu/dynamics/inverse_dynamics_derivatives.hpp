@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Analytic derivatives of the inverse dynamics (inverse_dynamics.hpp) with
 // respect to the platform motion and the external wrench. The actuator
 // forces F solve the reduced residual R(p, pd, pdd, F, we) = 0

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Terms of Eq. 1, M(q) qdd + V(q, qd) + G(q) + C_q^T lambda = f, derived
 // analytically from the Lagrangian of Eq. 14 with the bodies of Table III:
 //   slider: 1/2 m_s rhod^2,                       U = m_s g rho

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Partial derivatives of one leg's rows of Eq. 1 without the multipliers,
 //   w = M(q) qdd + V(q, qd) + G(q)          (lagrangian.hpp),
 // with respect to the leg's q = (rho, theta1, theta2) and qd. M, V and G

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "pkm4puu/dynamics/leg_lanes.hpp"
 
 #include "pkm4puu/base/lanes.hpp"

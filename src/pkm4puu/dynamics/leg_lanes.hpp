@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The derivative's legs as lanes: the leg arithmetic of the hot path
 // (leg inverse kinematics, the legs' velocities and their share of the
 // reduced system) for the four legs at once, in packed doubles

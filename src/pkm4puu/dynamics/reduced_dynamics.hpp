@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Eq. 13 with the null-space basis taken from the leg blocks (coordinate
 // partitioning, platform pose independent), built leg by leg.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Analytic derivatives of the reduced dynamics (reduced_dynamics.hpp), leg
 // by leg from the Lagrangian terms, chained through the leg partitioning.
 //

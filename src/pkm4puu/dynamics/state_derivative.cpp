@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "pkm4puu/dynamics/state_derivative.hpp"
 
 #include "pkm4puu/kinematics/constraints.hpp"

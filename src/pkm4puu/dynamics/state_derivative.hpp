@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The integrators' state and its derivative.
 //
 // The integrated state is the platform's pose and velocity,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // SUNDIALS CVODE (variable-order, variable-step Adams or BDF) on the
 // plant's integrated vector: the 8-dimensional state of state_derivative.hpp
 // and the two running energy integrals (plant.hpp). Optional root finding

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // CvodeIntegrator without SUNDIALS: what the source-code FMUs compile in
 // place of cvode_integrator.cpp, so that they build with nothing but a
 // C++17 compiler. cvode_available() is false, so the solver settings refuse

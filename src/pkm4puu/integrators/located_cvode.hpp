@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // CVODE across the end stops' switches: it stops at every root of the stop
 // indicators (a joint reaching or leaving a stop), switches the held stops
 // by each root's direction (not by the side of zero on which the located

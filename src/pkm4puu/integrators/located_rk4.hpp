@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // One fixed RK4 grid step across the end stops' switches: split where the
 // contact mode changes (located by bisection) and, while a contact is on,
 // substepped so that RK4 resolves the stop's spring.

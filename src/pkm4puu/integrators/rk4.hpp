@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Classical fixed-step Runge-Kutta (4th order), the paper's integrator.
 #pragma once
 

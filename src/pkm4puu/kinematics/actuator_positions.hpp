@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The actuator positions rho_1..4 (the sliders' heights) at a platform pose.
 #pragma once
 

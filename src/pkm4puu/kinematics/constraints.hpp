@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Loop closures of the whole mechanism (Eq. 15) and their derivatives, plus
 // the 4x4 actuator Jacobian. Full-size forms, as in the paper.
 #pragma once

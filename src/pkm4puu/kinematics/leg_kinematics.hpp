@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // One leg's kinematics in its base frame 0_i (MODEL_SPEC "Leg kinematics",
 // Table I, standard DH). Everything here is per leg and allocation free.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Second and third derivatives of the leg end point p_Q(rho, theta1, theta2)
 // (leg_kinematics.hpp), in frame 0_i. p_Q is linear in rho, so only the
 // theta derivatives are nonzero (subscripts 1 = theta1, 2 = theta2):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Inverse kinematics with the platform motion as a servo-constraint
 // (Eqs. 2-9): the 12 loop closures are augmented by the 4 servo equations
 // q_platform - pose(t) = 0, giving the square 16x16 system

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // theta1 of each leg, continuous in time: the closed form gives it modulo
 // 2 pi; a reference per leg, brought forward by whole turns, unwraps it.
 #pragma once

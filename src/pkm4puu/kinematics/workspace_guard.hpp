@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Guards against singular configurations (MODEL_SPEC "Working mode"):
 //   - leg (serial) singularities: det(dC_i/d(rho, theta1, theta2)) / l^2 =
 //     |cos theta2 sin theta2| goes to 0 when a rod turns horizontal

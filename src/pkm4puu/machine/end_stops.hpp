@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The sliders' compliant end stops, in one place: the force law, the
 // contact mode that the integrators hold between located events, and the
 // event indicators that locate its changes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The passive force on each actuated coordinate rho_i: friction plus end
 // stop, its slopes and the power it dissipates. On rho_i (positive along +z)
 // act F_i + (2 pi / p) tau_i (actuator force and motor torque through a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The immutable model: validated parameters plus the leg placement derived
 // from them once (Pinocchio's "model" half; per-call workspaces live with
 // the functions that need them).

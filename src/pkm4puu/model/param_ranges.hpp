@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The one table of the parameters' physical ranges: validate() checks and
 // words its messages from it, and the FMUs' variable tables take each
 // parameter's start, min and max from it (the modelDescription).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "pkm4puu/model/params.hpp"
 
 #include "pkm4puu/model/param_ranges.hpp"

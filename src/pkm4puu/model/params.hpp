@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Model parameters (MODEL_SPEC: Tables II and III, leg placement, gravity),
 // in SI units. Defaults are the spec's values, converted once here.
 #pragma once

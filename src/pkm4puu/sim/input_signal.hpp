@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The plant's inputs over an interval, as functions of time.
 #pragma once
 

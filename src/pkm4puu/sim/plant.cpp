@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "pkm4puu/sim/plant.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // Forward-dynamics simulation of the mechanism: the state, the solver
 // settings and the integrators around state_derivative(). One Plant per
 // simulated machine; no global state, so instances are independent.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The Plant's outputs at the current state: the joint coordinates, the
 // machine's forces and energies, the health measures. Reading changes
 // nothing but the caches (theta1's references, the actuator positions).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The Plant's stepping: advance() with RK4 or CVODE across the end stops'
 // switches (integrators/located_*.hpp), each step checked by the guard.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 #include "pkm4puu/sim/solver_settings.hpp"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-2-Clause
 // The plant's solver settings and their validation, in one place: the FMUs
 // and the C API pass their values through unchecked.
 #pragma once

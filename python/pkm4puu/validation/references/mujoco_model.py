@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """An independent model of the 4-PUU mechanism in MuJoCo (MJCF), built from
 MODEL_SPEC's numbers only (pkm4puu.spec).
 

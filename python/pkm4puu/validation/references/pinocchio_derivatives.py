@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Derivatives of the reduced forward dynamics from Pinocchio, on the
 independent model of pinocchio_model.py: the reference for this project's
 analytic A = dydot/dy and B = dydot/du (pkm_forward_derivatives, the plant

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """An independent model of the 4-PUU mechanism in Pinocchio, built from
 MODEL_SPEC's numbers only (pkm4puu.spec), used as the reference for the
 project's dynamics.

@@ -1,0 +1,56 @@
+# SPDX-License-Identifier: BSD-2-Clause
+# `cmake --install`: the C API (include/pkm4puu/pkm.h and version.h, libpkm
+# shared and static), a relocatable CMake package (pkm4puuConfig.cmake,
+# pkm4puuConfigVersion.cmake, targets pkm4puu::pkm and pkm4puu::pkm_static),
+# pkg-config's pkm4puu.pc, the FMUs under share/pkm4puu/fmi2 and fmi3 (those
+# built), and the licences under share/doc/pkm4puu/.
+include_guard(GLOBAL)
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+set(PKM_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/pkm4puu")
+set(PKM_INSTALL_DATADIR "${CMAKE_INSTALL_DATADIR}/pkm4puu")
+
+install(TARGETS pkm pkm_static EXPORT pkm4puuTargets
+        RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} NAMELINK_COMPONENT Development
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT Development)
+install(FILES "${PROJECT_SOURCE_DIR}/src/pkm4puu/pkm.h" "${PROJECT_BINARY_DIR}/include/pkm4puu/version.h"
+        DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/pkm4puu" COMPONENT Development)
+install(EXPORT pkm4puuTargets NAMESPACE pkm4puu:: DESTINATION "${PKM_INSTALL_CMAKEDIR}" COMPONENT Development)
+configure_package_config_file("${CMAKE_CURRENT_LIST_DIR}/pkm4puuConfig.cmake.in"
+                              "${PROJECT_BINARY_DIR}/cmake/pkm4puuConfig.cmake"
+                              INSTALL_DESTINATION "${PKM_INSTALL_CMAKEDIR}"
+                              PATH_VARS CMAKE_INSTALL_INCLUDEDIR PKM_INSTALL_DATADIR)
+# 0.x: a minor release may break the API.
+write_basic_package_version_file("${PROJECT_BINARY_DIR}/cmake/pkm4puuConfigVersion.cmake"
+                                 COMPATIBILITY SameMinorVersion)
+install(FILES "${PROJECT_BINARY_DIR}/cmake/pkm4puuConfig.cmake" "${PROJECT_BINARY_DIR}/cmake/pkm4puuConfigVersion.cmake"
+        DESTINATION "${PKM_INSTALL_CMAKEDIR}" COMPONENT Development)
+# pkg-config: relative to the .pc file's own place, so the prefix can move.
+configure_file("${CMAKE_CURRENT_LIST_DIR}/pkm4puu.pc.in" "${PROJECT_BINARY_DIR}/pkm4puu.pc" @ONLY)
+install(FILES "${PROJECT_BINARY_DIR}/pkm4puu.pc" DESTINATION "${CMAKE_INSTALL_LIBDIR}/pkgconfig"
+        COMPONENT Development)
+
+# The FMUs that this build packs: the merged archives (every platform and
+# the sources) under PKM_PLATFORMS, else the host's.
+if(_pkm_pack_python)
+  get_property(_pkm_models GLOBAL PROPERTY PKM_FMU_MODELS)
+  foreach(_id IN LISTS _pkm_models)
+    if(PKM_PLATFORMS AND NOT CMAKE_CROSSCOMPILING)
+      set(_fmi2 "${PROJECT_BINARY_DIR}/dist/fmi2/${_id}.fmu")
+      set(_fmi3 "${PROJECT_BINARY_DIR}/dist/fmi3/${_id}.fmu")
+    else()
+      set(_fmi2 "${PROJECT_BINARY_DIR}/${_id}.fmu")
+      set(_fmi3 "${PROJECT_BINARY_DIR}/fmi3/${_id}.fmu")
+    endif()
+    install(FILES "${_fmi2}" DESTINATION "${PKM_INSTALL_DATADIR}/fmi2" COMPONENT FMUs)
+    install(FILES "${_fmi3}" DESTINATION "${PKM_INSTALL_DATADIR}/fmi3" COMPONENT FMUs)
+  endforeach()
+endif()
+
+# The licences: the project's, and the notices of what libpkm links
+# (SUNDIALS statically, Eigen's compiled templates); the FMUs carry their own.
+install(FILES "${PROJECT_SOURCE_DIR}/LICENSE" "${PROJECT_SOURCE_DIR}/CHANGELOG.md"
+        DESTINATION "${CMAKE_INSTALL_DATADIR}/doc/pkm4puu")
+install(FILES "${PKM_LICENSES_DIR}/SUNDIALS.txt" "${PKM_LICENSES_DIR}/Eigen.txt"
+        DESTINATION "${CMAKE_INSTALL_DATADIR}/doc/pkm4puu/licenses")

@@ -1,0 +1,63 @@
+# SPDX-License-Identifier: BSD-2-Clause
+# ctest distribution_install_consumer: `cmake --install` of this build into
+# a temporary prefix, the prefix moved elsewhere (the packages must be
+# relocatable), then the outside project tests/consumer configured, built
+# and run against it: find_package(pkm4puu CONFIG) with the shared and with
+# the static library, and pkg-config when it is there. Each run computes
+# the holding forces at the home pose (2.655616050 N per actuator).
+# With -DMODE=add_subdirectory (ctest distribution_add_subdirectory): the
+# consumer adds this source tree with add_subdirectory() instead, builds the
+# library inside its own build and runs the same computation.
+#   cmake -DBUILD=... -DSOURCE=... -DWORK=... -DGENERATOR=... [-DWITH_FMUS=1] [-DMODE=...] -P check_install.cmake
+file(REMOVE_RECURSE "${WORK}")
+function(run what)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${what} failed (${rc}):\n${out}\n${err}")
+  endif()
+  message(STATUS "${what}: ok\n${out}")
+endfunction()
+if(MODE STREQUAL "add_subdirectory")
+  run("configure the consumer with add_subdirectory" ${CMAKE_COMMAND} -S "${SOURCE}/tests/consumer" -B "${WORK}"
+      -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=Release "-DPKM4PUU_SOURCE_DIR=${SOURCE}" -DPKM_LTO=OFF)
+  run("build the consumer with add_subdirectory" ${CMAKE_COMMAND} --build "${WORK}" -j2 --target holding_forces)
+  run("run the consumer with add_subdirectory" "${WORK}/holding_forces")
+  file(REMOVE_RECURSE "${WORK}")
+  return()
+endif()
+run("install" ${CMAKE_COMMAND} --install "${BUILD}" --prefix "${WORK}/staging")
+file(RENAME "${WORK}/staging" "${WORK}/prefix")
+set(prefix "${WORK}/prefix")
+set(expected include/pkm4puu/pkm.h include/pkm4puu/version.h lib/libpkm.a lib/cmake/pkm4puu/pkm4puuConfig.cmake
+    lib/cmake/pkm4puu/pkm4puuConfigVersion.cmake lib/pkgconfig/pkm4puu.pc share/doc/pkm4puu/LICENSE
+    share/doc/pkm4puu/licenses/SUNDIALS.txt share/doc/pkm4puu/licenses/Eigen.txt)
+if(WITH_FMUS)  # the archives, when the build packs them (it takes Python)
+  foreach(v 2 3)
+    list(APPEND expected share/pkm4puu/fmi${v}/PKM4PUU.fmu share/pkm4puu/fmi${v}/PKM4PUU_Inverse.fmu)
+  endforeach()
+endif()
+foreach(f IN LISTS expected)
+  if(NOT EXISTS "${prefix}/${f}")
+    message(FATAL_ERROR "cmake --install did not install ${f}")
+  endif()
+endforeach()
+file(GLOB sonames "${prefix}/lib/libpkm.so.*")
+list(LENGTH sonames n)
+if(n LESS 2)  # libpkm.so.0 -> libpkm.so.X.Y.Z
+  message(FATAL_ERROR "libpkm without its SOVERSION link: ${sonames}")
+endif()
+set(variants shared "-DUSE_STATIC=OFF" static "-DUSE_STATIC=ON")
+find_program(PKG_CONFIG pkg-config)
+if(PKG_CONFIG)
+  list(APPEND variants pkg-config "-DUSE_PKG_CONFIG=ON")
+endif()
+while(variants)
+  list(POP_FRONT variants name option)
+  set(b "${WORK}/consumer-${name}")
+  run("configure the consumer (${name})" ${CMAKE_COMMAND} -S "${SOURCE}/tests/consumer" -B "${b}" -G "${GENERATOR}"
+      -DCMAKE_BUILD_TYPE=Release "-DCMAKE_PREFIX_PATH=${prefix}" ${option})
+  run("build the consumer (${name})" ${CMAKE_COMMAND} --build "${b}")
+  # The shared library is found through the consumer's RPATH into the prefix.
+  run("run the consumer (${name})" "${b}/holding_forces")
+endwhile()
+file(REMOVE_RECURSE "${WORK}")

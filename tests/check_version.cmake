@@ -1,0 +1,19 @@
+# SPDX-License-Identifier: BSD-2-Clause
+# ctest distribution_one_version: the version of project() is the Python
+# package's (python/pkm4puu/_version.py, which pyproject.toml reads) and
+# CHANGELOG.md's latest release.
+#   cmake -DVERSION=X.Y.Z -DSOURCE=<repository> -P check_version.cmake
+file(STRINGS "${SOURCE}/python/pkm4puu/_version.py" py REGEX "^__version__ = ")
+if(NOT py STREQUAL "__version__ = \"${VERSION}\"")
+  message(FATAL_ERROR "python/pkm4puu/_version.py says '${py}', project() ${VERSION}")
+endif()
+file(STRINGS "${SOURCE}/python/pyproject.toml" dyn REGEX "^version = |^dynamic = ")
+if(NOT dyn STREQUAL "dynamic = [\"version\"];version = {attr = \"pkm4puu._version.__version__\"}")
+  message(FATAL_ERROR "python/pyproject.toml: '${dyn}', expected the version read from pkm4puu/_version.py")
+endif()
+file(STRINGS "${SOURCE}/CHANGELOG.md" releases REGEX "^## \\[[0-9]")
+list(GET releases 0 latest)
+if(NOT latest MATCHES "^## \\[${VERSION}\\] - [0-9][0-9][0-9][0-9]-[0-9][0-9]-[0-9][0-9]$")
+  message(FATAL_ERROR "CHANGELOG.md's latest release is '${latest}', project() ${VERSION}")
+endif()
+message(STATUS "version ${VERSION}: project(), _version.py, CHANGELOG.md")
