@@ -264,7 +264,7 @@ bool Instance::load(const unsigned char* bytes, std::size_t size, const char* fu
 
 Status Instance::get_fmu_state(void** state) {
   const char* fn = PKM_FN2(fmi2GetFMUstate, fmi3GetFMUState);
-  if (!allowed(kMaskFmuState, fn)) return Status::Error;
+  if (!allowed(Call::FmuState, fn)) return Status::Error;
   if (!state) {
     log_.error("%s: FMUState is NULL", fn);
     return Status::Error;
@@ -288,7 +288,7 @@ Status Instance::get_fmu_state(void** state) {
 }
 
 SavedState* Instance::state_argument(const char* fn, void* state, const void* out, const char* out_name) {
-  if (!allowed(kMaskFmuState, fn)) return nullptr;
+  if (!allowed(Call::FmuState, fn)) return nullptr;
   SavedState* s = as_state(state);
   if (!s || (out_name && !out)) {
     if (out_name && !out) log_.error("%s: %s is NULL", fn, out_name);
@@ -309,7 +309,7 @@ Status Instance::set_fmu_state(void* state) {
 
 Status Instance::free_fmu_state(void** state) {
   const char* fn = PKM_FN2(fmi2FreeFMUstate, fmi3FreeFMUState);
-  if (!allowed(kMaskFmuState, fn)) return Status::Error;
+  if (!allowed(Call::FmuState, fn)) return Status::Error;
   if (!state || !*state) return Status::OK;
   SavedState* s = as_state(*state);
   if (!s) {
@@ -345,7 +345,7 @@ Status Instance::serialize_fmu_state(void* state, unsigned char bytes[], std::si
 
 Status Instance::deserialize_fmu_state(const unsigned char bytes[], std::size_t size, void** state) {
   const char* fn = PKM_FN2(fmi2DeSerializeFMUstate, fmi3DeserializeFMUState);
-  if (!allowed(kMaskFmuState, fn)) return Status::Error;
+  if (!allowed(Call::FmuState, fn)) return Status::Error;
   if (!state) {
     log_.error("%s: FMUState is NULL", fn);
     return Status::Error;

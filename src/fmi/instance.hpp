@@ -58,6 +58,7 @@ enum Mode : std::uint32_t {
 const char* mode_name(std::uint32_t mode);
 
 struct SavedState;  // fmu_state.cpp
+enum class Call : unsigned;  // state_machine.hpp
 
 class Instance {
  public:
@@ -174,12 +175,13 @@ class Instance {
  private:
   Instance(const ModelDefinition& def, int fmi_version, Interface interface, Logger log);
 
-  bool allowed(std::uint32_t mask, const char* function);
-  bool require(Interface i, const char* function);
-  /// allowed() and require(ModelExchange) for a Model Exchange array get or
-  /// set, then its length (given, of what) against this FMU's and the array
-  /// not NULL; false (logged) refuses the call.
-  bool array_call_allowed(std::uint32_t mask, const char* fn, const char* what, std::size_t given,
+  /// The call's row of the state table (state_machine.hpp) for this
+  /// instance's FMI version and interface; false (logged) refuses the call.
+  bool allowed(Call call, const char* function);
+  /// allowed() for a Model Exchange array get or set, then its length
+  /// (given, of what) against this FMU's and the array not NULL; false
+  /// (logged) refuses the call.
+  bool array_call_allowed(Call call, const char* fn, const char* what, std::size_t given,
                           std::size_t expected, const void* array);
   Context context() {
     return Context{log_, interface_, mode_ == kInitializationMode, start_time_};
@@ -194,7 +196,7 @@ class Instance {
   const Variable* lookup(const char* function, VarType type, std::uint32_t vr);
 
   SavedState* new_state();
-  /// allowed(kMaskFmuState) and the FMU state argument: the saved state,
+  /// allowed(Call::FmuState) and the FMU state argument: the saved state,
   /// or NULL (logged) to refuse the call, also when the call's output out,
   /// named out_name, is NULL (out_name NULL: the call has no output).
   SavedState* state_argument(const char* fn, void* state, const void* out = nullptr,

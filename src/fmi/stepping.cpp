@@ -10,7 +10,7 @@ namespace pkm_fmi {
 Status Instance::set_real_input_derivatives(const std::uint32_t vr[], std::size_t n, const std::int32_t order[],
                                             const double value[]) {
   static const char* const fn = "fmi2SetRealInputDerivatives";
-  if (!allowed(kMaskInputDerivatives, fn) || !require(Interface::CoSimulation, fn)) return Status::Error;
+  if (!allowed(Call::InputDerivatives, fn)) return Status::Error;
   if (!def_.can_interpolate_inputs) {
     log_.error("%s: %s does not interpolate inputs (canInterpolateInputs = false)", fn, def_.identifier);
     return Status::Error;
@@ -53,14 +53,14 @@ Status Instance::set_real_input_derivatives(const std::uint32_t vr[], std::size_
 }
 
 Status Instance::get_real_output_derivatives(const char* function) {
-  if (!allowed(kMaskOutputDerivatives, function)) return Status::Error;
+  if (!allowed(Call::OutputDerivatives, function)) return Status::Error;
   log_.error("%s: not provided (maxOutputDerivativeOrder = 0)", function);
   return Status::Error;
 }
 
 Status Instance::do_step(double t, double h, bool* terminate, double* last_successful) {
   const char* fn = PKM_FN(DoStep);
-  if (!allowed(kMaskDoStep, fn) || !require(Interface::CoSimulation, fn)) return Status::Error;
+  if (!allowed(Call::DoStep, fn)) return Status::Error;
   if (log_.enabled(LogCategory::Calls)) log_.call("%s(%.17g, %.17g)", fn, t, h);
   if (!std::isfinite(h) || !(h > 0.0)) {
     log_.error("%s: communicationStepSize = %g must be positive and finite; the call has no effect", fn, h);
@@ -137,7 +137,7 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
 
 Status Instance::last_successful_time(double* t) {
   const char* fn = "fmi2GetRealStatus";
-  if (!allowed(kMaskStatus, fn)) return Status::Error;
+  if (!allowed(Call::StepStatus, fn)) return Status::Error;
   if (!t) {
     log_.error("%s: value is NULL", fn);
     return Status::Error;
@@ -148,7 +148,7 @@ Status Instance::last_successful_time(double* t) {
 
 Status Instance::terminated(bool* t) {
   const char* fn = "fmi2GetBooleanStatus";
-  if (!allowed(kMaskStatus, fn)) return Status::Error;
+  if (!allowed(Call::StepStatus, fn)) return Status::Error;
   if (!t) {
     log_.error("%s: value is NULL", fn);
     return Status::Error;
@@ -158,7 +158,7 @@ Status Instance::terminated(bool* t) {
 }
 
 Status Instance::not_pending(const char* function) {
-  if (!allowed(kMaskStatus, function)) return Status::Error;
+  if (!allowed(Call::StepStatus, function)) return Status::Error;
   return Status::Discard;  // fmi2DoStep is synchronous: no status of a pending step
 }
 
