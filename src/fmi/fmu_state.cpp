@@ -107,6 +107,7 @@ void Instance::save(std::vector<unsigned char>& out) const {
 void Instance::reserve_state_buffers() {
   load_values_.reserve(stored_count(def_));
   save(load_backup_);  // an initialised model's state has its final size
+  if (version_ == 3 && interface_ == Interface::CoSimulation) step_start_.reserve(load_backup_.size());
 }
 
 bool Instance::check_header(const unsigned char* bytes, std::size_t size, const char* function) {
@@ -250,6 +251,7 @@ bool Instance::load(const unsigned char* bytes, std::size_t size, const char* fu
   time_ = time;
   last_successful_time_ = last_time;
   elapsed_ = elapsed;
+  time_floor_ = time;  // ME: a restored state starts its own history
   valid_groups_ = 0;
   Context ctx = context();
   // The model replaces what it derived (its solver restarts); it may keep

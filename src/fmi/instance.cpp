@@ -201,7 +201,7 @@ Status Instance::exit_initialization_mode() {
   if (succeeded(s)) {
     reserve_state_buffers();
     mode_ = interface_ == Interface::CoSimulation ? kStepMode : kEventMode;
-    time_ = last_successful_time_ = start_time_;
+    time_ = last_successful_time_ = time_floor_ = start_time_;
     elapsed_ = 0.0;
     terminated_ = false;
     log_.event("%s: initialised at t = %.17g, now in %s", fn, start_time_, mode_name(mode_));
@@ -228,7 +228,7 @@ Status Instance::reset() {
   data_->reset();
   input_derivatives_set_ = false;
   mode_ = kInstantiated;
-  start_time_ = stop_time_ = time_ = last_successful_time_ = elapsed_ = 0.0;
+  start_time_ = stop_time_ = time_ = last_successful_time_ = elapsed_ = time_floor_ = 0.0;
   stop_time_defined_ = false;
   terminated_ = false;
   valid_groups_ = 0;

@@ -230,6 +230,7 @@ class Instance {
   // to 0.12 us: 7e-5 s lost over 1 s when the model integrated t + h - t).
   double elapsed_ = 0.0;
   double last_successful_time_ = 0.0;   // CS
+  double time_floor_ = 0.0;  // ME: the earliest time SetTime may go to (startTime, the last EnterEventMode)
   bool terminated_ = false;             // CS: set after a discarded step
   unsigned valid_groups_ = 0;           // output groups (Variable::group) up to date
   bool input_derivatives_set_ = false;  // SetRealInputDerivatives was used (or a state restored)
@@ -245,6 +246,7 @@ class Instance {
   // load()'s buffers (reserve_state_buffers).
   std::vector<double> load_values_;
   std::vector<unsigned char> load_backup_;
+  std::vector<unsigned char> step_start_;  // FMI 3.0 DoStep: the state at the call, restored on Discard
 
  public:
   /// Forgets a state freed through any instance (FreeFMUState).

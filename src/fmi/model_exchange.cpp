@@ -1,5 +1,6 @@
 // Model Exchange: the importer integrates the continuous states; the model
 // gives their derivatives and its event indicators.
+#include <algorithm>
 #include <cmath>
 
 #include "fmi/instance.hpp"
@@ -11,6 +12,7 @@ Status Instance::enter_event_mode() {
   const char* fn = PKM_FN(EnterEventMode);
   if (!allowed(Call::EnterEventMode, fn)) return Status::Error;
   mode_ = kEventMode;
+  time_floor_ = std::max(time_floor_, time_);  // no going back past an event
   log_.event("%s at t = %.17g", fn, time_);
   return Status::OK;
 }
@@ -54,6 +56,22 @@ Status Instance::set_time(double t) {
   if (!allowed(Call::SetTime, fn)) return Status::Error;
   if (!std::isfinite(t)) {
     log_.error("%s: time = %g is not finite; the call has no effect", fn, t);
+    return Status::Error;
+  }
+  // FMI 2.0.4 2.1.6 and FMI 3.0.2 2.3.2: computing past a defined stopTime is
+  // an error; FMI 3.0.2 3.2.1: time >= startTime and the time of the last
+  // EnterEventMode (FMI 2.0.4 3.2.2 alike: no going back past an event). The
+  // third bound, the second last CompletedIntegratorStep, is not enforced:
+  // importers locating roots (fmpy with CVODE) go back over several of them
+  // within one internal step, and nothing in this model depends on it.
+  if (stop_time_defined_ && t > stop_time_ + 1e-9 * std::max(1.0, std::abs(stop_time_))) {
+    log_.error("%s: time = %.17g lies past stopTime = %.17g; the call has no effect", fn, t, stop_time_);
+    return Status::Error;
+  }
+  if (t < time_floor_) {
+    log_.error("%s: time = %.17g lies before %.17g (%s); the call has no effect", fn, t, time_floor_,
+               time_floor_ == start_time_ ? "startTime"
+                                          : "the last event: the FMU cannot go back past it");
     return Status::Error;
   }
   time_ = t;

@@ -105,6 +105,10 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
   }
   Context ctx = context();
   if (data_->check_step(ctx, h) != Status::OK) return Status::Error;
+  // FMI 3.0.2 4.2.3: a Discard leaves the FMU in the state before the call.
+  // The model keeps only its last good point (RK4: the last whole step), so
+  // the state at the call is kept here (a buffer sized at initialisation).
+  if (version_ == 3) save(step_start_);
   // The model integrates from elapsed_ by h; the reported time follows the
   // master's t + h.
   double reached = elapsed_;
@@ -117,6 +121,20 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
       time_ = last_successful_time_ = t + h;
       break;
     case Status::Discard:
+      if (version_ == 3) {
+        // Back to the state at the call, still in Step Mode: the importer may
+        // retry with other inputs or a shorter step.
+        if (!load(step_start_.data(), step_start_.size(), fn, false)) {
+          mode_ = kError;
+          return Status::Error;
+        }
+        log_.discard("%s: the step from t = %.17g was discarded; the FMU is back in the state at the call (t = "
+                     "%.17g), still in Step Mode: retry with other inputs or a shorter step",
+                     fn, t, time_);
+        break;
+      }
+      // FMI 2.0.4 4.2.3: fmi2DoStep returned fmi2Discard: StepFailed, the
+      // state at fmi2LastSuccessfulTime, fmi2Terminated = true.
       time_ = last_successful_time_ = t + (reached - elapsed_);  // t itself when nothing was reached
       elapsed_ = reached;
       terminated_ = true;
