@@ -152,8 +152,8 @@ constexpr Variable kVariables[] = {
   real_parameter(141, "rk4_step", kDefaultSolver.rk4_step, "s",
                  "RK4 step: a communication step is split into whole steps no longer than this", PLANT_SCALAR(rk4_step), 0,
                  pkm::kMinRk4Step, pkm::kMaxRk4Step),
-  real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance", PLANT_SCALAR(rtol), 0, 0.0, 1.0),
-  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)", PLANT_SCALAR(atol), 0, 0.0, 1.0),
+  real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance", PLANT_SCALAR(rtol), 0, pkm::kMinRtol, pkm::kMaxRtol),
+  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)", PLANT_SCALAR(atol), 0, pkm::kMinAtol, pkm::kMaxAtol),
   integer_parameter(144, "cvode_method", static_cast<int>(kDefaultSolver.cvode_method),
                     "CVODE method: 0 = Adams-Moulton (non-stiff), 1 = BDF", PLANT_SCALAR(cvode_method), 0, 1),
   integer_parameter(145, "formulation", static_cast<int>(kDefaultSolver.formulation),
@@ -191,8 +191,9 @@ const ModelDefinition kDefinition{
     "so results depend only on the state and inputs at the step start) or by fixed-step RK4. With FMI 2.0 the "
     "inputs can be interpolated linearly within a step (fmi2SetRealInputDerivatives, order 1). A step that cannot "
     "be completed, or that ends near a leg singularity (min_leg_measure) or a parallel singularity "
-    "(max_jacobian_condition), returns Discard with the last good state kept at the last successful time and "
-    "terminated = true. <b>Model Exchange:</b> the continuous states are x, y, z, phi, dx, dy, dz, dphi; the legs "
+    "(max_jacobian_condition), returns Discard: with FMI 2.0 the last good state is kept at the last successful time "
+    "and terminated = true; with FMI 3.0 the FMU is back in the state at the call, still in Step Mode, and the "
+    "step may be retried. <b>Model Exchange:</b> the continuous states are x, y, z, phi, dx, dy, dz, dphi; the legs "
     "are reconstructed from them in closed form, so the loop closures hold exactly whatever the importer's "
     "integrator does. The five event indicators are the singularity guards (1/cond - 1/max_jacobian_condition, "
     "and |cos theta2 sin theta2| - min_leg_measure per leg); crossing one ends the simulation with a logged "
