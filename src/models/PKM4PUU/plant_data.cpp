@@ -187,6 +187,12 @@ bool PlantData::inputs_continue() const {
 }
 
 Status PlantData::check_step(Context& ctx, double h) const {
+  if (plant && plant->solver().solver == pkm::Solver::Cvode && h < pkm::kMinCvodeSpan) {
+    ctx.log.error("DoStep: a communication step of %.17g s is shorter than CVODE can start with (%.6g s, "
+                  "sqrt(DBL_MIN)); the call has no effect",
+                  h, pkm::kMinCvodeSpan);
+    return Status::Error;
+  }
   if (!plant || plant->solver().solver != pkm::Solver::Rk4) return Status::OK;
   const double step = plant->solver().rk4_step;
   const double steps = pkm::rk4_steps_for(h, step);
