@@ -16,6 +16,12 @@ import pytest
 from pkm4puu import locate
 
 REPO = Path(__file__).resolve().parents[1]
+
+
+def pytest_configure(config):
+    # An exception inside an importer's callback (fmpy's CVode right-hand
+    # side calling the FMU) is swallowed by ctypes: make it fail the test.
+    config.addinivalue_line("filterwarnings", "error::pytest.PytestUnraisableExceptionWarning")
 os.environ[locate.BUILD_ENV] = str(Path(os.environ.get(locate.BUILD_ENV) or REPO / "build").resolve())
 BUILD = locate.build_dir()
 # The C API's header, whose structs capi's binding must match.

@@ -28,7 +28,7 @@ bool depends_on(const ModelDefinition& def, const Variable& unknown, const Varia
 Status Instance::partial_derivative(const char* fn, bool adjoint, const std::uint32_t unknowns[], std::size_t nu,
                                     const std::uint32_t knowns[], std::size_t nk, const double seed[],
                                     std::size_t n_seed, double sensitivity[], std::size_t n_sensitivity) {
-  if (!allowed(kMaskGet, fn)) return Status::Error;
+  if (!allowed(Call::PartialDerivative, fn)) return Status::Error;
   if (!def_.provides_derivatives)
     return not_supported(fn, version_ == 2 ? "providesDirectionalDerivative = false"
                                            : "providesDirectionalDerivatives = false");

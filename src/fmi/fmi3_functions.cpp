@@ -56,7 +56,7 @@ Instance* instantiate(const char* fn, Interface interface, fmi3String name, fmi3
                       fmi3InstanceEnvironment env, fmi3LogMessageCallback log_message, bool event_mode_used) {
   try {
     pkm_fmi::Logger log(log_message ? &emit : nullptr, reinterpret_cast<void*>(log_message), env,
-                        name ? name : "", logging_on);
+                        name ? name : "", logging_on, /*categories_only=*/true);
     if (!name) {
       log.error("%s: instanceName is NULL", fn);
       return nullptr;
@@ -70,7 +70,7 @@ Instance* instantiate(const char* fn, Interface interface, fmi3String name, fmi3
   } catch (...) {
     // Out of memory (nothing else throws here): said through the callback
     // directly, the Logger may be what could not be built.
-    if (log_message) {
+    if (log_message && logging_on) {  // FMI 3.0: no message while logging is off
       char message[160];
       std::snprintf(message, sizeof message, "%s: out of memory; no instance created", fn);
       log_message(env, fmi3Error, "logStatusError", message);
@@ -136,7 +136,7 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3Stri
   (void)instantiationToken, (void)resourcePath, (void)visible, (void)clockUpdate, (void)lockPreemption,
       (void)unlockPreemption;
   pkm_fmi::Logger log(logMessage ? &emit : nullptr, reinterpret_cast<void*>(logMessage), instanceEnvironment,
-                      instanceName ? instanceName : "", loggingOn);
+                      instanceName ? instanceName : "", loggingOn, /*categories_only=*/true);
   log.error("fmi3InstantiateScheduledExecution: this FMU offers Model Exchange and Co-Simulation only");
   return nullptr;
 }

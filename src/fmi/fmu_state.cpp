@@ -108,6 +108,7 @@ void Instance::save(std::vector<unsigned char>& out) const {
 void Instance::reserve_state_buffers() {
   load_values_.reserve(stored_count(def_));
   save(load_backup_);  // an initialised model's state has its final size
+  if (version_ == 3 && interface_ == Interface::CoSimulation) step_start_.reserve(load_backup_.size());
 }
 
 bool Instance::check_header(const unsigned char* bytes, std::size_t size, const char* function) {
@@ -251,6 +252,7 @@ bool Instance::load(const unsigned char* bytes, std::size_t size, const char* fu
   time_ = time;
   last_successful_time_ = last_time;
   elapsed_ = elapsed;
+  time_floor_ = time;  // ME: a restored state starts its own history
   valid_groups_ = 0;
   Context ctx = context();
   // The model replaces what it derived (its solver restarts); it may keep
@@ -265,7 +267,7 @@ bool Instance::load(const unsigned char* bytes, std::size_t size, const char* fu
 
 Status Instance::get_fmu_state(void** state) {
   const char* fn = PKM_FN2(fmi2GetFMUstate, fmi3GetFMUState);
-  if (!allowed(kMaskFmuState, fn)) return Status::Error;
+  if (!allowed(Call::FmuState, fn)) return Status::Error;
   if (!state) {
     log_.error("%s: FMUState is NULL", fn);
     return Status::Error;
@@ -289,7 +291,7 @@ Status Instance::get_fmu_state(void** state) {
 }
 
 SavedState* Instance::state_argument(const char* fn, void* state, const void* out, const char* out_name) {
-  if (!allowed(kMaskFmuState, fn)) return nullptr;
+  if (!allowed(Call::FmuState, fn)) return nullptr;
   SavedState* s = as_state(state);
   if (!s || (out_name && !out)) {
     if (out_name && !out) log_.error("%s: %s is NULL", fn, out_name);
@@ -310,7 +312,7 @@ Status Instance::set_fmu_state(void* state) {
 
 Status Instance::free_fmu_state(void** state) {
   const char* fn = PKM_FN2(fmi2FreeFMUstate, fmi3FreeFMUState);
-  if (!allowed(kMaskFmuState, fn)) return Status::Error;
+  if (!allowed(Call::FmuState, fn)) return Status::Error;
   if (!state || !*state) return Status::OK;
   SavedState* s = as_state(*state);
   if (!s) {
@@ -346,7 +348,7 @@ Status Instance::serialize_fmu_state(void* state, unsigned char bytes[], std::si
 
 Status Instance::deserialize_fmu_state(const unsigned char bytes[], std::size_t size, void** state) {
   const char* fn = PKM_FN2(fmi2DeSerializeFMUstate, fmi3DeserializeFMUState);
-  if (!allowed(kMaskFmuState, fn)) return Status::Error;
+  if (!allowed(Call::FmuState, fn)) return Status::Error;
   if (!state) {
     log_.error("%s: FMUState is NULL", fn);
     return Status::Error;

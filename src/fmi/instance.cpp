@@ -101,22 +101,24 @@ Status Instance::concurrent_call(const char* function) {
 }
 
 Status Instance::not_supported(const char* function, const char* why) {
-  if (!allowed(kAlive, function)) return Status::Error;
+  if (!allowed(Call::NotProvided, function)) return Status::Error;
   log_.error("%s: not supported by %s: %s; the call has no effect", function, def_.identifier, why);
   return Status::Error;
 }
 
-bool Instance::allowed(std::uint32_t mask, const char* function) {
-  if (mode_ & mask) return true;
+bool Instance::allowed(Call call, const char* function) {
+  const CallRule& rule = call_rule(call);
+  const unsigned mine = interface_ == Interface::ModelExchange ? kForME : kForCS;
+  if (!(rule.interfaces & mine)) {
+    log_.error("%s: a %s function, not allowed on this instance, instantiated for %s; the call has no effect",
+               function, interface_name(interface_ == Interface::ModelExchange ? Interface::CoSimulation
+                                                                               : Interface::ModelExchange),
+               interface_name(interface_));
+    return false;
+  }
+  if (mode_ & allowed_states(call, version_)) return true;
   log_.error("%s: not allowed in state %s (illegal call sequence); the call has no effect", function,
              mode_name(mode_));
-  return false;
-}
-
-bool Instance::require(Interface i, const char* function) {
-  if (interface_ == i) return true;
-  log_.error("%s: a %s function, but this instance was instantiated for %s; the call has no effect", function,
-             interface_name(i), interface_name(interface_));
   return false;
 }
 
@@ -130,7 +132,7 @@ void Instance::apply_start_values() {
 
 Status Instance::set_debug_logging(bool on, std::size_t n, const char* const categories[]) {
   const char* fn = PKM_FN(SetDebugLogging);
-  if (!allowed(kMaskSetDebugLogging, fn)) return Status::Error;
+  if (!allowed(Call::SetDebugLogging, fn)) return Status::Error;
   if (n == 0) {
     log_.set_default(on);
     return Status::OK;
@@ -158,7 +160,7 @@ Status Instance::set_debug_logging(bool on, std::size_t n, const char* const cat
 Status Instance::setup_experiment(bool tolerance_defined, double tolerance, double start_time,
                                   bool stop_time_defined, double stop_time) {
   const char* fn = version_ == 2 ? "fmi2SetupExperiment" : "fmi3EnterInitializationMode";
-  if (!allowed(kMaskSetupExperiment, fn)) return Status::Error;
+  if (!allowed(Call::SetupExperiment, fn)) return Status::Error;
   log_.call("%s(toleranceDefined = %d, tolerance = %g, startTime = %.17g, stopTimeDefined = %d, stopTime = %.17g)",
             fn, tolerance_defined, tolerance, start_time, stop_time_defined, stop_time);
   if (!std::isfinite(start_time)) {
@@ -181,7 +183,7 @@ Status Instance::setup_experiment(bool tolerance_defined, double tolerance, doub
 
 Status Instance::enter_initialization_mode() {
   const char* fn = PKM_FN(EnterInitializationMode);
-  if (!allowed(kMaskEnterInitialization, fn)) return Status::Error;
+  if (!allowed(Call::EnterInitializationMode, fn)) return Status::Error;
   mode_ = kInitializationMode;
   time_ = last_successful_time_ = start_time_;
   elapsed_ = 0.0;
@@ -193,14 +195,14 @@ Status Instance::enter_initialization_mode() {
 
 Status Instance::exit_initialization_mode() {
   const char* fn = PKM_FN(ExitInitializationMode);
-  if (!allowed(kMaskExitInitialization, fn)) return Status::Error;
+  if (!allowed(Call::ExitInitializationMode, fn)) return Status::Error;
   Context ctx = context();
   const Status s = data_->exit_initialization(ctx);
   valid_groups_ = 0;
   if (succeeded(s)) {
     reserve_state_buffers();
     mode_ = interface_ == Interface::CoSimulation ? kStepMode : kEventMode;
-    time_ = last_successful_time_ = start_time_;
+    time_ = last_successful_time_ = time_floor_ = start_time_;
     elapsed_ = 0.0;
     terminated_ = false;
     log_.event("%s: initialised at t = %.17g, now in %s", fn, start_time_, mode_name(mode_));
@@ -214,7 +216,7 @@ Status Instance::exit_initialization_mode() {
 
 Status Instance::terminate() {
   const char* fn = PKM_FN(Terminate);
-  if (!allowed(kMaskTerminate, fn)) return Status::Error;
+  if (!allowed(Call::Terminate, fn)) return Status::Error;
   mode_ = kTerminated;
   log_.event("%s at t = %.17g", fn, time_);
   return Status::OK;
@@ -222,12 +224,12 @@ Status Instance::terminate() {
 
 Status Instance::reset() {
   const char* fn = PKM_FN(Reset);
-  if (!allowed(kMaskReset, fn)) return Status::Error;
+  if (!allowed(Call::Reset, fn)) return Status::Error;
   apply_start_values();
   data_->reset();
   input_derivatives_set_ = false;
   mode_ = kInstantiated;
-  start_time_ = stop_time_ = time_ = last_successful_time_ = elapsed_ = 0.0;
+  start_time_ = stop_time_ = time_ = last_successful_time_ = elapsed_ = time_floor_ = 0.0;
   stop_time_defined_ = false;
   terminated_ = false;
   valid_groups_ = 0;

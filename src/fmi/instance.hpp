@@ -59,6 +59,7 @@ enum Mode : std::uint32_t {
 const char* mode_name(std::uint32_t mode);
 
 struct SavedState;  // fmu_state.cpp
+enum class Call : unsigned;  // state_machine.hpp
 
 class Instance {
  public:
@@ -175,12 +176,13 @@ class Instance {
  private:
   Instance(const ModelDefinition& def, int fmi_version, Interface interface, Logger log);
 
-  bool allowed(std::uint32_t mask, const char* function);
-  bool require(Interface i, const char* function);
-  /// allowed() and require(ModelExchange) for a Model Exchange array get or
-  /// set, then its length (given, of what) against this FMU's and the array
-  /// not NULL; false (logged) refuses the call.
-  bool array_call_allowed(std::uint32_t mask, const char* fn, const char* what, std::size_t given,
+  /// The call's row of the state table (state_machine.hpp) for this
+  /// instance's FMI version and interface; false (logged) refuses the call.
+  bool allowed(Call call, const char* function);
+  /// allowed() for a Model Exchange array get or set, then its length
+  /// (given, of what) against this FMU's and the array not NULL; false
+  /// (logged) refuses the call.
+  bool array_call_allowed(Call call, const char* fn, const char* what, std::size_t given,
                           std::size_t expected, const void* array);
   Context context() {
     return Context{log_, interface_, mode_ == kInitializationMode, start_time_};
@@ -195,7 +197,7 @@ class Instance {
   const Variable* lookup(const char* function, VarType type, std::uint32_t vr);
 
   SavedState* new_state();
-  /// allowed(kMaskFmuState) and the FMU state argument: the saved state,
+  /// allowed(Call::FmuState) and the FMU state argument: the saved state,
   /// or NULL (logged) to refuse the call, also when the call's output out,
   /// named out_name, is NULL (out_name NULL: the call has no output).
   SavedState* state_argument(const char* fn, void* state, const void* out = nullptr,
@@ -229,6 +231,7 @@ class Instance {
   // to 0.12 us: 7e-5 s lost over 1 s when the model integrated t + h - t).
   double elapsed_ = 0.0;
   double last_successful_time_ = 0.0;   // CS
+  double time_floor_ = 0.0;  // ME: the earliest time SetTime may go to (startTime, the last EnterEventMode)
   bool terminated_ = false;             // CS: set after a discarded step
   unsigned valid_groups_ = 0;           // output groups (Variable::group) up to date
   bool input_derivatives_set_ = false;  // SetRealInputDerivatives was used (or a state restored)
@@ -244,6 +247,7 @@ class Instance {
   // load()'s buffers (reserve_state_buffers).
   std::vector<double> load_values_;
   std::vector<unsigned char> load_backup_;
+  std::vector<unsigned char> step_start_;  // FMI 3.0 DoStep: the state at the call, restored on Discard
 
  public:
   /// Forgets a state freed through any instance (FreeFMUState).

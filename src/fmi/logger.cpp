@@ -14,13 +14,16 @@ int log_category(const char* name) {
   return -1;
 }
 
-Logger::Logger(LogEmitter emit, void* callback, void* env, std::string instance_name, bool logging_on)
-    : emit_(emit), callback_(emit ? callback : nullptr), env_(env), name_(std::move(instance_name)) {
+Logger::Logger(LogEmitter emit, void* callback, void* env, std::string instance_name, bool logging_on,
+               bool categories_only)
+    : emit_(emit), callback_(emit ? callback : nullptr), env_(env), name_(std::move(instance_name)),
+      categories_only_(categories_only) {
   set_default(logging_on);
 }
 
 void Logger::set_default(bool logging_on) {
   for (bool& b : on_) b = false;
+  if (categories_only_ && !logging_on) return;  // FMI 3.0: logging off, nothing at all
   for (LogCategory c : {LogCategory::StatusWarning, LogCategory::StatusDiscard, LogCategory::StatusError,
                         LogCategory::StatusFatal})
     on_[static_cast<unsigned>(c)] = true;
@@ -33,6 +36,12 @@ void Logger::select(const bool (&named)[kLogCategoryCount], bool on) {
 }
 
 void Logger::vlog(Status status, LogCategory c, const char* fmt, va_list args) {
+  if (c == LogCategory::StatusError || c == LogCategory::StatusFatal) {
+    va_list copy;
+    va_copy(copy, args);
+    if (std::vsnprintf(last_error_, sizeof last_error_, fmt, copy) < 0) last_error_[0] = '\0';
+    va_end(copy);
+  }
   if (!enabled(c)) return;
   // On the stack when it fits (every message of this FMU does): logging an
   // event inside a step allocates nothing.

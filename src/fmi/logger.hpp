@@ -20,9 +20,12 @@
 //     others off ("only debug messages according to the categories");
 //   - SetDebugLogging(false, categories): the named categories off, the
 //     others keep their setting.
-// logCalls is on only when named. Whatever the setting, the reason of an
-// Error or a Fatal reaches the importer: switching debug logging off does not
-// hide why an instance became unusable.
+// logCalls is on only when named. FMI 2.0: whatever the setting, the reason
+// of an Error or a Fatal reaches the importer: switching debug logging off
+// does not hide why an instance became unusable. FMI 3.0 (categories_only):
+// logMessage "must only be called for log categories that were enabled"
+// (3.0.2 2.3.1), so logging off means no message at all; the reason of the
+// last Error or Fatal is kept as the last-error text whatever the setting.
 #pragma once
 
 #include <cstdarg>
@@ -62,11 +65,15 @@ using LogEmitter = void (*)(void* callback, void* env, const char* instance, Sta
 class Logger {
  public:
   Logger() = default;
-  Logger(LogEmitter emit, void* callback, void* env, std::string instance_name, bool logging_on);
+  Logger(LogEmitter emit, void* callback, void* env, std::string instance_name, bool logging_on,
+         bool categories_only = false);
 
   bool enabled(LogCategory c) const {
-    return callback_ && (on_[static_cast<unsigned>(c)] || c == LogCategory::StatusError || c == LogCategory::StatusFatal);
+    return callback_ && (on_[static_cast<unsigned>(c)] ||
+                         (!categories_only_ && (c == LogCategory::StatusError || c == LogCategory::StatusFatal)));
   }
+  /// The last Error or Fatal message, logged or not ("" if none).
+  const char* last_error() const { return last_error_; }
   /// The default set of categories for logging on or off (see above).
   void set_default(bool logging_on);
   /// Categories named in SetDebugLogging (see above): on = true selects
@@ -89,6 +96,8 @@ class Logger {
   void* env_ = nullptr;
   std::string name_;
   bool on_[kLogCategoryCount] = {};
+  bool categories_only_ = false;
+  char last_error_[1024] = {};
 };
 
 }  // namespace pkm_fmi

@@ -61,7 +61,8 @@ class ModelData {
   /// bit for bit alike.
   virtual void state_saved() {}
   /// Before do_step, nothing changed yet: Error (reason logged) if a step of
-  /// h would exceed the model's work budget. The instance stays usable.
+  /// h would exceed the model's work budget or is too short for its
+  /// integrator to start. The instance stays usable.
   virtual Status check_step(Context& ctx, double h) const { (void)ctx, (void)h; return Status::OK; }
 
   // ---- Model Exchange (models without states keep the defaults)

@@ -151,9 +151,7 @@ std::string type_attributes(const ModelDefinition& d, const Variable& v, int ver
   return a;
 }
 
-std::string unknown_dependencies(const ModelDefinition& d, const Variable& v, int version,
-                                 const std::map<std::uint32_t, int>& index) {
-  const Dependencies deps = dependencies_of(d, v);
+std::string dependencies_attributes(const Dependencies& deps, int version, const std::map<std::uint32_t, int>& index) {
   std::string list, kinds;
   for (std::size_t k = 0; k < deps.knowns.size(); ++k) {
     if (k) {
@@ -166,6 +164,16 @@ std::string unknown_dependencies(const ModelDefinition& d, const Variable& v, in
   std::string a = " dependencies=\"" + list + "\"";
   if (!deps.knowns.empty()) a += " dependenciesKind=\"" + kinds + "\"";
   return a;
+}
+
+std::string unknown_dependencies(const ModelDefinition& d, const Variable& v, int version,
+                                 const std::map<std::uint32_t, int>& index) {
+  return dependencies_attributes(dependencies_of(d, v), version, index);
+}
+
+std::string initial_dependencies(const ModelDefinition& d, const Variable& v, int version,
+                                 const std::map<std::uint32_t, int>& index) {
+  return dependencies_attributes(initial_dependencies_of(d, v), version, index);
 }
 
 std::string fmi2(const ModelDefinition& d, const std::string& version) {
@@ -205,7 +213,7 @@ std::string fmi2(const ModelDefinition& d, const std::string& version) {
       derivatives += "      <Unknown index=\"" + idx + "\"" + unknown_dependencies(d, v, 2, index) + "/>\n";
     if ((v.causality == Causality::Output && v.initial != Initial::Exact) || v.state_of >= 0 ||
         (is_state(v) && v.initial != Initial::Exact) || v.causality == Causality::CalculatedParameter)
-      initial += "      <Unknown index=\"" + idx + "\"/>\n";
+      initial += "      <Unknown index=\"" + idx + "\"" + initial_dependencies(d, v, 2, index) + "/>\n";
   }
   if (!outputs.empty()) x += "    <Outputs>\n" + outputs + "    </Outputs>\n";
   if (!derivatives.empty()) x += "    <Derivatives>\n" + derivatives + "    </Derivatives>\n";
@@ -254,7 +262,8 @@ std::string fmi3(const ModelDefinition& d, const std::string& version) {
     const Variable& v = d.variables[i];
     if ((v.causality == Causality::Output && v.initial != Initial::Exact) || v.state_of >= 0 ||
         v.causality == Causality::CalculatedParameter)
-      x += "    <InitialUnknown valueReference=\"" + std::to_string(v.vr) + "\"/>\n";
+      x += "    <InitialUnknown valueReference=\"" + std::to_string(v.vr) + "\"" + initial_dependencies(d, v, 3, none) +
+           "/>\n";
   }
   for (std::size_t i = 0; i < d.n_variables; ++i) {
     const Variable& v = d.variables[i];
@@ -307,6 +316,34 @@ Dependencies dependencies_of(const ModelDefinition& d, const Variable& v) {
     deps.knowns.assign(1, state_variable(d, v.state_of + half)->vr);
     deps.constant = true;
   }
+  return deps;
+}
+
+Dependencies initial_dependencies_of(const ModelDefinition& d, const Variable& v) {
+  auto initial_value = [&](int state) -> const Variable* {
+    for (std::size_t i = 0; i < d.n_variables; ++i)
+      if (d.variables[i].initial_of == state && state >= 0) return &d.variables[i];
+    return nullptr;
+  };
+  Dependencies deps;
+  if (v.state >= 0) {
+    if (const Variable* p = initial_value(v.state)) deps.knowns.push_back(p->vr);
+    return deps;
+  }
+  std::set<std::uint32_t> knowns;
+  for (std::uint32_t r : dependencies_of(d, v).knowns) {
+    const Variable* k = d.find(r);
+    if (k->state < 0) {
+      knowns.insert(r);  // an input
+    } else if (const Variable* p = initial_value(k->state)) {
+      knowns.insert(p->vr);
+    }
+  }
+  for (std::size_t i = 0; i < d.n_variables; ++i) {
+    const Variable& p = d.variables[i];
+    if (p.causality == Causality::Parameter && p.initial_of < 0) knowns.insert(p.vr);
+  }
+  deps.knowns.assign(knowns.begin(), knowns.end());
   return deps;
 }
 

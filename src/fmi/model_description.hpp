@@ -27,6 +27,13 @@ struct Dependencies {
   bool constant = false;
 };
 Dependencies dependencies_of(const ModelDefinition& def, const Variable& v);
+/// What an InitialUnknown depends on in Initialization Mode (knowns: inputs
+/// and parameters): a state its initial-value parameter (energy integrals,
+/// which start at 0, nothing); any other the inputs it depends on, the
+/// initial values of the states it depends on and every other parameter
+/// (those that do not change it are listed too: an InitialUnknown may list
+/// more than it depends on, never less).
+Dependencies initial_dependencies_of(const ModelDefinition& def, const Variable& v);
 
 /// The shortest decimal text that reads back as exactly x.
 std::string exact_text(double x);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // Model Exchange: the importer integrates the continuous states; the model
 // gives their derivatives and its event indicators.
+#include <algorithm>
 #include <cmath>
 
 #include "fmi/instance.hpp"
@@ -10,8 +11,9 @@ namespace pkm_fmi {
 
 Status Instance::enter_event_mode() {
   const char* fn = PKM_FN(EnterEventMode);
-  if (!allowed(kMaskEnterEventMode, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  if (!allowed(Call::EnterEventMode, fn)) return Status::Error;
   mode_ = kEventMode;
+  time_floor_ = std::max(time_floor_, time_);  // no going back past an event
   log_.event("%s at t = %.17g", fn, time_);
   return Status::OK;
 }
@@ -19,7 +21,7 @@ Status Instance::enter_event_mode() {
 Status Instance::event_update(bool* discrete_states_need_update, bool* terminate, bool* nominals_changed,
                               bool* values_changed, bool* next_event_time_defined, double* next_event_time) {
   const char* fn = PKM_FN2(fmi2NewDiscreteStates, fmi3UpdateDiscreteStates);
-  if (!allowed(kMaskEventUpdate, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  if (!allowed(Call::EventUpdate, fn)) return Status::Error;
   Context ctx = context();
   bool stop = false;
   const Status s = data_->event_update(ctx, stop);
@@ -37,14 +39,14 @@ Status Instance::event_update(bool* discrete_states_need_update, bool* terminate
 
 Status Instance::enter_continuous_time_mode() {
   const char* fn = PKM_FN(EnterContinuousTimeMode);
-  if (!allowed(kMaskEnterContinuousTime, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  if (!allowed(Call::EnterContinuousTimeMode, fn)) return Status::Error;
   mode_ = kContinuousTimeMode;
   return Status::OK;
 }
 
 Status Instance::completed_integrator_step(bool* enter_event_mode, bool* terminate) {
   const char* fn = PKM_FN(CompletedIntegratorStep);
-  if (!allowed(kMaskCompletedStep, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  if (!allowed(Call::CompletedIntegratorStep, fn)) return Status::Error;
   if (enter_event_mode) *enter_event_mode = false;  // no step events: the indicators locate every event
   if (terminate) *terminate = false;
   return Status::OK;
@@ -52,9 +54,25 @@ Status Instance::completed_integrator_step(bool* enter_event_mode, bool* termina
 
 Status Instance::set_time(double t) {
   const char* fn = PKM_FN(SetTime);
-  if (!allowed(kMaskSetTime, fn) || !require(Interface::ModelExchange, fn)) return Status::Error;
+  if (!allowed(Call::SetTime, fn)) return Status::Error;
   if (!std::isfinite(t)) {
     log_.error("%s: time = %g is not finite; the call has no effect", fn, t);
+    return Status::Error;
+  }
+  // FMI 2.0.4 2.1.6 and FMI 3.0.2 2.3.2: computing past a defined stopTime is
+  // an error; FMI 3.0.2 3.2.1: time >= startTime and the time of the last
+  // EnterEventMode (FMI 2.0.4 3.2.2 alike: no going back past an event). The
+  // third bound, the second last CompletedIntegratorStep, is not enforced:
+  // importers locating roots (fmpy with CVODE) go back over several of them
+  // within one internal step, and nothing in this model depends on it.
+  if (stop_time_defined_ && t > stop_time_ + 1e-9 * std::max(1.0, std::abs(stop_time_))) {
+    log_.error("%s: time = %.17g lies past stopTime = %.17g; the call has no effect", fn, t, stop_time_);
+    return Status::Error;
+  }
+  if (t < time_floor_) {
+    log_.error("%s: time = %.17g lies before %.17g (%s); the call has no effect", fn, t, time_floor_,
+               time_floor_ == start_time_ ? "startTime"
+                                          : "the last event: the FMU cannot go back past it");
     return Status::Error;
   }
   time_ = t;
@@ -63,9 +81,9 @@ Status Instance::set_time(double t) {
   return Status::OK;
 }
 
-bool Instance::array_call_allowed(std::uint32_t mask, const char* fn, const char* what, std::size_t given,
+bool Instance::array_call_allowed(Call call, const char* fn, const char* what, std::size_t given,
                                   std::size_t expected, const void* array) {
-  if (!allowed(mask, fn) || !require(Interface::ModelExchange, fn)) return false;
+  if (!allowed(call, fn)) return false;
   if (given != expected) {
     log_.error("%s: %llu %s given, this FMU has %llu; the call has no effect", fn,
                static_cast<unsigned long long>(given), what, static_cast<unsigned long long>(expected));
@@ -80,7 +98,7 @@ bool Instance::array_call_allowed(std::uint32_t mask, const char* fn, const char
 
 Status Instance::set_continuous_states(const double x[], std::size_t n) {
   const char* fn = PKM_FN(SetContinuousStates);
-  if (!array_call_allowed(kMaskSetStates, fn, "states", n, def_.n_states, x)) return Status::Error;
+  if (!array_call_allowed(Call::SetContinuousStates, fn, "states", n, def_.n_states, x)) return Status::Error;
   for (std::size_t k = 0; k < n; ++k) {
     if (!std::isfinite(x[k])) {
       log_.error("%s: state %llu = %g is not finite; the states are unchanged", fn, static_cast<unsigned long long>(k),
@@ -96,21 +114,21 @@ Status Instance::set_continuous_states(const double x[], std::size_t n) {
 
 Status Instance::get_continuous_states(double x[], std::size_t n) {
   const char* fn = PKM_FN(GetContinuousStates);
-  if (!array_call_allowed(kMaskGetStates, fn, "states", n, def_.n_states, x)) return Status::Error;
+  if (!array_call_allowed(Call::GetContinuousStates, fn, "states", n, def_.n_states, x)) return Status::Error;
   Context ctx = context();
   return data_->get_states(ctx, x);
 }
 
 Status Instance::get_derivatives(double dx[], std::size_t n) {
   const char* fn = PKM_FN2(fmi2GetDerivatives, fmi3GetContinuousStateDerivatives);
-  if (!array_call_allowed(kMaskGetStates, fn, "derivatives", n, def_.n_states, dx)) return Status::Error;
+  if (!array_call_allowed(Call::GetDerivatives, fn, "derivatives", n, def_.n_states, dx)) return Status::Error;
   Context ctx = context();
   return data_->get_derivatives(ctx, dx);
 }
 
 Status Instance::get_event_indicators(double z[], std::size_t n) {
   const char* fn = PKM_FN(GetEventIndicators);
-  if (!array_call_allowed(kMaskGetStates, fn, "event indicators", n, def_.n_event_indicators, z))
+  if (!array_call_allowed(Call::GetEventIndicators, fn, "event indicators", n, def_.n_event_indicators, z))
     return Status::Error;
   Context ctx = context();
   return data_->get_event_indicators(ctx, z);
@@ -118,14 +136,14 @@ Status Instance::get_event_indicators(double z[], std::size_t n) {
 
 Status Instance::get_nominals(double x[], std::size_t n) {
   const char* fn = PKM_FN2(fmi2GetNominalsOfContinuousStates, fmi3GetNominalsOfContinuousStates);
-  if (!array_call_allowed(kMaskGetStates | kInstantiated, fn, "nominals", n, def_.n_states, x)) return Status::Error;
+  if (!array_call_allowed(Call::GetNominals, fn, "nominals", n, def_.n_states, x)) return Status::Error;
   for (std::size_t k = 0; k < def_.n_variables; ++k)
     if (def_.variables[k].state >= 0) x[def_.variables[k].state] = def_.variables[k].nominal;
   return Status::OK;
 }
 
 Status Instance::get_number_of(const char* what, std::size_t count, std::size_t* n) {
-  if (!allowed(kAlive, what)) return Status::Error;
+  if (!allowed(Call::GetNumberOf, what)) return Status::Error;
   if (!n) {
     log_.error("%s: NULL argument", what);
     return Status::Error;

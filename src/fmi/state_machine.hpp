@@ -1,6 +1,12 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// Which states each FMI function may be called in (FMI 2.0 and 3.0 state
-// machines, merged: ME and CS states are distinct bits), in one place.
+// Which states each FMI function may be called in, for each FMI version, in
+// one table: the FMI 2.0.4 state tables (section 3.2.3 Model Exchange,
+// section 4.2.4 Co-Simulation) and the FMI 3.0.2 state machines (section 2.3
+// common states, section 3.2 Model Exchange, section 4.2 Co-Simulation),
+// read literally. ME and CS states are distinct bits; a row also says which
+// interfaces have the function. Instance::allowed() checks a call against
+// its row; tests/fmi/state_table.cpp calls every row's function in every
+// state and expects exactly what the row says.
 #pragma once
 
 #include "fmi/instance.hpp"
@@ -11,28 +17,140 @@ constexpr std::uint32_t kAlive = kInstantiated | kInitializationMode | kEventMod
                                  kStepFailed | kTerminated | kError;
 constexpr std::uint32_t kRunning = kEventMode | kContinuousTimeMode | kStepMode;
 
-constexpr std::uint32_t kMaskSetDebugLogging = kAlive;
-constexpr std::uint32_t kMaskSetupExperiment = kInstantiated;
-constexpr std::uint32_t kMaskEnterInitialization = kInstantiated;
-constexpr std::uint32_t kMaskExitInitialization = kInitializationMode;
-constexpr std::uint32_t kMaskTerminate = kRunning | kStepFailed;
-constexpr std::uint32_t kMaskReset = kAlive;
-constexpr std::uint32_t kMaskGet = kInitializationMode | kRunning | kStepFailed | kTerminated | kError;
-constexpr std::uint32_t kMaskSet = kInstantiated | kInitializationMode | kRunning;
-constexpr std::uint32_t kMaskFmuState = kAlive;
-// Co-Simulation.
-constexpr std::uint32_t kMaskInputDerivatives = kInstantiated | kInitializationMode | kStepMode;
-constexpr std::uint32_t kMaskOutputDerivatives = kStepMode | kStepFailed | kTerminated | kError;
-constexpr std::uint32_t kMaskDoStep = kStepMode;
-constexpr std::uint32_t kMaskStatus = kStepMode | kStepFailed | kTerminated;
-// Model Exchange.
-constexpr std::uint32_t kMaskEnterEventMode = kEventMode | kContinuousTimeMode;
-constexpr std::uint32_t kMaskEventUpdate = kEventMode;
-constexpr std::uint32_t kMaskEnterContinuousTime = kEventMode;
-constexpr std::uint32_t kMaskCompletedStep = kContinuousTimeMode;
-constexpr std::uint32_t kMaskSetTime = kEventMode | kContinuousTimeMode;
-constexpr std::uint32_t kMaskSetStates = kContinuousTimeMode;
-constexpr std::uint32_t kMaskGetStates = kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError;
+/// The interfaces a function belongs to (bits).
+constexpr unsigned kForME = 1u, kForCS = 2u, kForBoth = kForME | kForCS;
+
+/// The FMI calls that check the state machine (several C functions may share
+/// a row: every getter is Get).
+enum class Call : unsigned {
+  SetDebugLogging,
+  SetupExperiment,  // FMI 2.0 fmi2SetupExperiment; FMI 3.0 fmi3EnterInitializationMode's arguments
+  EnterInitializationMode,
+  ExitInitializationMode,
+  Terminate,
+  Reset,
+  Get,
+  Set,
+  FmuState,
+  PartialDerivative,
+  NotProvided,  // functions this FMU does not provide: Error with the reason, in any state
+  InputDerivatives,
+  OutputDerivatives,
+  DoStep,
+  StepStatus,
+  EnterEventMode,
+  EventUpdate,
+  EnterContinuousTimeMode,
+  CompletedIntegratorStep,
+  SetTime,
+  SetContinuousStates,
+  GetContinuousStates,
+  GetDerivatives,
+  GetEventIndicators,
+  GetNominals,
+  GetNumberOf,
+  Count
+};
+
+struct CallRule {
+  Call call;
+  const char* fmi2;     // the FMI 2.0 function (a representative one), nullptr if 2.0 has none
+  const char* fmi3;     // the FMI 3.0 function, nullptr if 3.0 has none
+  std::uint32_t v2;     // states allowed by FMI 2.0.4
+  std::uint32_t v3;     // states allowed by FMI 3.0.2
+  unsigned interfaces;  // kForME, kForCS
+  const char* clause;   // where the standards say so
+};
+
+// clang-format off
+inline constexpr CallRule kCallRules[] = {
+  {Call::SetDebugLogging, "fmi2SetDebugLogging", "fmi3SetDebugLogging", kAlive, kAlive, kForBoth,
+   "2.0.4 3.2.3/4.2.4: every state; 3.0.2 2.3.1: super state FMUStateSettable and after"},
+  {Call::SetupExperiment, "fmi2SetupExperiment", "fmi3EnterInitializationMode", kInstantiated, kInstantiated, kForBoth,
+   "2.0.4 3.2.3/4.2.4: instantiated; 3.0.2 2.3.2: Instantiated"},
+  {Call::EnterInitializationMode, "fmi2EnterInitializationMode", "fmi3EnterInitializationMode", kInstantiated,
+   kInstantiated, kForBoth, "2.0.4 3.2.3/4.2.4: instantiated; 3.0.2 2.3.2: Instantiated"},
+  {Call::ExitInitializationMode, "fmi2ExitInitializationMode", "fmi3ExitInitializationMode", kInitializationMode,
+   kInitializationMode, kForBoth, "2.0.4 3.2.3/4.2.4: Initialization Mode; 3.0.2 2.3.3: Initialization Mode"},
+  // FMI 3.0 has no StepFailed: a Discard leaves the FMU in Step Mode (3.0.2 4.2.3).
+  {Call::Terminate, "fmi2Terminate", "fmi3Terminate", kRunning | kStepFailed, kRunning, kForBoth,
+   "2.0.4 3.2.3: Continuous-Time/Event Mode, 4.2.4: stepComplete, stepFailed; 3.0.2 2.3.4: super state Initialized"},
+  {Call::Reset, "fmi2Reset", "fmi3Reset", kAlive, kAlive, kForBoth,
+   "2.0.4 3.2.3/4.2.4: every state but fatal; 3.0.2 2.3.1: super state FMUStateSettable"},
+  // FMI 3.0 reads start values in Instantiated (3.0.2 2.3.2, table "Get variable start values").
+  {Call::Get, "fmi2GetReal", "fmi3GetFloat64", kInitializationMode | kRunning | kStepFailed | kTerminated | kError,
+   kInstantiated | kInitializationMode | kRunning | kTerminated | kError, kForBoth,
+   "2.0.4 3.2.3/4.2.4: not in instantiated; 3.0.2 2.3.2: Instantiated (start values) and after"},
+  {Call::Set, "fmi2SetReal", "fmi3SetFloat64", kInstantiated | kInitializationMode | kRunning,
+   kInstantiated | kInitializationMode | kRunning, kForBoth,
+   "2.0.4 3.2.3/4.2.4: not after a failed step or termination; 3.0.2 2.3.2-2.3.5, 3.2.1, 4.2.1"},
+  {Call::FmuState, "fmi2GetFMUstate", "fmi3GetFMUState", kAlive, kAlive, kForBoth,
+   "2.0.4 3.2.3/4.2.4: every state but fatal; 3.0.2 2.3.1: super state FMUStateSettable"},
+  {Call::PartialDerivative, "fmi2GetDirectionalDerivative", "fmi3GetDirectionalDerivative",
+   kInitializationMode | kRunning | kStepFailed | kTerminated | kError, kInitializationMode | kRunning | kTerminated | kError,
+   kForBoth, "2.0.4 3.2.3/4.2.4: not in instantiated; 3.0.2 2.3.3-2.3.5, 4.2.1"},
+  {Call::NotProvided, "fmi2CancelStep", "fmi3EnterConfigurationMode", kAlive, kAlive, kForBoth,
+   "not provided by this FMU: Error with the reason in every state"},
+  {Call::InputDerivatives, "fmi2SetRealInputDerivatives", nullptr, kInstantiated | kInitializationMode | kStepMode, 0,
+   kForCS, "2.0.4 4.2.4: instantiated, Initialization Mode, stepComplete"},
+  {Call::OutputDerivatives, "fmi2GetRealOutputDerivatives", "fmi3GetOutputDerivatives",
+   kStepMode | kStepFailed | kTerminated | kError, kStepMode | kTerminated | kError, kForCS,
+   "2.0.4 4.2.4: stepComplete, stepFailed, terminated, error; 3.0.2 2.3.5 (Terminated), 4.2.1 (Step Mode)"},
+  {Call::DoStep, "fmi2DoStep", "fmi3DoStep", kStepMode, kStepMode, kForCS,
+   "2.0.4 4.2.4: stepComplete; 3.0.2 4.2.1: Step Mode"},
+  {Call::StepStatus, "fmi2GetStatus", nullptr, kStepMode | kStepFailed | kTerminated, 0, kForCS,
+   "2.0.4 4.2.4: stepComplete, stepFailed, terminated"},
+  {Call::EnterEventMode, "fmi2EnterEventMode", "fmi3EnterEventMode", kEventMode | kContinuousTimeMode,
+   kContinuousTimeMode, kForME, "2.0.4 3.2.3: Event and Continuous-Time Mode; 3.0.2 3.2.1: Continuous-Time Mode"},
+  {Call::EventUpdate, "fmi2NewDiscreteStates", "fmi3UpdateDiscreteStates", kEventMode, kEventMode, kForME,
+   "2.0.4 3.2.3: Event Mode; 3.0.2 2.3.4: Event Mode"},
+  {Call::EnterContinuousTimeMode, "fmi2EnterContinuousTimeMode", "fmi3EnterContinuousTimeMode", kEventMode,
+   kEventMode, kForME, "2.0.4 3.2.3: Event Mode; 3.0.2 2.3.4: Event Mode"},
+  {Call::CompletedIntegratorStep, "fmi2CompletedIntegratorStep", "fmi3CompletedIntegratorStep", kContinuousTimeMode,
+   kContinuousTimeMode, kForME, "2.0.4 3.2.3: Continuous-Time Mode; 3.0.2 3.2.1: Continuous-Time Mode"},
+  {Call::SetTime, "fmi2SetTime", "fmi3SetTime", kEventMode | kContinuousTimeMode, kContinuousTimeMode, kForME,
+   "2.0.4 3.2.3: Event and Continuous-Time Mode; 3.0.2 3.2.1: Continuous-Time Mode only"},
+  {Call::SetContinuousStates, "fmi2SetContinuousStates", "fmi3SetContinuousStates", kContinuousTimeMode,
+   kContinuousTimeMode, kForME, "2.0.4 3.2.3: Continuous-Time Mode; 3.0.2 3.2.1: Continuous-Time Mode"},
+  {Call::GetContinuousStates, "fmi2GetContinuousStates", "fmi3GetContinuousStates",
+   kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError,
+   kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError, kForME,
+   "2.0.4 3.2.3: not in instantiated; 3.0.2 2.3.3-2.3.5, 3.2.1"},
+  {Call::GetDerivatives, "fmi2GetDerivatives", "fmi3GetContinuousStateDerivatives",
+   kEventMode | kContinuousTimeMode | kTerminated | kError,
+   kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError, kForME,
+   "2.0.4 3.2.3: not in Initialization Mode; 3.0.2 2.3.3: also Initialization Mode"},
+  {Call::GetEventIndicators, "fmi2GetEventIndicators", "fmi3GetEventIndicators",
+   kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError,
+   kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError, kForME,
+   "2.0.4 3.2.3: not in instantiated; 3.0.2 2.3.3-2.3.5, 3.2.1"},
+  {Call::GetNominals, "fmi2GetNominalsOfContinuousStates", "fmi3GetNominalsOfContinuousStates",
+   kInstantiated | kEventMode | kContinuousTimeMode | kTerminated | kError,
+   kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError, kForME,
+   "2.0.4 3.2.3: instantiated, not Initialization Mode; 3.0.2 2.3.3 Initialization Mode, super state Initialized, "
+   "2.3.5 Terminated"},
+  {Call::GetNumberOf, nullptr, "fmi3GetNumberOfContinuousStates", 0, kAlive, kForME,
+   "3.0.2 2.3.2: \"can only be called in Model Exchange\""},
+};
+// clang-format on
+
+static_assert(sizeof kCallRules / sizeof kCallRules[0] == static_cast<unsigned>(Call::Count),
+              "one row per call");
+
+constexpr const CallRule& call_rule(Call c) { return kCallRules[static_cast<unsigned>(c)]; }
+
+constexpr bool rows_in_order() {
+  for (unsigned k = 0; k < static_cast<unsigned>(Call::Count); ++k)
+    if (static_cast<unsigned>(kCallRules[k].call) != k) return false;
+  return true;
+}
+static_assert(rows_in_order(), "kCallRules is indexed by Call");
+
+/// The states a call is allowed in, for an FMI version.
+constexpr std::uint32_t allowed_states(Call c, int fmi_version) {
+  return fmi_version == 2 ? call_rule(c).v2 : call_rule(c).v3;
+}
+
 // States an FMU state may carry (the others are unrecoverable).
 constexpr std::uint32_t kRestorableModes = kAlive;
 

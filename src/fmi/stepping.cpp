@@ -11,7 +11,7 @@ namespace pkm_fmi {
 Status Instance::set_real_input_derivatives(const std::uint32_t vr[], std::size_t n, const std::int32_t order[],
                                             const double value[]) {
   static const char* const fn = "fmi2SetRealInputDerivatives";
-  if (!allowed(kMaskInputDerivatives, fn) || !require(Interface::CoSimulation, fn)) return Status::Error;
+  if (!allowed(Call::InputDerivatives, fn)) return Status::Error;
   if (!def_.can_interpolate_inputs) {
     log_.error("%s: %s does not interpolate inputs (canInterpolateInputs = false)", fn, def_.identifier);
     return Status::Error;
@@ -54,14 +54,14 @@ Status Instance::set_real_input_derivatives(const std::uint32_t vr[], std::size_
 }
 
 Status Instance::get_real_output_derivatives(const char* function) {
-  if (!allowed(kMaskOutputDerivatives, function)) return Status::Error;
+  if (!allowed(Call::OutputDerivatives, function)) return Status::Error;
   log_.error("%s: not provided (maxOutputDerivativeOrder = 0)", function);
   return Status::Error;
 }
 
 Status Instance::do_step(double t, double h, bool* terminate, double* last_successful) {
   const char* fn = PKM_FN(DoStep);
-  if (!allowed(kMaskDoStep, fn) || !require(Interface::CoSimulation, fn)) return Status::Error;
+  if (!allowed(Call::DoStep, fn)) return Status::Error;
   if (log_.enabled(LogCategory::Calls)) log_.call("%s(%.17g, %.17g)", fn, t, h);
   if (!std::isfinite(h) || !(h > 0.0)) {
     log_.error("%s: communicationStepSize = %g must be positive and finite; the call has no effect", fn, h);
@@ -106,6 +106,10 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
   }
   Context ctx = context();
   if (data_->check_step(ctx, h) != Status::OK) return Status::Error;
+  // FMI 3.0.2 4.2.3: a Discard leaves the FMU in the state before the call.
+  // The model keeps only its last good point (RK4: the last whole step), so
+  // the state at the call is kept here (a buffer sized at initialisation).
+  if (version_ == 3) save(step_start_);
   // The model integrates from elapsed_ by h; the reported time follows the
   // master's t + h.
   double reached = elapsed_;
@@ -118,6 +122,20 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
       time_ = last_successful_time_ = t + h;
       break;
     case Status::Discard:
+      if (version_ == 3) {
+        // Back to the state at the call, still in Step Mode: the importer may
+        // retry with other inputs or a shorter step.
+        if (!load(step_start_.data(), step_start_.size(), fn, false)) {
+          mode_ = kError;
+          return Status::Error;
+        }
+        log_.discard("%s: the step from t = %.17g was discarded; the FMU is back in the state at the call (t = "
+                     "%.17g), still in Step Mode: retry with other inputs or a shorter step",
+                     fn, t, time_);
+        break;
+      }
+      // FMI 2.0.4 4.2.3: fmi2DoStep returned fmi2Discard: StepFailed, the
+      // state at fmi2LastSuccessfulTime, fmi2Terminated = true.
       time_ = last_successful_time_ = t + (reached - elapsed_);  // t itself when nothing was reached
       elapsed_ = reached;
       terminated_ = true;
@@ -138,7 +156,7 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
 
 Status Instance::last_successful_time(double* t) {
   const char* fn = "fmi2GetRealStatus";
-  if (!allowed(kMaskStatus, fn)) return Status::Error;
+  if (!allowed(Call::StepStatus, fn)) return Status::Error;
   if (!t) {
     log_.error("%s: value is NULL", fn);
     return Status::Error;
@@ -149,7 +167,7 @@ Status Instance::last_successful_time(double* t) {
 
 Status Instance::terminated(bool* t) {
   const char* fn = "fmi2GetBooleanStatus";
-  if (!allowed(kMaskStatus, fn)) return Status::Error;
+  if (!allowed(Call::StepStatus, fn)) return Status::Error;
   if (!t) {
     log_.error("%s: value is NULL", fn);
     return Status::Error;
@@ -159,7 +177,7 @@ Status Instance::terminated(bool* t) {
 }
 
 Status Instance::not_pending(const char* function) {
-  if (!allowed(kMaskStatus, function)) return Status::Error;
+  if (!allowed(Call::StepStatus, function)) return Status::Error;
   return Status::Discard;  // fmi2DoStep is synchronous: no status of a pending step
 }
 

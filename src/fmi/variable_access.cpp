@@ -34,7 +34,7 @@ Status Instance::ensure_outputs(const char* function, unsigned needed) {
 template <class T>
 Status Instance::get_values(const char* function, VarType type, const std::uint32_t vr[], std::size_t n,
                             T value[]) {
-  if (!allowed(kMaskGet, function)) return Status::Error;
+  if (!allowed(Call::Get, function)) return Status::Error;
   if (n == 0) return Status::OK;
   if (!vr || !value) {
     log_.error("%s: NULL value reference or value array", function);
@@ -44,6 +44,12 @@ Status Instance::get_values(const char* function, VarType type, const std::uint3
   for (std::size_t k = 0; k < n; ++k) {
     const Variable* v = lookup(function, type, vr[k]);
     if (!v) return Status::Error;
+    // Before initialisation only start values exist (FMI 3.0.2 2.3.2).
+    if (mode_ == kInstantiated && !v->has_start()) {
+      log_.error("%s: %s has no start value: it is computed from %s on; the call has no effect", function, v->name,
+                 PKM_FN(EnterInitializationMode));
+      return Status::Error;
+    }
     if (v->computed()) needed |= v->group;
   }
   Status s = Status::OK;
@@ -63,7 +69,7 @@ Status Instance::get_values(const char* function, VarType type, const std::uint3
 template <class T>
 Status Instance::set_values(const char* function, VarType type, const std::uint32_t vr[], std::size_t n,
                             const T value[]) {
-  if (!allowed(kMaskSet, function)) return Status::Error;
+  if (!allowed(Call::Set, function)) return Status::Error;
   if (n == 0) return Status::OK;
   if (!vr || !value) {
     log_.error("%s: NULL value reference or value array", function);
@@ -132,7 +138,7 @@ Status Instance::set_boolean(const std::uint32_t vr[], std::size_t n, const int 
 
 Status Instance::no_variables_of_type(const char* function, const char* type, const std::uint32_t vr[],
                                       std::size_t n, bool setter) {
-  if (!allowed(setter ? kMaskSet : kMaskGet, function)) return Status::Error;
+  if (!allowed(setter ? Call::Set : Call::Get, function)) return Status::Error;
   if (n == 0) return Status::OK;
   log_.error("%s: unknown value reference %u (this FMU has no %s variables)", function,
              vr ? static_cast<unsigned>(vr[0]) : 0u, type);

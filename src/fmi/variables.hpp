@@ -72,6 +72,9 @@ struct Variable {
   // Computed variables: the output group (a bit) that computes them, so that
   // a get pays only for what it reads (ModelData::update_outputs).
   std::uint8_t group = kAllGroups;
+  // Parameters that are the initial value of a continuous state: its index
+  // (the InitialUnknowns' dependencies); -1 otherwise.
+  int initial_of = -1;
 
   constexpr bool has_start() const {
     return causality == Causality::Input || initial == Initial::Exact || initial == Initial::Approx;
@@ -130,6 +133,14 @@ constexpr Variable real_parameter(std::uint32_t vr, const char* name, double sta
                                   double max = kNoMax) {
   return {vr,    name,  VarType::Real, Causality::Parameter, Variability::Fixed, Initial::Exact, start, unit,
           description, value, index, nullptr, min, max, kDependsNothing, -1, -1};
+}
+/// A fixed Real parameter that is the initial value of continuous state number `state`.
+constexpr Variable initial_state_parameter(std::uint32_t vr, const char* name, double start, const char* unit,
+                                           const char* description, Ref value, int index, double min, double max,
+                                           int state) {
+  Variable v = real_parameter(vr, name, start, unit, description, value, index, min, max);
+  v.initial_of = state;
+  return v;
 }
 /// A fixed Integer parameter (initial exact) with its range.
 constexpr Variable integer_parameter(std::uint32_t vr, const char* name, int start, const char* description,

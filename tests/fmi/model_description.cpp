@@ -6,6 +6,7 @@
 // the core's defaults, and a ModelStructure true to the mathematics, checked
 // by perturbing each input and each state of a Model Exchange instance and
 // watching which outputs and derivatives move.
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <memory>
@@ -273,6 +274,95 @@ TEST(ModelStructure, PlantStateDependenciesAreExact) {
   ASSERT_EQ(h.inst->set_continuous_states(x.data(), n), Status::OK);
   EXPECT_EQ(h.read(), base);
   EXPECT_GT(listed_and_moved, 100);  // the check saw real movement
+}
+
+}  // namespace
+
+namespace {
+
+// InitialUnknowns (FMI 2.0.4 section 2.2.8, FMI 3.0.2 section 2.4.8): their
+// dependencies on the knowns of Initialization Mode, inputs and parameters,
+// generated for both versions from the table (initial_dependencies_of).
+// Perturbing each input and each Real parameter before
+// ExitInitializationMode moves only InitialUnknowns that list it; a state
+// lists exactly its initial-value parameter, and moves with it.
+void check_initial_dependencies(const ModelDefinition& d, pkm_fmi::Interface interface) {
+  std::vector<std::uint32_t> unknowns;
+  for (std::size_t k = 0; k < d.n_variables; ++k) {
+    const Variable& v = d.variables[k];
+    if ((v.causality == Causality::Output && v.initial != pkm_fmi::Initial::Exact) || v.state_of >= 0 ||
+        v.causality == Causality::CalculatedParameter)
+      unknowns.push_back(v.vr);
+  }
+  auto initialised = [&](const Variable* changed, double x, std::vector<double>& y) {
+    std::unique_ptr<Instance> inst(Instance::create(d, 3, interface, d.guid().c_str(), pkm_fmi::Logger()));
+    if (changed) {
+      EXPECT_EQ(inst->set_real(&changed->vr, 1, &x), Status::OK) << changed->name;
+    }
+    if (inst->enter_initialization_mode() != Status::OK || inst->exit_initialization_mode() != Status::OK)
+      return false;
+    y.assign(unknowns.size(), 0.0);
+    const Status s = inst->get_real(unknowns.data(), unknowns.size(), y.data());
+    return s == Status::OK || s == Status::Warning;
+  };
+  std::vector<double> base;
+  ASSERT_TRUE(initialised(nullptr, 0.0, base));
+  int moved_and_listed = 0;
+  for (std::size_t k = 0; k < d.n_variables; ++k) {
+    const Variable& known = d.variables[k];
+    if (known.type != pkm_fmi::VarType::Real ||
+        (known.causality != Causality::Input && known.causality != Causality::Parameter))
+      continue;
+    const double x = known.start != 0.0 ? known.start * (1.0 + 1e-3) : 1e-4;
+    if (!(x >= known.min && x <= known.max)) continue;
+    std::vector<double> y;
+    if (!initialised(&known, x, y)) continue;  // a value initialisation refuses moves nothing
+    for (std::size_t o = 0; o < unknowns.size(); ++o) {
+      const Variable* u = d.find(unknowns[o]);
+      const pkm_fmi::Dependencies deps = pkm_fmi::initial_dependencies_of(d, *u);
+      const bool listed = std::find(deps.knowns.begin(), deps.knowns.end(), known.vr) != deps.knowns.end();
+      const bool moves = y[o] != base[o];
+      if (u->name == std::string("constraint_residual")) continue;  // zero up to rounding, whatever moves
+      EXPECT_TRUE(listed || !moves) << u->name << " moves with " << known.name << " but does not list it";
+      if (u->state >= 0) {
+        EXPECT_EQ(listed, moves) << u->name << (moves ? " moves" : " does not move") << " with " << known.name;
+      }
+      moved_and_listed += listed && moves;
+    }
+  }
+  EXPECT_GT(moved_and_listed, 50) << "the check saw real movement";
+}
+
+TEST(ModelStructure, PlantInitialUnknownDependenciesHold) {
+  check_initial_dependencies(pkm_fmi::pkm4puu_definition(), pkm_fmi::Interface::ModelExchange);
+}
+
+TEST(ModelStructure, InverseInitialUnknownDependenciesHold) {
+  check_initial_dependencies(pkm_fmi::pkm4puu_inverse_definition(), pkm_fmi::Interface::CoSimulation);
+}
+
+// Every Output, ContinuousStateDerivative and InitialUnknown of both versions
+// declares its dependencies (issue 27 item 3: without the attribute an
+// importer must assume everything, and some refuse such FMUs).
+TEST(ModelStructure, EveryUnknownDeclaresItsDependenciesInBothVersions) {
+  for (const ModelDefinition* d : {&pkm_fmi::pkm4puu_definition(), &pkm_fmi::pkm4puu_inverse_definition()}) {
+    for (int version : {2, 3}) {
+      const std::string xml = pkm_fmi::model_description_xml(*d, version, PKM_VERSION_STRING);
+      const std::string structure = xml.substr(xml.find("<ModelStructure>"));
+      int unknowns = 0;
+      for (std::size_t at = structure.find('<'); at != std::string::npos; at = structure.find('<', at + 1)) {
+        const std::string element = structure.substr(at, structure.find('>', at) - at);
+        const bool unknown = element.rfind("<Unknown ", 0) == 0 || element.rfind("<Output ", 0) == 0 ||
+                             element.rfind("<ContinuousStateDerivative ", 0) == 0 ||
+                             element.rfind("<InitialUnknown ", 0) == 0;
+        if (!unknown) continue;
+        ++unknowns;
+        EXPECT_NE(element.find(" dependencies=\""), std::string::npos) << d->identifier << " FMI " << version << ": "
+                                                                         << element;
+      }
+      EXPECT_GT(unknowns, 50);
+    }
+  }
 }
 
 }  // namespace

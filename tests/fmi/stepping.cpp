@@ -222,6 +222,27 @@ TEST_F(Stepping, BadCommunicationSteps) {
       });
 }
 
+// Issue 27 item 5: a first CVODE step of 1e-200 s passed the FMU's checks,
+// then CVODE could not start (its first-step estimate squares the span) and
+// the run was over (fmi2Discard, StepFailed). FMI 2.0.4 section 4.2.3
+// (fmi2DoStep) and FMI 3.0.2 section 4.2.3: an argument the FMU cannot use is
+// an Error; this FMU refuses it before any work, the instance unchanged. The
+// bound is sqrt(DBL_MIN) = 2^-511 s (pkm::kMinCvodeSpan): accepted at it,
+// refused below.
+TEST_F(Stepping, AFirstCvodeStepTooShortToStartIsRefusedWithoutEffect) {
+  PlantFmu p;
+  p.initialize();
+  const std::vector<double> before = p.all_reals();
+  EXPECT_EQ(p.step(0.0, 1e-200), fmi2Error) << p.log.dump();
+  EXPECT_TRUE(p.log.contains("shorter than CVODE can start with")) << p.log.dump();
+  EXPECT_EQ(p.step(0.0, std::ldexp(1.0, -512)), fmi2Error);
+  EXPECT_TRUE(bit_identical(p.all_reals(), before));
+  const double shortest = std::ldexp(1.0, -511);  // sqrt(DBL_MIN): its square is the smallest normal double
+  EXPECT_EQ(shortest * shortest, std::numeric_limits<double>::min());
+  EXPECT_EQ(p.step(0.0, shortest), fmi2OK) << p.log.dump();
+  EXPECT_EQ(p.step(shortest, 1e-3), fmi2OK) << p.log.dump();
+}
+
 TEST_F(Stepping, AStepWhoseEndOverflowsIsAnError) {
   PlantFmu p;
   p.initialize(1e308);

@@ -36,9 +36,11 @@ TEST_F(Variables, InvalidParametersAndUnreachablePosesFailInitialisation) {
     PlantFmu p;
     // Outside the modelDescription's range: refused when set, the start value kept.
     EXPECT_EQ(p.set("r_b", -1.0), fmi2Error);
-    EXPECT_TRUE(p.log.contains("r_b = -1 lies outside its range [0, 10] m")) << p.log.dump();
-    // Within the range but not usable (r_b must be positive): refused at initialisation.
-    ASSERT_EQ(p.set("r_b", 0.0), fmi2OK);
+    EXPECT_TRUE(p.log.contains("r_b = -1 lies outside its range [9.9999999999999995e-07, 10] m")) << p.log.dump();
+    // r_b must be positive: its declared min is a positive floor, so 0 is refused when set.
+    EXPECT_EQ(p.set("r_b", 0.0), fmi2Error);
+    // Within the range but not usable (a 1 mm base reaches no pose with these legs): refused at initialisation.
+    ASSERT_EQ(p.set("r_b", 1e-3), fmi2OK);
     ASSERT_EQ(lib.fmi2EnterInitializationMode(p.c), fmi2OK);
     EXPECT_EQ(lib.fmi2ExitInitializationMode(p.c), fmi2Error);
     EXPECT_TRUE(p.log.contains("r_b")) << p.log.dump();
@@ -60,11 +62,43 @@ TEST_F(Variables, InvalidParametersAndUnreachablePosesFailInitialisation) {
   }
   {
     PlantFmu p;
-    ASSERT_EQ(p.set("atol", 0.0), fmi2OK);  // within [0, 1], but CVODE needs it positive
-    ASSERT_EQ(lib.fmi2EnterInitializationMode(p.c), fmi2OK);
-    EXPECT_EQ(lib.fmi2ExitInitializationMode(p.c), fmi2Error);
-    EXPECT_TRUE(p.log.contains("atol = 0 must be positive")) << p.log.dump();
+    EXPECT_EQ(p.set("atol", 0.0), fmi2Error);  // CVODE needs it positive: below the declared min
+    EXPECT_TRUE(p.log.contains("atol = 0 lies outside its range")) << p.log.dump();
   }
+}
+
+// FMI 2.0.4 section 2.2.7 and FMI 3.0.2 section 2.4.7.4: min and max are
+// inclusive ("min <= value <= max"). Every Real parameter of both FMUs, set
+// to its declared min and to its declared max, passes the parameter's own
+// check at initialisation (issue 27 item 5: rtol was declared [0, 1] and
+// lengths and masses min 0 while 0 and 1 were refused). Initialisation may
+// still refuse a combination (a 1 um rod reaches no pose); never with the
+// parameter's range as the reason.
+TEST_F(Variables, DeclaredMinAndMaxAreAccepted) {
+  const char* const range_refusals[] = {"must be positive", "must be zero or positive", "must lie in",
+                                        "lies outside its", "must be greater than"};
+  int checked = 0;
+  for (const pkm_fmi::ModelDefinition* d : {&pkm_fmi::pkm4puu_definition(), &pkm_fmi::pkm4puu_inverse_definition()}) {
+    for (std::size_t k = 0; k < d->n_variables; ++k) {
+      const pkm_fmi::Variable& v = d->variables[k];
+      if (v.causality != pkm_fmi::Causality::Parameter || v.type != pkm_fmi::VarType::Real) continue;
+      for (double bound : {v.min, v.max}) {
+        if (!std::isfinite(bound)) continue;
+        SCOPED_TRACE(std::string(d->identifier) + " " + v.name + " = " + std::to_string(bound));
+        FmuInstance p(d == &pkm_fmi::pkm4puu_definition() ? plant_library() : inverse_library(), *d,
+                      d->guid().c_str());
+        ASSERT_EQ(p.set(v.name, bound), fmi2OK) << p.log.dump();
+        ASSERT_EQ(p.setup(), fmi2OK);
+        ASSERT_EQ(p.enter(), fmi2OK);
+        if (p.exit() != fmi2OK) {
+          for (const char* why : range_refusals)
+            EXPECT_FALSE(p.log.contains(std::string(v.name) + " = ") && p.log.contains(why)) << p.log.dump();
+        }
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 100);
 }
 
 TEST_F(Variables, OutputsAreAvailableInInitializationMode) {

@@ -165,11 +165,11 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
     case pkm::Status::Singular:
     case pkm::Status::NotConverged:
       // The plant kept its last good state (RK4: last whole step; CVODE: the
-      // step start), within the singularity limits. The layer sets
-      // terminated: a master stops at the last successful time instead of
-      // retrying the same step.
+      // step start), within the singularity limits. The layer says what
+      // follows (FMI 2.0: StepFailed, terminated; FMI 3.0: back to the state
+      // at the call).
       ctx.log.discard("DoStep: integration from t = %.17g to %.17g failed (%s%s%s, times since startTime); the "
-                      "state is kept at t = %.17g (the last successful time), terminated = true",
+                      "last good state is at t = %.17g",
                       ctx.start_time + t_start, ctx.start_time + t_end, pkm::status_name(s),
                       plant->last_error().empty() ? "" : ": ", plant->last_error().c_str(), ctx.start_time + t_reached);
       return Status::Discard;
@@ -188,6 +188,12 @@ bool PlantData::inputs_continue() const {
 }
 
 Status PlantData::check_step(Context& ctx, double h) const {
+  if (plant && plant->solver().solver == pkm::Solver::Cvode && h < pkm::kMinCvodeSpan) {
+    ctx.log.error("DoStep: a communication step of %.17g s is shorter than CVODE can start with (%.6g s, "
+                  "sqrt(DBL_MIN)); the call has no effect",
+                  h, pkm::kMinCvodeSpan);
+    return Status::Error;
+  }
   if (!plant || plant->solver().solver != pkm::Solver::Rk4) return Status::OK;
   const double step = plant->solver().rk4_step;
   const double steps = pkm::rk4_steps_for(h, step);

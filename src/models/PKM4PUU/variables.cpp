@@ -139,22 +139,22 @@ constexpr Variable kVariables[] = {
   // Parameters: the mechanism (100..120), the initial state (130..137), the
   // solver (140..147), the end stops' compliance (148..149), the machine (150..160).
   PKM_FMI_MECHANISM_PARAMETERS,
-  real_parameter(130, "x0", 0.0, "m", "Initial x of P", PLANT(pose0), 0, -pkm::kMaxLength, pkm::kMaxLength),
-  real_parameter(131, "y0", 0.0, "m", "Initial y of P", PLANT(pose0), 1, -pkm::kMaxLength, pkm::kMaxLength),
-  real_parameter(132, "z0", 0.05, "m", "Initial z of P (home pose: 0.05 m)", PLANT(pose0), 2, -pkm::kMaxLength, pkm::kMaxLength),
-  real_parameter(133, "phi0", 0.0, "rad", "Initial platform rotation about z", PLANT(pose0), 3, -pkm::kMaxAngle, pkm::kMaxAngle),
-  real_parameter(134, "dx0", 0.0, "m/s", "Initial velocity of P, x component", PLANT(vel0), 0, -pkm::kMaxSpeed, pkm::kMaxSpeed),
-  real_parameter(135, "dy0", 0.0, "m/s", "Initial velocity of P, y component", PLANT(vel0), 1, -pkm::kMaxSpeed, pkm::kMaxSpeed),
-  real_parameter(136, "dz0", 0.0, "m/s", "Initial velocity of P, z component", PLANT(vel0), 2, -pkm::kMaxSpeed, pkm::kMaxSpeed),
-  real_parameter(137, "dphi0", 0.0, "rad/s", "Initial platform angular velocity about z", PLANT(vel0), 3, -pkm::kMaxSpeed / pkm::kConditionLength, pkm::kMaxSpeed / pkm::kConditionLength),
+  initial_state_parameter(130, "x0", 0.0, "m", "Initial x of P", PLANT(pose0), 0, -pkm::kMaxLength, pkm::kMaxLength, 0),
+  initial_state_parameter(131, "y0", 0.0, "m", "Initial y of P", PLANT(pose0), 1, -pkm::kMaxLength, pkm::kMaxLength, 1),
+  initial_state_parameter(132, "z0", 0.05, "m", "Initial z of P (home pose: 0.05 m)", PLANT(pose0), 2, -pkm::kMaxLength, pkm::kMaxLength, 2),
+  initial_state_parameter(133, "phi0", 0.0, "rad", "Initial platform rotation about z", PLANT(pose0), 3, -pkm::kMaxAngle, pkm::kMaxAngle, 3),
+  initial_state_parameter(134, "dx0", 0.0, "m/s", "Initial velocity of P, x component", PLANT(vel0), 0, -pkm::kMaxSpeed, pkm::kMaxSpeed, 4),
+  initial_state_parameter(135, "dy0", 0.0, "m/s", "Initial velocity of P, y component", PLANT(vel0), 1, -pkm::kMaxSpeed, pkm::kMaxSpeed, 5),
+  initial_state_parameter(136, "dz0", 0.0, "m/s", "Initial velocity of P, z component", PLANT(vel0), 2, -pkm::kMaxSpeed, pkm::kMaxSpeed, 6),
+  initial_state_parameter(137, "dphi0", 0.0, "rad/s", "Initial platform angular velocity about z", PLANT(vel0), 3, -pkm::kMaxSpeed / pkm::kConditionLength, pkm::kMaxSpeed / pkm::kConditionLength, 7),
   integer_parameter(140, "solver", static_cast<int>(kDefaultSolver.solver),
                     "Co-Simulation integrator: 0 = CVODE (variable step, rtol and atol), 1 = fixed-step RK4 (rk4_step), as in the paper",
                     PLANT_SCALAR(solver), 0, 1),
   real_parameter(141, "rk4_step", kDefaultSolver.rk4_step, "s",
                  "RK4 step: a communication step is split into whole steps no longer than this", PLANT_SCALAR(rk4_step), 0,
                  pkm::kMinRk4Step, pkm::kMaxRk4Step),
-  real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance", PLANT_SCALAR(rtol), 0, 0.0, 1.0),
-  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)", PLANT_SCALAR(atol), 0, 0.0, 1.0),
+  real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance", PLANT_SCALAR(rtol), 0, pkm::kMinRtol, pkm::kMaxRtol),
+  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)", PLANT_SCALAR(atol), 0, pkm::kMinAtol, pkm::kMaxAtol),
   integer_parameter(144, "cvode_method", static_cast<int>(kDefaultSolver.cvode_method),
                     "CVODE method: 0 = Adams-Moulton (non-stiff), 1 = BDF", PLANT_SCALAR(cvode_method), 0, 1),
   integer_parameter(145, "formulation", static_cast<int>(kDefaultSolver.formulation),
@@ -193,8 +193,9 @@ const ModelDefinition kDefinition{
     "communication points while the inputs continue smoothly, and restarts where they jump, after a failed step "
     "and after a restored FMU state. With FMI 2.0 the inputs can be interpolated linearly within a step "
     "(fmi2SetRealInputDerivatives, order 1). A step that cannot be completed, or that ends near a leg "
-    "singularity (min_leg_measure) or a parallel singularity (max_jacobian_condition), returns Discard with the "
-    "last good state kept. <b>Model Exchange:</b> the legs are reconstructed in closed form from the continuous "
+    "singularity (min_leg_measure) or a parallel singularity (max_jacobian_condition), returns Discard: with FMI 2.0 the "
+    "last good state is kept at the last successful time and terminated = true; with FMI 3.0 the FMU is back in "
+    "the state at the call, still in Step Mode, and the step may be retried. <b>Model Exchange:</b> the legs are reconstructed in closed form from the continuous "
     "states, so the loop closures hold exactly whatever the importer's integrator does. The event indicators "
     "are the singularity guards, whose crossing ends the simulation with a logged reason, and the end stops, "
     "whose crossings are events logged under logEvents. A pose that no leg can reach is refused by "

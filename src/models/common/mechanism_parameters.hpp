@@ -103,12 +103,12 @@ constexpr Variable mechanism_parameter(std::uint32_t vr, const char* name, const
                  "column divided by 0.1 m); a pose beyond it is refused (plant: the step is discarded, state "        \
                  "kept, or in Model Exchange an event indicator ends the run; inverse: Discard, last good "           \
                  "outputs kept); > 1",                                                                                \
-                 PKM_FMI_LIMIT(max_jacobian_condition), 0, 1.0),                                                      \
+                 PKM_FMI_LIMIT(max_jacobian_condition), 0, pkm::kLeastConditionLimit),                                                      \
   real_parameter(147, "min_leg_measure", kDefaultLimits.min_leg_measure, "",                                          \
                  "Leg-singularity guard: smallest admissible |cos(theta2) sin(theta2)| of every leg (rod nearly "     \
                  "horizontal or vertical below it); a pose beyond it is refused as for max_jacobian_condition; "      \
                  "in [0, 0.5)",                                                                                       \
-                 PKM_FMI_LIMIT(min_leg_measure), 0, 0.0, 0.5)
+                 PKM_FMI_LIMIT(min_leg_measure), 0, 0.0, pkm::kGreatestLegMeasureLimit)
 
 // Value references 150..160, identical in both FMUs: the machine around the
 // mechanism (MODEL_SPEC "The machine around the mechanism"). Every default

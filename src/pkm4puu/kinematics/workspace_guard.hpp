@@ -64,6 +64,13 @@ std::string describe_configuration_failure(const Model& m, const Pose& pose, con
 /// `condition`, if given, receives the condition number itself (+inf at a
 /// parallel singularity): the one SVD serves both.
 constexpr int kGuardIndicators = 5;
+
+/// The extreme values validate() accepts, as a modelDescription declares them
+/// (inclusive): the least double above 1 for max_jacobian_condition (a
+/// condition number is at least 1), the greatest below 0.5 for
+/// min_leg_measure (|cos theta2 sin theta2| is at most 0.5).
+constexpr double kLeastConditionLimit = 1.0 + 0x1p-52;
+constexpr double kGreatestLegMeasureLimit = 0.5 - 0x1p-54;
 Status guard_indicators(const Model& m, const Pose& pose, const GuardLimits& lim, double z[kGuardIndicators],
                         double* condition = nullptr);
 

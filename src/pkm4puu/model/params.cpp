@@ -21,12 +21,11 @@ std::string validate(const Params& p) {
   for (const ParamRange& e : kParamRanges) {
     const double value = e.value(p);
     if (!std::isfinite(value)) return describe(e.name, value, "is not finite");
-    const bool above_lo = e.lo_open ? value > e.lo : value >= e.lo;
+    const bool above_lo = value >= e.lo;
     if (above_lo && value <= e.hi) continue;
     if (!above_lo && *e.why) return describe(e.name, value, e.why);
     char range[96];
-    std::snprintf(range, sizeof range, "lies outside its physical range %s%.17g, %.17g]", e.lo_open ? "(" : "[",
-                  e.lo, e.hi);
+    std::snprintf(range, sizeof range, "lies outside its physical range [%.17g, %.17g]", e.lo, e.hi);
     return describe(e.name, value, range);
   }
   // The rod's inertia about its own axis x3 is the smallest; a rigid body's

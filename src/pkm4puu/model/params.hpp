@@ -68,6 +68,16 @@ constexpr double kMaxForce = 1e6;       // N: friction_coulomb
 constexpr double kMaxDamping = 1e6;     // N*s/m: friction_viscous, stop_damping
 constexpr double kMaxStiffness = 1e9;   // N/m: stop_stiffness
 constexpr double kMaxSlipSpeed = 10.0;  // m/s: friction_velocity
+// The smallest values of the parameters that must be positive. A min in a
+// modelDescription is inclusive, so "positive" is declared as these floors,
+// far below any real machine's and far above where the dynamics' arithmetic
+// over- or underflows: a micrometre (lengths, screw lead), a milligram
+// (masses), a milligram at a millimetre (inertias: 1e-6 kg x (1e-3 m)^2),
+// a nanometre per second (the Coulomb friction's regularising speed).
+constexpr double kMinLength = 1e-6;     // m
+constexpr double kMinMass = 1e-6;       // kg
+constexpr double kMinInertia = 1e-12;   // kg*m^2
+constexpr double kMinSlipSpeed = 1e-9;  // m/s
 
 /// Checks every parameter. Returns an empty string when they are valid,
 /// otherwise a message that names the offending parameter and its value.

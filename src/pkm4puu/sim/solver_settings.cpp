@@ -37,12 +37,12 @@ std::string validate(const SolverSettings& s) {
                   kMaxRk4Step);
     return buf;
   }
-  if (!(s.rtol > 0.0) || !(s.rtol < 1.0)) {
-    std::snprintf(buf, sizeof buf, "rtol = %.17g must lie in (0, 1)", s.rtol);
+  if (!(s.rtol >= kMinRtol) || !(s.rtol <= kMaxRtol)) {
+    std::snprintf(buf, sizeof buf, "rtol = %.17g must lie in [%g, %g]", s.rtol, kMinRtol, kMaxRtol);
     return buf;
   }
-  if (!(s.atol > 0.0) || !(s.atol <= 1.0)) {
-    std::snprintf(buf, sizeof buf, "atol = %.17g must be positive and at most 1", s.atol);
+  if (!(s.atol >= kMinAtol) || !(s.atol <= kMaxAtol)) {
+    std::snprintf(buf, sizeof buf, "atol = %.17g must be positive and at most 1 (at least %g)", s.atol, kMinAtol);
     return buf;
   }
   return validate(s.limits());

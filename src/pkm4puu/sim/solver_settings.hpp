@@ -39,6 +39,20 @@ inline bool operator==(const SolverSettings& a, const SolverSettings& b) {
 /// over; above 1 s RK4 says nothing about this machine.
 constexpr double kMinRk4Step = 1e-6, kMaxRk4Step = 1.0;
 
+/// The shortest interval CVODE is asked to integrate from rest (model time
+/// 0): its first-step estimate squares the interval, which below
+/// sqrt(DBL_MIN) = 2^-511 s is no longer a normal double (CVODE then fails,
+/// measured from about 2^-540 s on). Shorter steps are refused before any work.
+constexpr double kMinCvodeSpan = 0x1p-511;
+
+/// The range of CVODE's rtol: no tighter than the double's resolution
+/// (2^-52: CVODE cannot meet a smaller one), no looser than one half (a step
+/// error half the solution's size controls nothing); both ends accepted.
+constexpr double kMinRtol = 0x1p-52, kMaxRtol = 0.5;
+/// The range of atol: positive (a zero weight makes CVODE refuse a state
+/// with a zero component), so the smallest normal double, up to 1.
+constexpr double kMinAtol = 0x1p-1022, kMaxAtol = 1.0;
+
 /// At most this many RK4 steps in one advance (a longer interval or a
 /// smaller rk4_step is refused with Status::InvalidArgument before any work).
 constexpr double kMaxRk4StepsPerAdvance = 1e7;
