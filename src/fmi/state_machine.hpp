@@ -31,6 +31,10 @@ constexpr std::uint32_t kMaskEnterContinuousTime = kEventMode;
 constexpr std::uint32_t kMaskCompletedStep = kContinuousTimeMode;
 constexpr std::uint32_t kMaskSetTime = kEventMode | kContinuousTimeMode;
 constexpr std::uint32_t kMaskSetStates = kContinuousTimeMode;
+// Continuous states set by value reference (fmi2SetReal, fmi3SetFloat64):
+// FMI 2.0.4's state table (footnote on fmi2SetReal, since 2.0.1) and FMI
+// 3.0.2 §3.2.1 / §2.3.5.
+constexpr std::uint32_t kMaskSetStatesByReference = kEventMode | kContinuousTimeMode;
 constexpr std::uint32_t kMaskGetStates = kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError;
 // States an FMU state may carry (the others are unrecoverable).
 constexpr std::uint32_t kRestorableModes = kAlive;

@@ -105,8 +105,8 @@ struct PlantData final : MechanismData {
   double energy[2] = {};  // actuator_work, dissipated_energy (states)
   double dy[kStates] = {};  // der(x) .. der(dphi), der(actuator_work), der(dissipated_energy)
   double z[kIndicators] = {};  // the event indicators: guards, then end stops
-  // Model Exchange: the stops passed at the last event (end_stops.hpp's
-  // contact mode), to log contacts and releases.
+  // The contact mode last logged (the Plant's, end_stops.hpp), to log
+  // contacts and releases.
   unsigned logged_stops = 0;
   // Co-Simulation: end-stop events located so far (logged per step).
   long contact_events = 0;
@@ -155,8 +155,6 @@ struct PlantData final : MechanismData {
   /// The plant, built from the current parameters in initialisation mode.
   Status ready(Context& ctx, const char* function);
   pkm::LinearInputs inputs(double t0) const;
-  /// The stops passed now (end_stops.hpp's contact mode; bit k: indicator k < 0).
-  unsigned stops_passed_now() const;
   /// Logs (logEvents) each stop passed or left since the last call.
   void log_stop_changes(Context& ctx, unsigned now, const char* where);
 };

@@ -30,7 +30,8 @@ inline double switch_time_tolerance(double t) {
 /// `mode` and `rho` hold the contact mode and actuator positions at x on
 /// entry and at the end on return (`rho_valid` false where unknown);
 /// `switches` counts the located switches. `t` returns where the step got to
-/// (t1 on success). The stops are held from the state (kStopsFromState) on return.
+/// (t1 on success). On return the stops of the final mode are held (the
+/// plant's contact mode from there on).
 template <class System>
 Status located_rk4_step(System& sys, double t0, double t1, double h_contact, Vec10& x, unsigned& mode, Vec4& rho,
                         bool& rho_valid, long& switches, double& t) {
@@ -85,7 +86,7 @@ Status located_rk4_step(System& sys, double t0, double t1, double h_contact, Vec
     rho_valid = rho_trial_valid;
     t = to_end ? t1 : t + step;
   }
-  sys.hold(kStopsFromState);
+  sys.hold(mode & 0xFFu);
   return s;
 }
 

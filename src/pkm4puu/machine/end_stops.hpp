@@ -43,8 +43,14 @@ inline double stop_force(const Params& p, double rho, double rhod) { return stop
 /// the integrators (bit i: leg i's lower stop, bit 4 + i: its upper stop),
 /// so that the state derivative is smooth between events (up to the
 /// release kink) and the rounding of a located crossing cannot switch a
-/// stop on or off again. kStopsFromState: each stop acts when its joint is
-/// past it (the plain state function, for Model Exchange and the outputs).
+/// stop on or off again. The Plant holds one such mode for Co-Simulation
+/// and Model Exchange alike, switched only at located events and in Event
+/// Mode (stops_after_event). The release kink, where k delta + d delta_dot
+/// changes sign inside a contact, is not a relation: the force is
+/// continuous there (only its slope jumps), as a variable-step error test
+/// expects between events. kStopsFromState: each stop acts when its joint
+/// is past it (the plain state function, for the analyses outside a
+/// simulation: inverse dynamics, Jacobians of a pose).
 constexpr unsigned kStopsFromState = ~0u;
 
 /// The same as stop_contact with the stops held: a held stop acts with
@@ -97,8 +103,48 @@ inline void stop_indicators(const Params& p, const Vec4& rho, double g[kStopIndi
   }
 }
 
-/// The indicators at a platform pose (any state: they depend on the pose only).
-Status stop_indicators(const Model& m, const Pose& pose, double g[kStopIndicators]);
+
+/// The switches' hysteresis (m): indicator k reads g_k + h while stop k is
+/// not held and g_k - h while it is (stop_indicators with a contact mode),
+/// so a stop switches on where its joint has passed it by h and off where
+/// the joint is h short of it, and no indicator is exactly zero after an
+/// event (FMI 2.0.4 §3.2.2, FMI 3.0.2 §3.1.1: z_j != 0 on leaving Event
+/// Mode): after a switch the indicator is g_k -+ h with |g_k -+ h| >= 2h.
+/// 1 pm, four orders above the rounding of rho (~1e-16 m at this machine's
+/// scale) so that the state at a located switch cannot read as the other
+/// side once switched, and far below anything the model resolves (a stop
+/// switched 1 pm late changes its force by k h = 1e-7 N at 1e5 N/m).
+constexpr double kStopHysteresis = 1e-12;
+
+/// The indicators under the contact mode `stops` (held, with the
+/// hysteresis): each is positive while its stop's mode is consistent with
+/// the joint (within the travel and not held, or past and held: then its
+/// sign is flipped), and a zero crossing is a switch of that stop.
+/// kStopsFromState: the plain g_k, no hysteresis.
+inline void stop_indicators(const Params& p, const Vec4& rho, unsigned stops, double z[kStopIndicators]) {
+  stop_indicators(p, rho, z);
+  if (stops == kStopsFromState) return;
+  for (int k = 0; k < kStopIndicators; ++k) z[k] += (stops & (1u << k)) ? -kStopHysteresis : kStopHysteresis;
+}
+
+/// The same at a platform pose (any velocity: they depend on the pose only).
+Status stop_indicators(const Model& m, const Pose& pose, unsigned stops, double z[kStopIndicators]);
+
+/// The contact mode after an event at actuator positions rho (the one rule
+/// for Event Mode and initialisation, from stops = 0): a stop not held
+/// whose indicator (with the hysteresis) is <= 0 is switched on, a held one
+/// whose indicator is >= 0 is released. The result is consistent with rho:
+/// every indicator under it is nonzero and needs no further switch.
+inline unsigned stops_after_event(const Params& p, const Vec4& rho, unsigned stops) {
+  double z[kStopIndicators];
+  stop_indicators(p, rho, stops, z);
+  for (int k = 0; k < kStopIndicators; ++k) {
+    const bool held = stops & (1u << k);
+    if (!held && z[k] <= 0.0) stops |= 1u << k;
+    if (held && z[k] >= 0.0) stops &= ~(1u << k);
+  }
+  return stops;
+}
 
 /// The contact mode after located crossings: dirs[k] < 0 where indicator k
 /// fell through zero (its stop now acts), > 0 where it rose (released).

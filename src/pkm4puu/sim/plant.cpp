@@ -55,10 +55,14 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
     error_ = "the state derivative at the initial state is not finite (initial velocity too large?)";
     return Status::NonFinite;
   }
+  Vec4 rho;
+  s = pkm::actuator_positions(model_, pose, rho);
+  if (s != Status::Ok) return s;
   s = prepare_cvode();
   if (s != Status::Ok) return s;
   y_ = y;
   rho_valid_ = false;
+  stops_ = stops_after_event(model_.p, rho, 0u);
   t_ = t0;
   energy_ = EnergyIntegrals{};
   for (int i = 0; i < kLegs; ++i) theta1_.ref[i] = q[leg_offset(i) + 1];
@@ -69,6 +73,16 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
 }
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
+  return restore(t, y, theta1_ref, ~0u);
+}
+
+Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned stops) {
+  if (stops != ~0u && ((stops >> kStopIndicators) != 0u || (stops & (stops >> kLegs) & ((1u << kLegs) - 1u)) != 0u)) {
+    char buf[120];
+    std::snprintf(buf, sizeof buf, "the contact mode %#x names no stop or both stops of one leg", stops);
+    error_ = buf;
+    return Status::InvalidArgument;
+  }
   if (!std::isfinite(t) || !y.allFinite() || !theta1_ref.allFinite()) {
     error_ = "the time, state or theta1 references are not finite";
     return Status::NonFinite;
@@ -98,6 +112,8 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
   t_ = t;
   y_ = y;
   rho_valid_ = false;
+  Vec4 rho;
+  stops_ = stops != ~0u ? stops : (actuator_positions(rho) == Status::Ok ? stops_after_event(model_.p, rho, 0u) : 0u);
   theta1_.ref = theta1_ref;
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
@@ -129,14 +145,30 @@ Status Plant::derivative_now(const InputSignal& inputs, Vec10& xdot) const {
   x.head<8>() = y_;
   x[8] = energy_.actuator_work;
   x[9] = energy_.dissipated;
-  return machine_rates(inputs, t_, x, kStopsFromState, xdot);
+  return machine_rates(inputs, t_, x, stops_, xdot);
+}
+
+Status Plant::update_stops(unsigned& switched) {
+  switched = 0;
+  if (!initialized_) return Status::NotInitialized;
+  Vec4 rho;
+  const Status s = actuator_positions(rho);
+  if (s != Status::Ok) return s;
+  const unsigned now = stops_after_event(model_.p, rho, stops_);
+  switched = now ^ stops_;
+  stops_ = now;
+  return Status::Ok;
 }
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e) {
+  return restore(t, y, theta1_ref, e, ~0u);
+}
+
+Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e, unsigned stops) {
   if (!std::isfinite(e.actuator_work) || !std::isfinite(e.dissipated)) return Status::NonFinite;
   const EnergyIntegrals keep = energy_;
   energy_ = e;
-  const Status s = restore(t, y, theta1_ref);
+  const Status s = restore(t, y, theta1_ref, stops);
   if (s != Status::Ok) energy_ = keep;
   return s;
 }

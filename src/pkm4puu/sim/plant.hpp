@@ -42,7 +42,8 @@ struct MachineOutputs {
   double dissipated_energy = 0;        // J, running integral
   double actuator_power = 0;           // W, d(actuator_work)/dt
   double dissipation_rate = 0;         // W, d(dissipated_energy)/dt
-  /// Event indicators (machine.hpp): rho_i - rho_min, then rho_max - rho_i.
+  /// Event indicators (end_stops.hpp): rho_i - rho_min, then rho_max - rho_i,
+  /// each offset by the hysteresis under the contact mode.
   double stop_indicators[kStopIndicators] = {};
 };
 
@@ -83,8 +84,24 @@ class Plant {
   /// singularity limits or kMaxSpeed, or theta1_ref is not the pose's
   /// closed-form theta1 (modulo 2 pi). The energy integrals keep their
   /// values unless given.
+  /// The contact mode is the one that the event rule gives at y
+  /// (stops_after_event from none) unless given (`stops`, end_stops.hpp's
+  /// bits; InvalidArgument if it names no stop or both of one leg's).
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref);
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e);
+  Status restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e, unsigned stops);
+  Status restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned stops);
+
+  /// The contact mode (end_stops.hpp): which end stops act. Set at
+  /// initialize() and restore() by the event rule, switched at every event
+  /// located by advance() and by update_stops(), and nothing else: the
+  /// derivatives, the outputs and both integrators use it, so that
+  /// Co-Simulation and Model Exchange are the same hybrid model.
+  unsigned stops() const { return stops_; }
+  /// Model Exchange's Event Mode: switches the contact mode by the event
+  /// rule (stops_after_event) at the current state; returns the stops
+  /// switched (Unreachable off the workspace: nothing changes).
+  Status update_stops(unsigned& switched);
 
   /// The running energy integrals (zero at initialize()).
   const EnergyIntegrals& energy_integrals() const { return energy_; }
@@ -99,7 +116,8 @@ class Plant {
   // ---- Model Exchange: the importer's integrator owns time and state.
   /// Sets the time (the state is kept).
   void set_time(double t) { t_ = t; }
-  /// Sets the state [pose; velocity] reached by the importer's integrator:
+  /// Sets the state [pose; velocity] reached by the importer's integrator
+  /// (the contact mode is kept: relations change in Event Mode only):
   /// Status::Unreachable (nothing changes, last_error() says which leg) if a
   /// leg cannot be assembled there, ::NonFinite if y is not finite. The
   /// singularity limits are not checked here: the event indicators
@@ -108,7 +126,7 @@ class Plant {
   /// Sets the running energy integrals (the importer integrates them too).
   void set_energy_integrals(const EnergyIntegrals& e) { energy_ = e; }
   /// d/dt of [y; actuator_work; dissipated] at the current time and state
-  /// for the given inputs, each end stop acting when its joint is past it.
+  /// for the given inputs, under the contact mode stops().
   Status derivative_now(const InputSignal& inputs, Vec10& xdot) const;
 
   /// q, qd, qdd and lambda at the current time, for the inputs at that time
@@ -151,8 +169,9 @@ class Plant {
                        bool* inputs_fault = nullptr) const;
   Vec10 packed() const;
   void unpack(const Vec10& x);
-  /// The contact mode at x (located_rk4.hpp): the stops passed at the pose
-  /// x.head<4>() and, bit 8 + i, leg i's stop passed but released (its
+  /// The contact mode at x (located_rk4.hpp): the stops the event rule
+  /// switches on from the held ones (stops_) at the pose x.head<4>() and,
+  /// bit 8 + i, leg i's stop passed but released (its
   /// spring and damper would pull: a kink in the force that RK4 should not
   /// step across either); ~0u if unreachable. rho receives the actuator
   /// positions there (valid unless ~0u).
@@ -180,7 +199,7 @@ class Plant {
   Vec8 y_ = Vec8::Zero();
   EnergyIntegrals energy_;
   long contact_events_ = 0;
-  unsigned stops_ = kStopsFromState;  // the stops held on while integrating (machine.hpp)
+  unsigned stops_ = 0;  // the contact mode (stops()): never kStopsFromState
   // actuator_positions at y_, when rho_valid_ (every change of y_ clears it).
   mutable Vec4 rho_ = Vec4::Zero();
   mutable bool rho_valid_ = false;

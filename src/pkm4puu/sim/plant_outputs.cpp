@@ -48,7 +48,7 @@ Status Plant::machine_outputs(const InputSignal& inputs, MachineOutputs& out) co
     const int o = leg_offset(i);
     out.rho[i] = q[o];
     out.rhod[i] = qd[o];
-    out.stop_force[i] = stop_force(p, q[o], qd[o]);
+    out.stop_force[i] = stop_contact(p, i, stops_, q[o], qd[o]).force;
     out.friction_force[i] = friction_force(p, qd[o]);
   }
   s = holding_forces(model_, q, we, out.F_hold);
@@ -57,9 +57,9 @@ Status Plant::machine_outputs(const InputSignal& inputs, MachineOutputs& out) co
   out.potential_energy = potential_energy(model_, q);
   out.actuator_work = energy_.actuator_work;
   out.dissipated_energy = energy_.dissipated;
-  energy_rates(p, kStopsFromState, F + model_.drive_ratio * tau, we, y_.tail<4>(), out.rho, out.rhod,
+  energy_rates(p, stops_, F + model_.drive_ratio * tau, we, y_.tail<4>(), out.rho, out.rhod,
                out.actuator_power, out.dissipation_rate);
-  stop_indicators(p, out.rho, out.stop_indicators);
+  stop_indicators(p, out.rho, stops_, out.stop_indicators);
   return Status::Ok;
 }
 
