@@ -116,10 +116,10 @@ inline void stop_indicators(const Params& p, const Vec4& rho, double g[kStopIndi
 /// switched 1 pm late changes its force by k h = 1e-7 N at 1e5 N/m).
 constexpr double kStopHysteresis = 1e-12;
 
-/// The indicators under the contact mode `stops` (held, with the
-/// hysteresis): each is positive while its stop's mode is consistent with
-/// the joint (within the travel and not held, or past and held: then its
-/// sign is flipped), and a zero crossing is a switch of that stop.
+/// The indicators under the contact mode `stops` (with the hysteresis):
+/// g_k + h where stop k is not held, g_k - h where it is held (so negative
+/// in contact, as g_k); a zero crossing switches that stop (falling: on,
+/// rising: off).
 /// kStopsFromState: the plain g_k, no hysteresis.
 inline void stop_indicators(const Params& p, const Vec4& rho, unsigned stops, double z[kStopIndicators]) {
   stop_indicators(p, rho, z);

@@ -19,7 +19,7 @@ Status Plant::mechanism(const InputSignal& inputs, MechanismState& out) const {
   read_inputs(inputs, t_, F, we, tau);
   Vec8 ydot;
   const Status s = state_derivative(model_, settings_.formulation, y_, generalized_forces(model_, F, tau, we),
-                                    ydot, &out);
+                                    ydot, &out, nullptr, stops_);
   if (s != Status::Ok) return s;
   theta1_ref();  // brought up to date
   theta1_.unwrap(out.q);
