@@ -264,6 +264,7 @@ Status PlantData::update_outputs(Context& ctx, unsigned groups) {
     dy[8] = mo.actuator_power;
     dy[9] = mo.dissipation_rate;
     for (int k = 0; k < pkm::kStopIndicators; ++k) z[pkm::kGuardIndicators + k] = mo.stop_indicators[k];
+    for (int i = 0; i < 4; ++i) z[pkm::kGuardIndicators + pkm::kStopIndicators + i] = mo.clamp_indicators[i];
     for (const double* block : {F_hold, stop_force}) all_finite(block, 4);
     for (double v : {kinetic, potential, dy[8], dy[9]}) finite = finite && std::isfinite(v);
   }
@@ -407,10 +408,8 @@ Status PlantData::partial_derivatives(Context& ctx, const Variable* const unknow
 Status PlantData::get_event_indicators(Context& ctx, double z[]) {
   const Status st = ready(ctx, "GetEventIndicators");
   if (st != Status::OK) return st;
-  const pkm::Pose pose_now = plant->state().head<4>();
-  pkm::Status s = pkm::guard_indicators(plant->model(), pose_now, plant->solver().limits(), z);
-  if (s == pkm::Status::Ok)
-    s = pkm::stop_indicators(plant->model(), pose_now, plant->stops(), z + pkm::kGuardIndicators);
+  pkm::Status s = pkm::guard_indicators(plant->model(), plant->state().head<4>(), plant->solver().limits(), z);
+  if (s == pkm::Status::Ok) s = plant->contact_indicators(z + pkm::kGuardIndicators);
   if (s != pkm::Status::Ok) {
     ctx.log.error("GetEventIndicators: not defined at t = %.17g: %s", absolute_time(ctx), pkm::status_name(s));
     return Status::Error;
@@ -481,8 +480,8 @@ bool PlantData::load(StateReader& r, Context& ctx) {
   const pkm::EnergyIntegrals e{r.f64(), r.f64()};
   const unsigned stops = r.u32();
   if (!r.ok()) return false;
-  if ((stops >> pkm::kStopIndicators) || (stops & (stops >> 4) & 0xFu)) {
-    ctx.log.error("SetFMUState: malformed FMU state (end-stop record %#x, the contact mode, names no stop or both stops of a leg)", stops);
+  if (stops & ~pkm::kContactModeBits) {  // the rest of its consistency: Plant::restore
+    ctx.log.error("SetFMUState: malformed FMU state (end-stop record %#x: no contact mode)", stops);
     return false;
   }
   // The plant, with its solver's objects, is kept when the restored

@@ -31,7 +31,7 @@ inline Status located_cvode_advance(CvodeIntegrator& cvode, double t_end, Vec10&
   for (;;) {
     double t_reached = t_end;
     bool root = false;
-    int dirs[kStopIndicators] = {};
+    int dirs[kContactIndicators] = {};
     s = cvode.advance(t_end, x, t_reached, root, dirs);
     if (s != Status::Ok || !root) break;
     stops = stops_after_crossings(stops, dirs);

@@ -55,14 +55,15 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
     error_ = "the state derivative at the initial state is not finite (initial velocity too large?)";
     return Status::NonFinite;
   }
-  Vec4 rho;
+  Vec4 rho, rhod;
   s = pkm::actuator_positions(model_, pose, rho);
   if (s != Status::Ok) return s;
+  for (int i = 0; i < kLegs; ++i) rhod[i] = qd[leg_offset(i)];
   s = prepare_cvode();
   if (s != Status::Ok) return s;
   y_ = y;
   rho_valid_ = false;
-  stops_ = stops_after_event(model_.p, rho, 0u);
+  stops_ = stops_after_event(model_.p, rho, rhod, 0u);
   t_ = t0;
   energy_ = EnergyIntegrals{};
   for (int i = 0; i < kLegs; ++i) theta1_.ref[i] = q[leg_offset(i) + 1];
@@ -77,9 +78,12 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
 }
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned stops) {
-  if (stops != ~0u && ((stops >> kStopIndicators) != 0u || (stops & (stops >> kLegs) & ((1u << kLegs) - 1u)) != 0u)) {
-    char buf[120];
-    std::snprintf(buf, sizeof buf, "the contact mode %#x names no stop or both stops of one leg", stops);
+  const unsigned legs_held = (stops | (stops >> kLegs)) & ((1u << kLegs) - 1u);
+  if (stops != ~0u && ((stops & ~kContactModeBits) != 0u || (stops & (stops >> kLegs) & ((1u << kLegs) - 1u)) != 0u ||
+                       ((stops >> (2 * kLegs)) & ~legs_held) != 0u)) {
+    char buf[140];
+    std::snprintf(buf, sizeof buf,
+                  "the contact mode %#x names no stop, both stops of one leg or the clamp of a stop not held", stops);
     error_ = buf;
     return Status::InvalidArgument;
   }
@@ -112,8 +116,12 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned 
   t_ = t;
   y_ = y;
   rho_valid_ = false;
-  Vec4 rho;
-  stops_ = stops != ~0u ? stops : (actuator_positions(rho) == Status::Ok ? stops_after_event(model_.p, rho, 0u) : 0u);
+  Vec4 rho, rhod;
+  for (int i = 0; i < kLegs; ++i) {
+    rho[i] = q[leg_offset(i)];
+    rhod[i] = qd[leg_offset(i)];
+  }
+  stops_ = stops != ~0u ? stops : stops_after_event(model_.p, rho, rhod, 0u);
   theta1_.ref = theta1_ref;
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
@@ -151,10 +159,10 @@ Status Plant::derivative_now(const InputSignal& inputs, Vec10& xdot) const {
 Status Plant::update_stops(unsigned& switched) {
   switched = 0;
   if (!initialized_) return Status::NotInitialized;
-  Vec4 rho;
-  const Status s = actuator_positions(rho);
+  Vec4 rho, rhod;
+  const Status s = joint_motion(y_, rho, rhod);
   if (s != Status::Ok) return s;
-  const unsigned now = stops_after_event(model_.p, rho, stops_);
+  const unsigned now = stops_after_event(model_.p, rho, rhod, stops_);
   switched = now ^ stops_;
   stops_ = now;
   return Status::Ok;
@@ -170,6 +178,25 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const Ene
   energy_ = e;
   const Status s = restore(t, y, theta1_ref, stops);
   if (s != Status::Ok) energy_ = keep;
+  return s;
+}
+
+Status Plant::joint_motion(const Vec8& y, Vec4& rho, Vec4& rhod) const {
+  Vec16 q, qd;
+  const Status s = expand_state(model_, y, q, qd);
+  if (s != Status::Ok) return s;
+  for (int i = 0; i < kLegs; ++i) {
+    rho[i] = q[leg_offset(i)];
+    rhod[i] = qd[leg_offset(i)];
+  }
+  return Status::Ok;
+}
+
+Status Plant::contact_indicators(double z[kContactIndicators]) const {
+  if (!initialized_) return Status::NotInitialized;
+  Vec4 rho, rhod;
+  const Status s = joint_motion(y_, rho, rhod);
+  if (s == Status::Ok) pkm::contact_indicators(model_.p, rho, rhod, stops_, z);
   return s;
 }
 

@@ -45,6 +45,8 @@ struct MachineOutputs {
   /// Event indicators (end_stops.hpp): rho_i - rho_min, then rho_max - rho_i,
   /// each offset by the hysteresis under the contact mode.
   double stop_indicators[kStopIndicators] = {};
+  /// Then the clamps' (end_stops.hpp's clamp_indicators).
+  double clamp_indicators[kLegs] = {};
 };
 
 class Plant {
@@ -102,6 +104,9 @@ class Plant {
   /// rule (stops_after_event) at the current state; returns the stops
   /// switched (Unreachable off the workspace: nothing changes).
   Status update_stops(unsigned& switched);
+  /// The contact mode's event indicators at the current state
+  /// (end_stops.hpp's contact_indicators, under stops()).
+  Status contact_indicators(double z[kContactIndicators]) const;
 
   /// The running energy integrals (zero at initialize()).
   const EnergyIntegrals& energy_integrals() const { return energy_; }
@@ -167,14 +172,14 @@ class Plant {
   /// Exchange's); *inputs_fault tells a NonFinite caused by the inputs.
   Status machine_rates(const InputSignal& inputs, double t, const Vec10& x, unsigned stops, Vec10& xdot,
                        bool* inputs_fault = nullptr) const;
+  /// rho and rhod at the state y (closed form).
+  Status joint_motion(const Vec8& y, Vec4& rho, Vec4& rhod) const;
   Vec10 packed() const;
   void unpack(const Vec10& x);
-  /// The contact mode at x (located_rk4.hpp): the stops the event rule
-  /// switches on from the held ones (stops_) at the pose x.head<4>() and,
-  /// bit 8 + i, leg i's stop passed but released (its
-  /// spring and damper would pull: a kink in the force that RK4 should not
-  /// step across either); ~0u if unreachable. rho receives the actuator
-  /// positions there (valid unless ~0u).
+  /// The contact mode at x (located_rk4.hpp): the event rule
+  /// (stops_after_event) from the held mode (stops_) at x, the clamps
+  /// included; ~0u if unreachable. rho receives the actuator positions
+  /// there (valid unless ~0u).
   unsigned contact_mode(const Vec10& x, Vec4& rho) const;
   /// The same with rho, the actuator positions at x, known.
   unsigned contact_mode_at(const Vec10& x, const Vec4& rho) const;

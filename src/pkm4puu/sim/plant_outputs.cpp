@@ -59,7 +59,10 @@ Status Plant::machine_outputs(const InputSignal& inputs, MachineOutputs& out) co
   out.dissipated_energy = energy_.dissipated;
   energy_rates(p, stops_, F + model_.drive_ratio * tau, we, y_.tail<4>(), out.rho, out.rhod,
                out.actuator_power, out.dissipation_rate);
-  stop_indicators(p, out.rho, stops_, out.stop_indicators);
+  double z[kContactIndicators];
+  pkm::contact_indicators(p, out.rho, out.rhod, stops_, z);
+  for (int k = 0; k < kStopIndicators; ++k) out.stop_indicators[k] = z[k];
+  for (int i = 0; i < kLegs; ++i) out.clamp_indicators[i] = z[kStopIndicators + i];
   return Status::Ok;
 }
 

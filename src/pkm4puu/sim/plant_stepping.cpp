@@ -22,7 +22,7 @@ struct PlantOde {
 Status Plant::prepare_cvode() {
   if (settings_.solver != Solver::Cvode || cvode_ready_) return Status::Ok;
   const Status s = cvode_.init(settings_.cvode_method, settings_.rtol, settings_.atol, &Plant::cvode_rhs, this,
-                               kStopIndicators, &Plant::cvode_roots);
+                               kContactIndicators, &Plant::cvode_roots);
   if (s != Status::Ok) {
     error_ = "CVODE could not be set up: " + cvode_.last_error();
     return s == Status::InvalidArgument ? s : Status::SolverFailure;
@@ -37,22 +37,23 @@ unsigned Plant::contact_mode(const Vec10& x, Vec4& rho) const {
 }
 
 unsigned Plant::contact_mode_at(const Vec10& x, const Vec4& rho) const {
-  unsigned mode = stops_after_event(model_.p, rho, stops_);
-  if (mode == 0) return mode;
-  Vec16 q, qd;  // the joint rates tell a released stop
-  if (expand_state(model_, x.head<8>(), q, qd) != Status::Ok) return ~0u;
-  for (int i = 0; i < kLegs; ++i) {
-    const StopContact c = stop_contact(model_.p, i, mode, rho[i], qd[leg_offset(i)]);
-    if (c.depth > 0.0 && c.force == 0.0) mode |= 1u << (2 * kLegs + i);
-  }
-  return mode;
+  // The stops first (rho only): the joint rates matter only to a held stop's clamp.
+  const Vec4 at_rest = Vec4::Zero();
+  if ((stops_after_event(model_.p, rho, at_rest, stops_) & ((1u << kStopIndicators) - 1u)) == 0u) return 0u;
+  Vec4 rho_x, rhod;
+  if (joint_motion(x.head<8>(), rho_x, rhod) != Status::Ok) return ~0u;
+  return stops_after_event(model_.p, rho, rhod, stops_);
 }
 
 int Plant::cvode_roots(double t, const Vec10& x, double* g, void* self) {
   (void)t;
   const auto* me = static_cast<const Plant*>(self);
-  if (stop_indicators(me->model_, x.head<4>(), me->stops_, g) != Status::Ok)
-    for (int k = 0; k < kStopIndicators; ++k) g[k] = 1.0;  // off the workspace: the rhs reports it
+  Vec4 rho, rhod;
+  if (me->joint_motion(x.head<8>(), rho, rhod) == Status::Ok) {
+    pkm::contact_indicators(me->model_.p, rho, rhod, me->stops_, g);
+  } else {
+    for (int k = 0; k < kContactIndicators; ++k) g[k] = 1.0;  // off the workspace: the rhs reports it
+  }
   return 0;
 }
 
