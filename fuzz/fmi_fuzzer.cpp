@@ -222,47 +222,63 @@ double step_size(FuzzedDataProvider& in) {
 
 // ---------------------------------------------------------------- the world of one input
 
-struct State {
-  fmi2FMUstate s = nullptr;
-  int owner = -1;  // slot that created it
-};
-
-struct Slot {
-  int kind = 0;  // 0 plant, 1 inverse
-  fmi2Component c = nullptr;
-  double time = 0.0;  // what the harness believes the current time is
-};
-
 constexpr int kSlots = 3;
 constexpr int kMaxOps = 48;
 
-struct World {
+/// The instances and FMU states of one input, for either FMI version V
+/// (Fmi2, Fmi3 below: its Api, instance, state and byte types, and how to
+/// free an instance and a state).
+template <class V>
+struct WorldOf {
+  struct State {
+    typename V::FmuState s = nullptr;
+    int owner = -1;  // slot that created it
+  };
+  struct Slot {
+    int kind = 0;     // 0 plant, 1 inverse
+    bool me = false;  // FMI 3.0: a Model Exchange instance (FMI 2.0 tracks none)
+    typename V::Instance c = nullptr;
+    double time = 0.0;  // what the harness believes the current time is
+  };
   Slot slots[kSlots];
   std::vector<State> states;
-  std::vector<std::vector<fmi2Byte>> blobs;
+  std::vector<std::vector<typename V::Byte>> blobs;
 
-  const Api& api(int i) const { return kApis[slots[i].kind]; }
+  const typename V::Api& api(int i) const { return V::apis[slots[i].kind]; }
 
   void free_slot(int i) {
     if (!slots[i].c) return;
     ++g_calls;
-    api(i).fmi2FreeInstance(slots[i].c);  // frees the states it created
+    V::free_instance(api(i), slots[i].c);  // frees the states it created
     slots[i].c = nullptr;
     for (auto it = states.begin(); it != states.end();)
       it = (it->owner == i) ? states.erase(it) : it + 1;
   }
-  ~World() {
-    // Free every other state explicitly, leave the rest to fmi2FreeInstance.
+  ~WorldOf() {
+    // Free every other state explicitly, leave the rest to FreeInstance.
     for (std::size_t k = 0; k < states.size(); k += 2) {
       State& st = states[k];
       if (slots[st.owner].c) {
         ++g_calls;
-        api(st.owner).fmi2FreeFMUstate(slots[st.owner].c, &st.s);
+        V::free_state(api(st.owner), slots[st.owner].c, &st.s);
       }
     }
     for (int i = 0; i < kSlots; ++i) free_slot(i);
   }
 };
+
+struct Fmi2 {
+  using Api = ::Api;
+  using Instance = fmi2Component;
+  using FmuState = fmi2FMUstate;
+  using Byte = fmi2Byte;
+  static constexpr const Api* apis = kApis;
+  static void free_instance(const Api& a, Instance c) { a.fmi2FreeInstance(c); }
+  static void free_state(const Api& a, Instance c, FmuState* s) { a.fmi2FreeFMUstate(c, s); }
+};
+using World = WorldOf<Fmi2>;
+using State = World::State;
+using Slot = World::Slot;
 
 fmi2Component component(FuzzedDataProvider& in, World& w, int i) {
   switch (in.ConsumeIntegralInRange<int>(0, 31)) {
@@ -684,43 +700,18 @@ void logger3(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category
   (void)n;
 }
 
-struct Slot3 {
-  int kind = 0;  // 0 plant, 1 inverse
-  bool me = false;  // Model Exchange (else Co-Simulation)
-  fmi3Instance c = nullptr;
-  double time = 0.0;
+struct Fmi3 {
+  using Api = Api3;
+  using Instance = fmi3Instance;
+  using FmuState = fmi3FMUState;
+  using Byte = fmi3Byte;
+  static constexpr const Api* apis = kApis3;
+  static void free_instance(const Api& a, Instance c) { a.fmi3FreeInstance(c); }
+  static void free_state(const Api& a, Instance c, FmuState* s) { a.fmi3FreeFMUState(c, s); }
 };
-
-struct State3 {
-  fmi3FMUState s = nullptr;
-  int owner = -1;
-};
-
-struct World3 {
-  Slot3 slots[kSlots];
-  std::vector<State3> states;
-  std::vector<std::vector<fmi3Byte>> blobs;
-
-  const Api3& api(int i) const { return kApis3[slots[i].kind]; }
-  void free_slot(int i) {
-    if (!slots[i].c) return;
-    ++g_calls;
-    api(i).fmi3FreeInstance(slots[i].c);
-    slots[i].c = nullptr;
-    for (auto it = states.begin(); it != states.end();)
-      it = (it->owner == i) ? states.erase(it) : it + 1;
-  }
-  ~World3() {
-    for (std::size_t k = 0; k < states.size(); k += 2) {
-      State3& st = states[k];
-      if (slots[st.owner].c) {
-        ++g_calls;
-        api(st.owner).fmi3FreeFMUState(slots[st.owner].c, &st.s);
-      }
-    }
-    for (int i = 0; i < kSlots; ++i) free_slot(i);
-  }
-};
+using World3 = WorldOf<Fmi3>;
+using Slot3 = World3::Slot;
+using State3 = World3::State;
 
 fmi3Instance instance3(FuzzedDataProvider& in, World3& w, int i) {
   switch (in.ConsumeIntegralInRange<int>(0, 31)) {
