@@ -352,6 +352,9 @@ TEST(ModelExchange, EndStopContactsChangeInEventModeOnly) {
   EXPECT_GT(expected, 9.0);
   const double contact_below = me.derivatives()[6];
   EXPECT_GT(contact_below - free_below, 1.0) << "four stops pushing up at about 10 N each";
+  std::printf("  der(dz) across the stops by SetContinuousStates: %.3g m/s^2 (contact frozen); at the event: %.4g "
+              "m/s^2, stop_force %.6g N each\n",
+              free_below - free_above, contact_below - free_below, expected);
   for (double z : me.stop_indicators()) EXPECT_NE(z, 0.0);
 
   me.set_states(above);  // back above the stops: still in contact until Event Mode
