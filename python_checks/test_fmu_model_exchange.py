@@ -156,3 +156,121 @@ def test_guard_crossing_is_an_event_the_importer_locates(case, archive, request,
         assert k * H <= t_event < (k + 1) * H, f"Co-Simulation stopped in [{k * H}, {(k + 1) * H}], ME at {t_event}"
     print(f"\n{archive}, {case} guard: event at t = {t_event:.9f} s, "
           f"{INDICATORS[crossed]} = {z[-1, crossed]:.2g}; Co-Simulation discards the step [{k * H:.3f}, {(k + 1) * H:.3f}]")
+
+
+# --- a drop onto the lower end stops: bounces located by the importer -----------
+# The platform starts at the home pose moving down at 1 m/s, each slider
+# pushed down by its actuator with 5 N: it hits the lower stops (rho_min) at
+# about 1.9 m/s and bounces on their springs and dampers (stop_stiffness
+# 1e5 N/m, stop_damping 100 N s/m: damping ratio about 0.3 against a quarter
+# of the moving mass) until it rests on them. x, y and phi stay 0: the four
+# legs move alike and the mechanism translates along z (sliders, rods and
+# platform rigidly, dz = drho_i), so its motion is that of one mass
+# M = m_platform + 4 (m_slider + m_rod) on four stops. The expected switches
+# come from that one-mass model, solved here independently of the FMU:
+# flight; contact (spring and damper k delta + d delta_dot); clamped (that
+# force would pull: none) until it pushes again or the depth
+# delta = rho_min - rho returns to 0.
+# The actuators push down (rather than letting the platform fall under
+# gravity alone) to keep the flights short: an error du in a rebound speed
+# moves the next impact by 2 du / a, a the net deceleration; at a = g the
+# importer's own CVode error at rtol 1e-10 (1e-11 s on the first impact,
+# growing through each contact) reaches 2.3e-9 s by the fourth impact
+# (measured against rtol 1e-13), beyond what a comparison to 1e-9 s can
+# tell from the Co-Simulation's; at a = 28 m/s^2 it stays below 7e-10 s.
+DROP_F = -5.0  # N per slider
+DROP = {**{name: DROP_F for name in F}, "dz0": -1.0}
+DROP_STOP = 0.3  # s: the model's last switch is at 0.133 s, sustained contact after
+STOPS_LOWER = indexed_names("stop_margin_lower", 4)
+EVENT_TOL = 1e-9  # s: ME against CS event times
+DROP_TOL = 1e-7  # m: ME against CS trajectory
+
+
+def one_mass_switches(depth0, p):
+    """(time, 'passes' | 'leaves') of the one-mass model from depth `depth0`
+    (< 0: above the stops) at the speed -dz0 into them, to DROP_STOP, with
+    the plant's parameters p; and whether it ends at rest on the stops."""
+    from scipy.integrate import solve_ivp
+    m = (p["m_platform"] + 4 * (p["m_slider"] + p["m_rod"])) / 4  # per stop
+    w = m * p["g"] - DROP_F  # net force into the stop, per slider
+    k, d = p["stop_stiffness"], p["stop_damping"]
+    push = lambda t, y: k * y[0] + d * y[1]
+    depth = lambda t, y: y[0]
+    laws = {"flight": lambda t, y: [y[1], w / m], "contact": lambda t, y: [y[1], (w - push(t, y)) / m]}
+    laws["clamped"] = laws["flight"]
+    # phase: (its law, [(indicator, direction, next phase)])
+    phases = {"flight": [(depth, 1, "contact")], "contact": [(push, -1, "clamped")],
+              "clamped": [(push, 1, "contact"), (depth, -1, "flight")]}
+    t, y, phase, out = 0.0, [depth0, -DROP["dz0"]], "flight", []
+    while True:
+        events = []
+        for g, direction, _ in phases[phase]:
+            e = lambda t, y, g=g: g(t, y)
+            e.terminal, e.direction = True, direction
+            events.append(e)
+        s = solve_ivp(laws[phase], (t, DROP_STOP), y, events=events, rtol=1e-13, atol=1e-16, method="DOP853")
+        hits = [j for j in range(len(events)) if s.t_events[j].size]
+        if not hits:
+            return out, phase != "flight"
+        j = min(hits, key=lambda j: s.t_events[j][0])
+        t, y = s.t_events[j][0], list(s.y_events[j][0])
+        nxt = phases[phase][j][2]
+        if phase == "flight" or nxt == "flight":
+            out.append((t, "passes" if phase == "flight" else "leaves"))
+        phase = nxt
+
+
+@pytest.mark.parametrize("archive", ["plant_fmu", "plant_fmu3"])
+def test_drop_onto_the_end_stops_bounces_located_as_in_co_simulation(archive, request, capfd):
+    """fmpy's CVode at rtol 1e-10 through Model Exchange: no solver failure,
+    every switch of the stops a state event (the FMU logs each one in Event
+    Mode), as many as the one-mass model predicts; the event times within
+    1e-9 s and z within 1e-7 m of the Co-Simulation FMU's CVODE at rtol 1e-10."""
+    import re
+    path = request.getfixturevalue(archive)
+    names = ["m_platform", "m_slider", "m_rod", "g", "stop_stiffness", "stop_damping", "rho_min", "rho[1]"]
+    with Fmu(path, start=DROP) as fmu:
+        p = dict(zip(names, fmu.get(names)))
+    expected, resting = one_mass_switches(p["rho_min"] - p["rho[1]"], p)
+    assert resting and len(expected) >= 6, f"the drop should bounce several times and come to rest: {expected}"
+    assert expected[-1][0] < DROP_STOP - 0.1
+
+    r = simulate_fmu(str(path), fmi_type="ModelExchange", solver="CVode", relative_tolerance=1e-10,
+                     stop_time=DROP_STOP, set_stop_time=False,  # test_fmu_flavours.py: why
+                     output_interval=H, start_values=DROP, output=["z"] + STOPS_LOWER,
+                     record_events=False, debug_logging=True)
+    log = capfd.readouterr().out
+    assert r["time"][-1] == pytest.approx(DROP_STOP), "the importer's integration stopped early"
+    # The FMU's Event Mode log: "event at t = ...: slider i passes|leaves its lower end stop".
+    found = re.findall(r"event at t = ([-+0-9.eE]+): slider (\d) (passes|leaves) its (\w+) end stop", log)
+    assert all(side == "lower" for *_, side in found)
+    per_leg = {i: [(float(t), what) for t, leg, what, _ in found if int(leg) == i] for i in range(1, 5)}
+    for i in range(1, 5):
+        assert [w for _, w in per_leg[i]] == [w for _, w in expected], f"slider {i}: {per_leg[i]} vs {expected}"
+    me_times = np.array([t for t, _ in per_leg[1]])
+    model_dt = np.abs(me_times - np.array([t for t, _ in expected])).max()
+    legs_dt = max(np.abs(np.array([t for t, _ in per_leg[i]]) - me_times).max() for i in range(2, 5))
+
+    # Co-Simulation: communication points on the grid and 1e-9 s either side
+    # of each event fmpy located; the stops' mode (the sign of their
+    # indicators: negative while held) must switch between the two.
+    grid = np.arange(round(DROP_STOP / H) + 1) * H
+    probes = np.concatenate([me_times - EVENT_TOL, me_times + EVENT_TOL])
+    times = np.unique(np.concatenate([grid, probes]))
+    cs = {}
+    with Fmu(path, start=dict(DROP, rtol=1e-10, atol=1e-12)) as fmu:
+        for t0, t1 in zip(times[:-1], times[1:]):
+            fmu.do_step(t0, t1 - t0)
+            cs[t1] = fmu.get(["z"] + STOPS_LOWER)
+    for k, (t, what) in enumerate(per_leg[1]):
+        held_before = [z < 0 for z in cs[t - EVENT_TOL][1:]]
+        held_after = [z < 0 for z in cs[t + EVENT_TOL][1:]]
+        assert held_before == [what == "leaves"] * 4 and held_after == [what == "passes"] * 4, \
+            f"event {k} ({what}) at t = {t:.12f}: CS held {held_before} before, {held_after} after"
+    assert np.array_equal(r["time"], grid)
+    dz = np.abs(np.array([row["z"] for row in r])[1:] - np.array([cs[t][0] for t in grid[1:]])).max()
+    print(f"\n{archive}: {len(expected)} switches per slider as the one-mass model's (within {model_dt:.2g} s), "
+          f"the legs' within {legs_dt:.2g} s of each other; CS switches within {EVENT_TOL:g} s of each; "
+          f"|z_ME - z_CS| {dz:.3g} m")
+    assert dz < DROP_TOL
+    assert model_dt < 1e-7, "the mechanism's drop is the one-mass model's"

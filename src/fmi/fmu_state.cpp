@@ -15,7 +15,8 @@ namespace {
 
 constexpr std::uint64_t kStateTag = 0x53324d464d4b5002ull;  // marks a live SavedState
 constexpr unsigned char kMagic[8] = {'P', 'K', 'M', 'F', 'M', 'U', 'S', 'T'};
-constexpr std::uint32_t kFormatVersion = 4;  // 3: the plant's energy integrals and end-stop contacts; 4: elapsed
+constexpr std::uint32_t kFormatVersion = 5;  // 3: the plant's energy integrals and end-stop contacts; 4: elapsed
+// time; 5: the plant's end-stop record is its contact mode (held between events, hysteresis)
 constexpr std::size_t kHeaderSize = 32;
 constexpr std::size_t kTrailerSize = 8;
 

@@ -151,6 +151,12 @@ constexpr std::uint32_t allowed_states(Call c, int fmi_version) {
   return fmi_version == 2 ? call_rule(c).v2 : call_rule(c).v3;
 }
 
+/// Continuous states set by value reference (fmi2SetReal, fmi3SetFloat64),
+/// a case of Call::Set: in Model Exchange's Event and Continuous-Time Modes
+/// (FMI 2.0.4's state table, footnote on fmi2SetReal since 2.0.1; FMI 3.0.2
+/// 3.2.1 and 2.3.5).
+constexpr std::uint32_t kSetStatesByReference = kEventMode | kContinuousTimeMode;
+
 // States an FMU state may carry (the others are unrecoverable).
 constexpr std::uint32_t kRestorableModes = kAlive;
 

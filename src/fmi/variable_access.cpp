@@ -2,6 +2,7 @@
 // Get and set through the variable table.
 #include <cmath>
 #include <type_traits>
+#include <vector>
 
 #include "fmi/instance.hpp"
 #include "fmi/state_machine.hpp"
@@ -75,11 +76,19 @@ Status Instance::set_values(const char* function, VarType type, const std::uint3
     log_.error("%s: NULL value reference or value array", function);
     return Status::Error;
   }
+  // Continuous states (the outputs that are states) are set by value
+  // reference in Model Exchange's Event and Continuous-Time Modes, as
+  // SetContinuousStates sets them (FMI 2.0.4 state table, footnote on
+  // fmi2SetReal; FMI 3.0.2 §3.2.1, §2.3.5), and nowhere else.
+  const bool states_settable = interface_ == Interface::ModelExchange && (mode_ & kSetStatesByReference);
+  bool sets_states = false;
   // Check everything first: a rejected call changes nothing.
   for (std::size_t k = 0; k < n; ++k) {
     const Variable* v = lookup(function, type, vr[k]);
     if (!v) return Status::Error;
-    if (!v->stored_in_state() || v->variability == Variability::Constant || !v->value) {
+    const bool as_state = states_settable && v->state >= 0 && v->value;
+    sets_states = sets_states || as_state;
+    if (!as_state && (!v->stored_in_state() || v->variability == Variability::Constant || !v->value)) {
       log_.error("%s: %s (value reference %u) is a %s %s variable and cannot be set", function, v->name,
                  static_cast<unsigned>(v->vr), xml_name(v->variability), xml_name(v->causality));
       return Status::Error;
@@ -101,8 +110,26 @@ Status Instance::set_values(const char* function, VarType type, const std::uint3
       return Status::Error;
     }
   }
+  Context ctx = context();
+  if (sets_states) {  // all at once, as SetContinuousStates: refused (Discard, Error) with nothing changed
+    double fixed[32];  // no allocation for the models' few states
+    std::vector<double> more(def_.n_states > 32 ? def_.n_states : 0);
+    double* x = more.empty() ? fixed : more.data();
+    Status s = data_->get_states(ctx, x);
+    for (std::size_t k = 0; k < n && s == Status::OK; ++k) {
+      const Variable* v = def_.find(vr[k]);
+      if (v->state >= 0) x[static_cast<std::size_t>(v->state)] = static_cast<double>(value[k]);
+    }
+    if (s == Status::OK) s = data_->set_states(ctx, x);
+    valid_groups_ = 0;
+    if (s != Status::OK) return s;
+  }
   for (std::size_t k = 0; k < n; ++k) {
     const Variable* v = def_.find(vr[k]);
+    if (sets_states && v->state >= 0) {
+      if (log_.enabled(LogCategory::Calls)) log_.call("%s: %s = %.17g (state)", function, v->name, static_cast<double>(value[k]));
+      continue;
+    }
     void* p = v->value(*data_, v->index);
     if (type == VarType::Boolean) {
       *static_cast<T*>(p) = value[k] != 0 ? 1 : 0;

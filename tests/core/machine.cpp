@@ -476,7 +476,7 @@ TEST(MachineStops, DropOntoTheLowerStopsComesToRestWithinTheDerivedBound) {
 TEST(MachineStops, IndicatorsAndStopForcesAtAnArbitraryState) {
   const Model m = default_model();
   double g[kStopIndicators];
-  ASSERT_EQ(stop_indicators(m, Pose(0, 0, 0.05, 0), g), Status::Ok);
+  ASSERT_EQ(stop_indicators(m, Pose(0, 0, 0.05, 0), kStopsFromState, g), Status::Ok);
   for (int i = 0; i < 4; ++i) {
     EXPECT_NEAR(g[i], 0.0443193423, 1e-10);
     EXPECT_NEAR(g[4 + i], 0.15 - 0.0443193423, 1e-10);

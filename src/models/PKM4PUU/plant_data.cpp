@@ -78,15 +78,9 @@ Status PlantData::build(Context& ctx, const char* function) {
   }
   plant = std::move(p);
   contact_events = plant->contact_events();
-  logged_stops = stops_passed_now();
+  logged_stops = plant->stops();
   may_continue = false;
   return Status::OK;
-}
-
-unsigned PlantData::stops_passed_now() const {
-  pkm::Vec4 rho;
-  if (plant->actuator_positions(rho) != pkm::Status::Ok) return 0;
-  return pkm::stops_passed(plant->model().p, rho);
 }
 
 void PlantData::log_stop_changes(Context& ctx, unsigned now, const char* where) {
@@ -155,7 +149,7 @@ Status PlantData::do_step(Context& ctx, double t, double h, double& t_reached) {
   if (plant->contact_events() != contact_events) {
     contact_events = plant->contact_events();
     // Also with logEvents off: the record of the stops passed stays current.
-    log_stop_changes(ctx, stops_passed_now(), "DoStep");
+    log_stop_changes(ctx, plant->stops(), "DoStep");
   }
   switch (s) {
     case pkm::Status::Ok:
@@ -277,6 +271,7 @@ Status PlantData::update_outputs(Context& ctx, unsigned groups) {
     dy[8] = mo.actuator_power;
     dy[9] = mo.dissipation_rate;
     for (int k = 0; k < pkm::kStopIndicators; ++k) z[pkm::kGuardIndicators + k] = mo.stop_indicators[k];
+    for (int i = 0; i < 4; ++i) z[pkm::kGuardIndicators + pkm::kStopIndicators + i] = mo.clamp_indicators[i];
     for (const double* block : {F_hold, stop_force}) all_finite(block, 4);
     for (double v : {kinetic, potential, dy[8], dy[9]}) finite = finite && std::isfinite(v);
   }
@@ -364,7 +359,7 @@ Status PlantData::partial_derivatives(Context& ctx, const Variable* const unknow
   pkm::Mat8x12 B;
   pkm::JointJacobians joints;
   const pkm::Status s =
-      pkm::state_derivative_jacobians(plant->model(), y, F, tau, we, pkm::kStopsFromState, ydot, A, B, &joints);
+      pkm::state_derivative_jacobians(plant->model(), y, F, tau, we, plant->stops(), ydot, A, B, &joints);
   if (s != pkm::Status::Ok) {
     ctx.log.error("%s: the derivatives at t = %.17g cannot be evaluated: %s", fn, plant->time(), pkm::status_name(s));
     return Status::Error;
@@ -392,7 +387,7 @@ Status PlantData::partial_derivatives(Context& ctx, const Variable* const unknow
       row.segment<4>(kStates + 8) = plant->model().drive_ratio * rhod.transpose();
     } else if (v.state_of == 9) {  // der(dissipated_energy): sum over the joints
       for (int l = 0; l < 4; ++l) {
-        const pkm::PassiveSlopes d = pkm::dissipated_power_slopes(plant->model().p, l, pkm::kStopsFromState, rho[l], rhod[l]);
+        const pkm::PassiveSlopes d = pkm::dissipated_power_slopes(plant->model().p, l, plant->stops(), rho[l], rhod[l]);
         row.head<4>() += d.drho * joints.J_rho.row(l) + d.drhod * joints.drhod_dp.row(l);
         row.segment<4>(4) += d.drhod * joints.J_rho.row(l);
       }
@@ -420,9 +415,8 @@ Status PlantData::partial_derivatives(Context& ctx, const Variable* const unknow
 Status PlantData::get_event_indicators(Context& ctx, double z[]) {
   const Status st = ready(ctx, "GetEventIndicators");
   if (st != Status::OK) return st;
-  const pkm::Pose pose_now = plant->state().head<4>();
-  pkm::Status s = pkm::guard_indicators(plant->model(), pose_now, plant->solver().limits(), z);
-  if (s == pkm::Status::Ok) s = pkm::stop_indicators(plant->model(), pose_now, z + pkm::kGuardIndicators);
+  pkm::Status s = pkm::guard_indicators(plant->model(), plant->state().head<4>(), plant->solver().limits(), z);
+  if (s == pkm::Status::Ok) s = plant->contact_indicators(z + pkm::kGuardIndicators);
   if (s != pkm::Status::Ok) {
     ctx.log.error("GetEventIndicators: not defined at t = %.17g: %s", absolute_time(ctx), pkm::status_name(s));
     return Status::Error;
@@ -432,13 +426,23 @@ Status PlantData::get_event_indicators(Context& ctx, double z[]) {
 
 Status PlantData::event_update(Context& ctx, bool& terminate) {
   terminate = false;
+  const Status ready_st = ready(ctx, "NewDiscreteStates");
+  if (ready_st != Status::OK) return ready_st;
+  // The relations change here and only here (FMI 2.0.4 §3.2.2, FMI 3.0.2
+  // §3.1.1): the contact mode by the event rule, after which every stop
+  // indicator is nonzero and consistent (end_stops.hpp, kStopHysteresis),
+  // so one iteration suffices.
+  unsigned switched = 0;
+  const pkm::Status us = plant->update_stops(switched);
+  if (us != pkm::Status::Ok) {
+    ctx.log.error("event at t = %.17g: the end stops cannot be evaluated: %s", absolute_time(ctx),
+                  pkm::status_name(us));
+    return Status::Error;
+  }
+  log_stop_changes(ctx, plant->stops(), "event");
   double z[kIndicators];
   const Status st = get_event_indicators(ctx, z);
   if (st != Status::OK) return st;
-  unsigned beyond = 0;
-  for (int k = 0; k < pkm::kStopIndicators; ++k)
-    if (z[pkm::kGuardIndicators + k] < 0.0) beyond |= 1u << k;
-  log_stop_changes(ctx, beyond, "event");
   for (int k = 0; k < pkm::kGuardIndicators; ++k) {
     if (z[k] > 0.0) continue;
     terminate = true;
@@ -467,7 +471,7 @@ void PlantData::save(StateWriter& w) const {
   w.f64s(plant->theta1_ref().data(), plant->theta1_ref().data() + 4);
   w.f64(plant->energy_integrals().actuator_work);
   w.f64(plant->energy_integrals().dissipated);
-  w.u32(logged_stops);
+  w.u32(plant->stops());  // the contact mode: part of the hybrid state
 }
 
 bool PlantData::load(StateReader& r, Context& ctx) {
@@ -481,10 +485,10 @@ bool PlantData::load(StateReader& r, Context& ctx) {
   r.f64s(y.data(), y.data() + 8);
   r.f64s(ref.data(), ref.data() + 4);
   const pkm::EnergyIntegrals e{r.f64(), r.f64()};
-  const unsigned beyond = r.u32();
+  const unsigned stops = r.u32();
   if (!r.ok()) return false;
-  if (beyond >> pkm::kStopIndicators) {
-    ctx.log.error("SetFMUState: malformed FMU state (end-stop record %#x names no stop)", beyond);
+  if (stops & ~pkm::kContactModeBits) {  // the rest of its consistency: Plant::restore
+    ctx.log.error("SetFMUState: malformed FMU state (end-stop record %#x: no contact mode)", stops);
     return false;
   }
   // The plant, with its solver's objects, is kept when the restored
@@ -496,7 +500,7 @@ bool PlantData::load(StateReader& r, Context& ctx) {
   std::unique_ptr<pkm::Plant> fresh;
   if (!built_from(model, settings) && make_plant(ctx, "SetFMUState", fresh) != Status::OK) return false;
   pkm::Plant& p = fresh ? *fresh : *plant;
-  const pkm::Status s = p.restore(t, y, ref, e);
+  const pkm::Status s = p.restore(t, y, ref, e, stops);
   if (s != pkm::Status::Ok) {
     ctx.log.error("SetFMUState: the saved state at t = %.17g cannot be restored: %s%s%s", t, pkm::status_name(s),
                   p.last_error().empty() ? "" : ": ", p.last_error().c_str());
@@ -504,7 +508,7 @@ bool PlantData::load(StateReader& r, Context& ctx) {
   }
   if (fresh) plant = std::move(fresh);
   contact_events = plant->contact_events();  // the count continues from here
-  logged_stops = beyond;
+  logged_stops = stops;
   may_continue = false;  // the integrator restarts here, as the original run does after saving
   return true;
 }

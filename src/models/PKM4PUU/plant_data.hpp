@@ -58,7 +58,7 @@ namespace pkm4puu_model {
 
 constexpr pkm::SolverSettings kDefaultSolver{};
 constexpr int kStates = 10;  // pose, velocity, actuator_work, dissipated_energy
-constexpr int kIndicators = pkm::kGuardIndicators + pkm::kStopIndicators;
+constexpr int kIndicators = pkm::kGuardIndicators + pkm::kContactIndicators;
 constexpr int kInputs = 12;  // F[1..4], Fe[1..3], Me_z, tau[1..4]
 // MODEL_SPEC "A check anyone can derive": each actuator's share of the
 // weight at the default initial pose, the start value of F[1..4] (so that a
@@ -105,9 +105,9 @@ struct PlantData final : MechanismData {
   double kinetic = 0.0, potential = 0.0;
   double energy[2] = {};  // actuator_work, dissipated_energy (states)
   double dy[kStates] = {};  // der(x) .. der(dphi), der(actuator_work), der(dissipated_energy)
-  double z[kIndicators] = {};  // the event indicators: guards, then end stops
-  // Model Exchange: the stops passed at the last event (end_stops.hpp's
-  // contact mode), to log contacts and releases.
+  double z[kIndicators] = {};  // the event indicators: guards, then end stops, then their clamps
+  // The contact mode last logged (the Plant's, end_stops.hpp), to log
+  // contacts and releases.
   unsigned logged_stops = 0;
   // Co-Simulation: end-stop events located so far (logged per step).
   long contact_events = 0;
@@ -156,8 +156,6 @@ struct PlantData final : MechanismData {
   /// The plant, built from the current parameters in initialisation mode.
   Status ready(Context& ctx, const char* function);
   pkm::LinearInputs inputs(double t0) const;
-  /// The stops passed now (end_stops.hpp's contact mode; bit k: indicator k < 0).
-  unsigned stops_passed_now() const;
   /// Logs (logEvents) each stop passed or left since the last call.
   void log_stop_changes(Context& ctx, unsigned now, const char* where);
 };

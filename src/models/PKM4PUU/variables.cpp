@@ -123,7 +123,7 @@ constexpr Variable kVariables[] = {
   event_indicator(72, "guard_leg_margin[2]", "", "The same for leg 2", PLANT(z), 2, 2, kOnPositions, kGroupHealth),
   event_indicator(73, "guard_leg_margin[3]", "", "The same for leg 3", PLANT(z), 3, 3, kOnPositions, kGroupHealth),
   event_indicator(74, "guard_leg_margin[4]", "", "The same for leg 4", PLANT(z), 4, 4, kOnPositions, kGroupHealth),
-  event_indicator(75, "stop_margin_lower[1]", "m", "rho[1] - rho_min: event indicator of leg 1's lower end stop (negative in contact)", PLANT(z), 5, 5, kSliders, kGroupMachine),
+  event_indicator(75, "stop_margin_lower[1]", "m", "rho[1] - rho_min, +1e-12 m out of contact, -1e-12 m in contact (hysteresis): event indicator of leg 1's lower end stop (negative in contact)", PLANT(z), 5, 5, kSliders, kGroupMachine),
   event_indicator(76, "stop_margin_lower[2]", "m", "rho[2] - rho_min", PLANT(z), 6, 6, kSliders, kGroupMachine),
   event_indicator(77, "stop_margin_lower[3]", "m", "rho[3] - rho_min", PLANT(z), 7, 7, kSliders, kGroupMachine),
   event_indicator(78, "stop_margin_lower[4]", "m", "rho[4] - rho_min", PLANT(z), 8, 8, kSliders, kGroupMachine),
@@ -131,6 +131,13 @@ constexpr Variable kVariables[] = {
   event_indicator(80, "stop_margin_upper[2]", "m", "rho_max - rho[2]", PLANT(z), 10, 10, kSliders, kGroupMachine),
   event_indicator(81, "stop_margin_upper[3]", "m", "rho_max - rho[3]", PLANT(z), 11, 11, kSliders, kGroupMachine),
   event_indicator(82, "stop_margin_upper[4]", "m", "rho_max - rho[4]", PLANT(z), 12, 12, kSliders, kGroupMachine),
+  event_indicator(83, "stop_push_margin[1]", "N",
+                  "k delta + d delta_dot of leg 1's end stop in contact, +1e-9 N while it pushes, -1e-9 N while "
+                  "clamped (it would pull: no force): event indicator of the release within a contact; 1 without "
+                  "contact", PLANT(z), 13, 13, kSliders | kSliderRates, kGroupMachine),
+  event_indicator(84, "stop_push_margin[2]", "N", "The same for leg 2", PLANT(z), 14, 14, kSliders | kSliderRates, kGroupMachine),
+  event_indicator(85, "stop_push_margin[3]", "N", "The same for leg 3", PLANT(z), 15, 15, kSliders | kSliderRates, kGroupMachine),
+  event_indicator(86, "stop_push_margin[4]", "N", "The same for leg 4", PLANT(z), 16, 16, kSliders | kSliderRates, kGroupMachine),
   // Motor torques: 90..93.
   real_input(90, "tau[1]", 0.0, "N.m", "Motor torque of leg 1's drive: adds (2 pi/screw_lead) tau to F[1]", PLANT(u), 8, PLANT(du), kOnInputs),
   real_input(91, "tau[2]", 0.0, "N.m", "Motor torque of leg 2's drive", PLANT(u), 9, PLANT(du), kOnInputs),

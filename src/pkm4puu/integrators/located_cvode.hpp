@@ -18,7 +18,9 @@ constexpr int kMaxSwitchesPerAdvance = 100000;
 
 /// Integrates x from CVODE's current point to t_end. `stops` holds the
 /// contact mode (end_stops.hpp) at the start; it is switched at every root
-/// and held from the state (kStopsFromState) on return. `switches` counts
+/// and returned as it is at the end (on failure the caller restores its
+/// own). CVODE's root function is the stop indicators under `stops`
+/// (with the hysteresis). `switches` counts
 /// the roots. On failure `error` says why (CVODE's message, or the
 /// chattering bound: then `chattering` is set) and CVODE is left for the
 /// caller to reset.
@@ -30,7 +32,7 @@ inline Status located_cvode_advance(CvodeIntegrator& cvode, double t_end, Vec10&
   for (;;) {
     double t_reached = t_end;
     bool root = false;
-    int dirs[kStopIndicators] = {};
+    int dirs[kContactIndicators] = {};
     s = cvode.advance(t_end, x, t_reached, root, dirs);
     if (s != Status::Ok || !root) break;
     stops = stops_after_crossings(stops, dirs);
@@ -39,7 +41,6 @@ inline Status located_cvode_advance(CvodeIntegrator& cvode, double t_end, Vec10&
       char buf[160];
       std::snprintf(buf, sizeof buf, "more than %d end-stop events before t = %.17g s (chattering contact)",
                     kMaxSwitchesPerAdvance, t_end);
-      stops = kStopsFromState;
       error = buf;
       chattering = true;
       return Status::SolverFailure;
@@ -48,7 +49,6 @@ inline Status located_cvode_advance(CvodeIntegrator& cvode, double t_end, Vec10&
     s = cvode.reset(t_reached, x);
     if (s != Status::Ok) break;
   }
-  stops = kStopsFromState;
   if (s != Status::Ok) error = cvode.last_error();
   return s;
 }

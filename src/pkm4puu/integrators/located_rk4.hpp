@@ -25,13 +25,13 @@ inline double switch_time_tolerance(double t) {
 ///   Status rates(double t, const Vec10& x, Vec10& xdot)  under the held stops,
 ///   void hold(unsigned stops)                           the stops held from now on,
 ///   unsigned mode(const Vec10& x, Vec4& rho)            the contact mode at x (end_stops.hpp's
-///                                                       bits, plus bit 8 + i while leg i's stop
-///                                                       is passed but released; ~0u off the
+///                                                       bits, the clamps' included; ~0u off the
 ///                                                       workspace) and the actuator positions.
 /// `mode` and `rho` hold the contact mode and actuator positions at x on
 /// entry and at the end on return (`rho_valid` false where unknown);
 /// `switches` counts the located switches. `t` returns where the step got to
-/// (t1 on success). The stops are held from the state (kStopsFromState) on return.
+/// (t1 on success). On return the stops of the final mode are held (the
+/// plant's contact mode from there on).
 template <class System>
 Status located_rk4_step(System& sys, double t0, double t1, double h_contact, Vec10& x, unsigned& mode, Vec4& rho,
                         bool& rho_valid, long& switches, double& t) {
@@ -46,7 +46,7 @@ Status located_rk4_step(System& sys, double t0, double t1, double h_contact, Vec
       step = h_contact;
       to_end = false;
     }
-    sys.hold(mode & 0xFFu);  // over the step and its re-steps
+    sys.hold(mode & kContactModeBits);  // over the step and its re-steps
     Vec10 trial = x;
     s = rk4_step(f, t, step, trial);
     if (s != Status::Ok) break;
@@ -86,7 +86,7 @@ Status located_rk4_step(System& sys, double t0, double t1, double h_contact, Vec
     rho_valid = rho_trial_valid;
     t = to_end ? t1 : t + step;
   }
-  sys.hold(kStopsFromState);
+  sys.hold(mode & kContactModeBits);
   return s;
 }
 

@@ -7,10 +7,10 @@
 
 namespace pkm {
 
-Status stop_indicators(const Model& m, const Pose& pose, double g[kStopIndicators]) {
+Status stop_indicators(const Model& m, const Pose& pose, unsigned stops, double z[kStopIndicators]) {
   Vec4 rho;
   const Status s = actuator_positions(m, pose, rho);
-  if (s == Status::Ok) stop_indicators(m.p, rho, g);
+  if (s == Status::Ok) stop_indicators(m.p, rho, stops, z);
   return s;
 }
 

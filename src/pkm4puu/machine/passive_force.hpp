@@ -46,7 +46,7 @@ inline PassiveSlopes passive_joint_force_slopes(const Params& p, int leg, unsign
 /// (header comment).
 inline double dissipated_power(const Params& p, int leg, unsigned stops, double rho, double rhod) {
   const StopContact c = stop_contact(p, leg, stops, rho, rhod);
-  return -friction_force(p, rhod) * rhod + (std::fabs(c.force) - p.stop_stiffness * c.depth) * c.rate;
+  return -friction_force(p, rhod) * rhod + (-c.side * c.force - p.stop_stiffness * c.depth) * c.rate;
 }
 
 /// d/d(rho, rhod) of dissipated_power. With s = side (d depth/drho =

@@ -56,10 +56,15 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
     error_ = "the state derivative at the initial state is not finite (initial velocity too large?)";
     return Status::NonFinite;
   }
+  Vec4 rho, rhod;
+  s = pkm::actuator_positions(model_, pose, rho);
+  if (s != Status::Ok) return s;
+  for (int i = 0; i < kLegs; ++i) rhod[i] = qd[leg_offset(i)];
   s = prepare_cvode();
   if (s != Status::Ok) return s;
   y_ = y;
   rho_valid_ = false;
+  stops_ = stops_after_event(model_.p, rho, rhod, 0u);
   t_ = t0;
   energy_ = EnergyIntegrals{};
   for (int i = 0; i < kLegs; ++i) theta1_.ref[i] = q[leg_offset(i) + 1];
@@ -70,6 +75,19 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
 }
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
+  return restore(t, y, theta1_ref, ~0u);
+}
+
+Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned stops) {
+  const unsigned legs_held = (stops | (stops >> kLegs)) & ((1u << kLegs) - 1u);
+  if (stops != ~0u && ((stops & ~kContactModeBits) != 0u || (stops & (stops >> kLegs) & ((1u << kLegs) - 1u)) != 0u ||
+                       ((stops >> (2 * kLegs)) & ~legs_held) != 0u)) {
+    char buf[140];
+    std::snprintf(buf, sizeof buf,
+                  "the contact mode %#x names no stop, both stops of one leg or the clamp of a stop not held", stops);
+    error_ = buf;
+    return Status::InvalidArgument;
+  }
   if (!std::isfinite(t) || !y.allFinite() || !theta1_ref.allFinite()) {
     error_ = "the time, state or theta1 references are not finite";
     return Status::NonFinite;
@@ -99,6 +117,12 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
   t_ = t;
   y_ = y;
   rho_valid_ = false;
+  Vec4 rho, rhod;
+  for (int i = 0; i < kLegs; ++i) {
+    rho[i] = q[leg_offset(i)];
+    rhod[i] = qd[leg_offset(i)];
+  }
+  stops_ = stops != ~0u ? stops : stops_after_event(model_.p, rho, rhod, 0u);
   theta1_.ref = theta1_ref;
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
@@ -130,15 +154,50 @@ Status Plant::derivative_now(const InputSignal& inputs, Vec10& xdot) const {
   x.head<8>() = y_;
   x[8] = energy_.actuator_work;
   x[9] = energy_.dissipated;
-  return machine_rates(inputs, t_, x, kStopsFromState, xdot);
+  return machine_rates(inputs, t_, x, stops_, xdot);
+}
+
+Status Plant::update_stops(unsigned& switched) {
+  switched = 0;
+  if (!initialized_) return Status::NotInitialized;
+  Vec4 rho, rhod;
+  const Status s = joint_motion(y_, rho, rhod);
+  if (s != Status::Ok) return s;
+  const unsigned now = stops_after_event(model_.p, rho, rhod, stops_);
+  switched = now ^ stops_;
+  stops_ = now;
+  return Status::Ok;
 }
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e) {
+  return restore(t, y, theta1_ref, e, ~0u);
+}
+
+Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e, unsigned stops) {
   if (!std::isfinite(e.actuator_work) || !std::isfinite(e.dissipated)) return Status::NonFinite;
   const EnergyIntegrals keep = energy_;
   energy_ = e;
-  const Status s = restore(t, y, theta1_ref);
+  const Status s = restore(t, y, theta1_ref, stops);
   if (s != Status::Ok) energy_ = keep;
+  return s;
+}
+
+Status Plant::joint_motion(const Vec8& y, Vec4& rho, Vec4& rhod) const {
+  Vec16 q, qd;
+  const Status s = expand_state(model_, y, q, qd);
+  if (s != Status::Ok) return s;
+  for (int i = 0; i < kLegs; ++i) {
+    rho[i] = q[leg_offset(i)];
+    rhod[i] = qd[leg_offset(i)];
+  }
+  return Status::Ok;
+}
+
+Status Plant::contact_indicators(double z[kContactIndicators]) const {
+  if (!initialized_) return Status::NotInitialized;
+  Vec4 rho, rhod;
+  const Status s = joint_motion(y_, rho, rhod);
+  if (s == Status::Ok) pkm::contact_indicators(model_.p, rho, rhod, stops_, z);
   return s;
 }
 

@@ -43,8 +43,11 @@ struct MachineOutputs {
   double dissipated_energy = 0;        // J, running integral
   double actuator_power = 0;           // W, d(actuator_work)/dt
   double dissipation_rate = 0;         // W, d(dissipated_energy)/dt
-  /// Event indicators (machine.hpp): rho_i - rho_min, then rho_max - rho_i.
+  /// Event indicators (end_stops.hpp): rho_i - rho_min, then rho_max - rho_i,
+  /// each offset by the hysteresis under the contact mode.
   double stop_indicators[kStopIndicators] = {};
+  /// Then the clamps' (end_stops.hpp's clamp_indicators).
+  double clamp_indicators[kLegs] = {};
 };
 
 class Plant {
@@ -84,8 +87,27 @@ class Plant {
   /// singularity limits or kMaxSpeed, or theta1_ref is not the pose's
   /// closed-form theta1 (modulo 2 pi). The energy integrals keep their
   /// values unless given.
+  /// The contact mode is the one that the event rule gives at y
+  /// (stops_after_event from none) unless given (`stops`, end_stops.hpp's
+  /// bits; InvalidArgument if it names no stop or both of one leg's).
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref);
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e);
+  Status restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e, unsigned stops);
+  Status restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned stops);
+
+  /// The contact mode (end_stops.hpp): which end stops act. Set at
+  /// initialize() and restore() by the event rule, switched at every event
+  /// located by advance() and by update_stops(), and nothing else: the
+  /// derivatives, the outputs and both integrators use it, so that
+  /// Co-Simulation and Model Exchange are the same hybrid model.
+  unsigned stops() const { return stops_; }
+  /// Model Exchange's Event Mode: switches the contact mode by the event
+  /// rule (stops_after_event) at the current state; returns the stops
+  /// switched (Unreachable off the workspace: nothing changes).
+  Status update_stops(unsigned& switched);
+  /// The contact mode's event indicators at the current state
+  /// (end_stops.hpp's contact_indicators, under stops()).
+  Status contact_indicators(double z[kContactIndicators]) const;
 
   /// The running energy integrals (zero at initialize()).
   const EnergyIntegrals& energy_integrals() const { return energy_; }
@@ -100,7 +122,8 @@ class Plant {
   // ---- Model Exchange: the importer's integrator owns time and state.
   /// Sets the time (the state is kept).
   void set_time(double t) { t_ = t; }
-  /// Sets the state [pose; velocity] reached by the importer's integrator:
+  /// Sets the state [pose; velocity] reached by the importer's integrator
+  /// (the contact mode is kept: relations change in Event Mode only):
   /// Status::Unreachable (nothing changes, last_error() says which leg) if a
   /// leg cannot be assembled there, ::NonFinite if y is not finite. The
   /// singularity limits are not checked here: the event indicators
@@ -109,7 +132,7 @@ class Plant {
   /// Sets the running energy integrals (the importer integrates them too).
   void set_energy_integrals(const EnergyIntegrals& e) { energy_ = e; }
   /// d/dt of [y; actuator_work; dissipated] at the current time and state
-  /// for the given inputs, each end stop acting when its joint is past it.
+  /// for the given inputs, under the contact mode stops().
   Status derivative_now(const InputSignal& inputs, Vec10& xdot) const;
 
   /// q, qd, qdd and lambda at the current time, for the inputs at that time
@@ -150,13 +173,14 @@ class Plant {
   /// Exchange's); *inputs_fault tells a NonFinite caused by the inputs.
   Status machine_rates(const InputSignal& inputs, double t, const Vec10& x, unsigned stops, Vec10& xdot,
                        bool* inputs_fault = nullptr) const;
+  /// rho and rhod at the state y (closed form).
+  Status joint_motion(const Vec8& y, Vec4& rho, Vec4& rhod) const;
   Vec10 packed() const;
   void unpack(const Vec10& x);
-  /// The contact mode at x (located_rk4.hpp): the stops passed at the pose
-  /// x.head<4>() and, bit 8 + i, leg i's stop passed but released (its
-  /// spring and damper would pull: a kink in the force that RK4 should not
-  /// step across either); ~0u if unreachable. rho receives the actuator
-  /// positions there (valid unless ~0u).
+  /// The contact mode at x (located_rk4.hpp): the event rule
+  /// (stops_after_event) from the held mode (stops_) at x, the clamps
+  /// included; ~0u if unreachable. rho receives the actuator positions
+  /// there (valid unless ~0u).
   unsigned contact_mode(const Vec10& x, Vec4& rho) const;
   /// The same with rho, the actuator positions at x, known.
   unsigned contact_mode_at(const Vec10& x, const Vec4& rho) const;
@@ -181,7 +205,7 @@ class Plant {
   Vec8 y_ = Vec8::Zero();
   EnergyIntegrals energy_;
   long contact_events_ = 0;
-  unsigned stops_ = kStopsFromState;  // the stops held on while integrating (machine.hpp)
+  unsigned stops_ = 0;  // the contact mode (stops()): never kStopsFromState
   // actuator_positions at y_, when rho_valid_ (every change of y_ clears it).
   mutable Vec4 rho_ = Vec4::Zero();
   mutable bool rho_valid_ = false;

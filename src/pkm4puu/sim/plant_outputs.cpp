@@ -20,7 +20,7 @@ Status Plant::mechanism(const InputSignal& inputs, MechanismState& out) const {
   read_inputs(inputs, t_, F, we, tau);
   Vec8 ydot;
   const Status s = state_derivative(model_, settings_.formulation, y_, generalized_forces(model_, F, tau, we),
-                                    ydot, &out);
+                                    ydot, &out, nullptr, stops_);
   if (s != Status::Ok) return s;
   theta1_ref();  // brought up to date
   theta1_.unwrap(out.q);
@@ -49,7 +49,7 @@ Status Plant::machine_outputs(const InputSignal& inputs, MachineOutputs& out) co
     const int o = leg_offset(i);
     out.rho[i] = q[o];
     out.rhod[i] = qd[o];
-    out.stop_force[i] = stop_force(p, q[o], qd[o]);
+    out.stop_force[i] = stop_contact(p, i, stops_, q[o], qd[o]).force;
     out.friction_force[i] = friction_force(p, qd[o]);
   }
   s = holding_forces(model_, q, we, out.F_hold);
@@ -58,9 +58,12 @@ Status Plant::machine_outputs(const InputSignal& inputs, MachineOutputs& out) co
   out.potential_energy = potential_energy(model_, q);
   out.actuator_work = energy_.actuator_work;
   out.dissipated_energy = energy_.dissipated;
-  energy_rates(p, kStopsFromState, F + model_.drive_ratio * tau, we, y_.tail<4>(), out.rho, out.rhod,
+  energy_rates(p, stops_, F + model_.drive_ratio * tau, we, y_.tail<4>(), out.rho, out.rhod,
                out.actuator_power, out.dissipation_rate);
-  stop_indicators(p, out.rho, out.stop_indicators);
+  double z[kContactIndicators];
+  pkm::contact_indicators(p, out.rho, out.rhod, stops_, z);
+  for (int k = 0; k < kStopIndicators; ++k) out.stop_indicators[k] = z[k];
+  for (int i = 0; i < kLegs; ++i) out.clamp_indicators[i] = z[kStopIndicators + i];
   return Status::Ok;
 }
 

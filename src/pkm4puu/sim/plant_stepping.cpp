@@ -23,7 +23,7 @@ struct PlantOde {
 Status Plant::prepare_cvode() {
   if (settings_.solver != Solver::Cvode || cvode_ready_) return Status::Ok;
   const Status s = cvode_.init(settings_.cvode_method, settings_.rtol, settings_.atol, &Plant::cvode_rhs, this,
-                               kStopIndicators, &Plant::cvode_roots);
+                               kContactIndicators, &Plant::cvode_roots);
   if (s != Status::Ok) {
     error_ = "CVODE could not be set up: " + cvode_.last_error();
     return s == Status::InvalidArgument ? s : Status::SolverFailure;
@@ -38,22 +38,23 @@ unsigned Plant::contact_mode(const Vec10& x, Vec4& rho) const {
 }
 
 unsigned Plant::contact_mode_at(const Vec10& x, const Vec4& rho) const {
-  unsigned mode = stops_passed(model_.p, rho);
-  if (mode == 0) return mode;
-  Vec16 q, qd;  // the joint rates tell a released stop
-  if (expand_state(model_, x.head<8>(), q, qd) != Status::Ok) return ~0u;
-  for (int i = 0; i < kLegs; ++i) {
-    const StopContact c = stop_contact(model_.p, rho[i], qd[leg_offset(i)]);
-    if (c.depth > 0.0 && c.force == 0.0) mode |= 1u << (2 * kLegs + i);
-  }
-  return mode;
+  // The stops first (rho only): the joint rates matter only to a held stop's clamp.
+  const Vec4 at_rest = Vec4::Zero();
+  if ((stops_after_event(model_.p, rho, at_rest, stops_) & ((1u << kStopIndicators) - 1u)) == 0u) return 0u;
+  Vec4 rho_x, rhod;
+  if (joint_motion(x.head<8>(), rho_x, rhod) != Status::Ok) return ~0u;
+  return stops_after_event(model_.p, rho, rhod, stops_);
 }
 
 int Plant::cvode_roots(double t, const Vec10& x, double* g, void* self) {
   (void)t;
   const auto* me = static_cast<const Plant*>(self);
-  if (stop_indicators(me->model_, x.head<4>(), g) != Status::Ok)
-    for (int k = 0; k < kStopIndicators; ++k) g[k] = 1.0;  // off the workspace: the rhs reports it
+  Vec4 rho, rhod;
+  if (me->joint_motion(x.head<8>(), rho, rhod) == Status::Ok) {
+    pkm::contact_indicators(me->model_.p, rho, rhod, me->stops_, g);
+  } else {
+    for (int k = 0; k < kContactIndicators; ++k) g[k] = 1.0;  // off the workspace: the rhs reports it
+  }
   return 0;
 }
 
@@ -88,6 +89,7 @@ Status Plant::advance_rk4(double t_end) {
   for (long k = 0; k < n; ++k) {
     const double tk = (k == 0) ? t0 : t0 + static_cast<double>(k) * h;
     const double t_next = (k + 1 == n) ? t_end : t0 + static_cast<double>(k + 1) * h;
+    const unsigned stops_start = stops_;  // kept with the state if the step is undone
     Vec10 x = packed();
     // rho at x: the previous grid step's end computed it (actuator_positions).
     Vec4 rho;
@@ -100,10 +102,14 @@ Status Plant::advance_rk4(double t_end) {
       std::snprintf(buf, sizeof buf, "the RK4 step from t = %.17g s could not be evaluated: %s", t,
                     status_name(s));
       error_ = buf;
+      stops_ = stops_start;
       return s;
     }
     s = guard(x.head<8>(), t_next);  // every step ends within the limits, or is undone
-    if (s != Status::Ok) return s;
+    if (s != Status::Ok) {
+      stops_ = stops_start;
+      return s;
+    }
     unpack(x);
     t_ = t_next;
     if (rho_valid) {  // what actuator_positions would compute at the new state
@@ -126,17 +132,18 @@ Status Plant::advance_cvode(double t_end, bool continuous) {
   }
   Vec10 x = packed();
   rhs_status_ = Status::Ok;
-  // The stops held between roots: those past at the start, then switched at each root.
-  Vec4 rho;
-  stops_ = (actuator_positions(rho) == Status::Ok ? contact_mode_at(x, rho) : ~0u) & 0xFFu;
+  // The stops held between roots: the contact mode, switched at each root.
+  const unsigned stops_start = stops_;
   bool chattering = false;
   Status s = located_cvode_advance(cvode_, t_end, x, stops_, contact_events_, error_, chattering);
   if (s != Status::Ok) {
+    stops_ = stops_start;
     cvode_.reset(t_, packed());
     return (rhs_status_ != Status::Ok && !chattering) ? rhs_status_ : s;
   }
   s = guard(x.head<8>(), t_end);  // the interval ends within the limits, or is undone
   if (s != Status::Ok) {
+    stops_ = stops_start;
     cvode_.reset(t_, packed());
     return s;
   }
