@@ -12,7 +12,7 @@
 #   scripts/setup.sh --for-main-job what ./run_autotest.sh needs: the
 #                                   compiler, CMake, Ninja, Eigen, SUNDIALS and
 #                                   Python, and in .venv fmpy, numpy,
-#                                   matplotlib and pkm4puu; a later full run
+#                                   matplotlib (and wheel) and pkm4puu; a later full run
 #                                   still installs the rest (its stamp file
 #                                   is not written here)
 set -euo pipefail
@@ -115,7 +115,7 @@ case "$mode" in
     install_pinned fmpy
     log "done (for the build)"
     exit 0 ;;
-  main-job) install_pinned fmpy numpy matplotlib ;;
+  main-job) install_pinned fmpy numpy matplotlib wheel ;;  # wheel: the editable install of pkm4puu below
   *)
     if [ ! -f "$stamp" ] || [ "$req" -nt "$stamp" ]; then
       log "installing Python requirements from $req"
