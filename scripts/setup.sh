@@ -107,7 +107,9 @@ PY
   )
   if [ "${#pins[@]}" -gt 0 ]; then
     log "installing ${pins[*]} (the rest of $req comes with scripts/setup.sh)"
-    .venv/bin/pip install --disable-pip-version-check -q "${pins[@]}"
+    # --no-compile: Python compiles the modules it imports when it first does,
+    # not every module of numpy and matplotlib now (a third of the install).
+    .venv/bin/pip install --disable-pip-version-check -q --no-compile "${pins[@]}"
   fi
 }
 case "$mode" in

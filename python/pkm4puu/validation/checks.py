@@ -44,12 +44,16 @@ def verdict(passed):
 
 
 def format_line(case, quantity, measured, relation, bound, unit, result, width=48):
+    """One check's line; `measured` and `bound` are numbers or their text."""
+    try:
+        measured = f"{float(measured):.3e}"
+    except ValueError:
+        pass
     return f"  {case + ': ' + quantity:<{width}} {measured:>10} {unit:<3} {relation:>2} {bound:<8} {result}"
 
 
 def format_check(c, width=48):
-    return format_line(c.case, c.quantity, f"{c.measured:.3e}", c.relation, f"{c.bound:g}", c.unit,
-                       verdict(c.passed), width)
+    return format_line(c.case, c.quantity, c.measured, c.relation, f"{c.bound:g}", c.unit, verdict(c.passed), width)
 
 
 def format_checks(checks):
