@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """The command line `python -m pkm4puu COMMAND` refuses wrong input at once:
 an unknown option or an --out that cannot be written ends with exit status
 2 and a message naming it, before the command looks for the FMUs (a build

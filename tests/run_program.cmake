@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 # Runs a program and checks its exit status and output (cmake -P):
 #   -DPROGRAM=<path> -DARGS=<arguments, separated by |> -DEXIT=<expected status>
 #   [-DSTDERR=<regex stderr must match>] [-DSTDOUT=<regex stdout must match>]

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-2-Clause
 """Checks against bounds, one line each: what was measured, the value, the
 bound, PASS or FAIL. The main job's stages (pkm_autotest, `python -m
 pkm4puu autotest`, `python -m pkm4puu comparison`) each write theirs to a
