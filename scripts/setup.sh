@@ -12,9 +12,9 @@
 #   scripts/setup.sh --for-main-job what ./run_autotest.sh needs: the
 #                                   compiler, CMake, Ninja, Eigen, SUNDIALS and
 #                                   Python, and in .venv fmpy, numpy,
-#                                   matplotlib (and wheel) and pkm4puu; a later full run
-#                                   still installs the rest (its stamp file
-#                                   is not written here)
+#                                   matplotlib (and wheel) and pkm4puu; a
+#                                   later full run still installs the rest
+#                                   (its stamp file is not written here)
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 log() { echo "setup: $*" >&2; }
