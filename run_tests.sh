@@ -15,8 +15,10 @@ cd "$(dirname "${BASH_SOURCE[0]}")"
 # of the Python requirements (the checks' numpy, SciPy, MuJoCo, Pinocchio,
 # ...) install beside the build, which does not need them.
 # Every platform: the Windows and aarch64 FMUs, built and tested under wine
-# and qemu-user (cmake/Platforms.cmake).
-PKM_SETUP=for-build ./scripts/build.sh --configure-only -DPKM_PLATFORMS=ON
+# and qemu-user (cmake/Platforms.cmake). The tests and benchmarks are turned
+# on by name: a build/ that the main job configured has them off.
+PKM_SETUP=for-build ./scripts/build.sh --configure-only -DPKM_PLATFORMS=ON -DPKM_BUILD_TESTS=ON \
+  -DPKM_BUILD_BENCHMARKS=ON
 setup_log=build/setup.log
 ./scripts/setup.sh >"$setup_log" 2>&1 &
 setup_pid=$!

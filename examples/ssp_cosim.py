@@ -52,6 +52,7 @@ from xml.sax.saxutils import quoteattr
 import matplotlib
 import numpy as np
 
+from pkm4puu.validation.autotest import BOUNDS as AUTOTEST_BOUNDS
 from pkm4puu.validation.cli import add_common_args, start, write_outputs
 from pkm4puu.closed_loop import PoseErrors
 from pkm4puu.validation.plots import save_figure
@@ -70,8 +71,7 @@ SOLVERS = {"cvode": 0, "rk4": 1}
 # What test_examples_ssp.py requires: the bound pkm4puu.validation.autotest
 # holds the midpoint-held case to (the libcosim run is that case), and
 # agreement with that fmpy run to rounding.
-TOL_POS = 5e-8  # m
-TOL_PHI = 5e-8  # rad
+TOL_POS, TOL_PHI = AUTOTEST_BOUNDS.position, AUTOTEST_BOUNDS.phi  # m, rad
 
 MOTION_INPUTS = POSE + VEL + ACC
 NS = {

@@ -8,9 +8,9 @@ The runner, the three input modes (a) midpoint, (b) first order, (c) zero-order
 hold, and the result writers are in pkm4puu.validation.autotest (the main job runs the
 same code); the checks are here:
 
-(a) and (b) must reproduce the prescribed motion to TOL_POS / TOL_PHI with
-    both solvers (the bounds are here, not in the report; test_fmu_platforms.py
-    holds its runs to the same).
+(a) and (b) must reproduce the prescribed motion to BOUNDS with both solvers
+    (the bounds are the report's, which the main job's verdict uses too;
+    test_fmu_platforms.py holds its runs to the same).
 (c) lags the true force by half a step on average, so every step's impulse is
     off by -h^2/2 dF/dt: an O(h) error, ~ (h/2) x velocity ~ 1e-5 m here. It is
     reported, not bounded: only its being larger than (a)'s is asserted, which
@@ -19,17 +19,13 @@ same code); the checks are here:
 import numpy as np
 import pytest
 
-from pkm4puu.validation.autotest import Bounds, SOLVERS, format_table, half_step_forces, run_all, write_results
+from pkm4puu.validation.autotest import (BOUNDS, SOLVERS, checks, format_table, half_step_forces, run_all,
+                                         write_results)
 from pkm4puu.fmu import Fmu, inverse_forces
 from pkm4puu.interface import indexed_names, POSE
 from pkm4puu.spec import P0, P1, STATIC_FORCE_P0, TOTAL_WEIGHT
 
-# The bounds on (a) and (b)'s max errors; (c), the ZOH mode, is only required
-# to be worse than the midpoint hold.
-TOL_POS = 5e-8  # m
-TOL_PHI = 5e-8  # rad
-BOUNDED_MODES = ("midpoint", "first_order")
-BOUNDS = Bounds(TOL_POS, TOL_PHI, BOUNDED_MODES)  # shown in the table and the error plot
+TOL_POS, TOL_PHI, BOUNDED_MODES = BOUNDS
 
 
 @pytest.fixture(scope="module")
@@ -78,6 +74,18 @@ def test_reproduces_prescribed_motion(runs, mode, solver):
     assert np.all(np.isfinite(e_pos)) and np.all(np.isfinite(e_phi)), "non-finite pose"
     assert e_pos.max() <= TOL_POS, f"{mode}/{solver}: max position error {e_pos.max():.3e} m > {TOL_POS} m"
     assert e_phi.max() <= TOL_PHI, f"{mode}/{solver}: max phi error {e_phi.max():.3e} rad > {TOL_PHI} rad"
+
+
+def test_verdict_checks_every_bounded_case(runs):
+    """The main job's verdict (checks) holds each bounded case's two errors
+    to BOUNDS, as test_reproduces_prescribed_motion does, and fails a case
+    that a tighter bound would fail."""
+    lines = checks(runs)
+    assert len(lines) == 2 * len(BOUNDED_MODES) * len(SOLVERS)
+    assert all(c.passed for c in lines), [c for c in lines if not c.passed]
+    worst = max(c.measured for c in lines if c.unit == "m")
+    tighter = checks(runs, BOUNDS._replace(position=worst / 2))
+    assert any(not c.passed for c in tighter)
 
 
 @pytest.mark.parametrize("solver", list(SOLVERS))

@@ -14,25 +14,21 @@ Checked facts, each following from the model rather than from a past run:
   with z_rod_i = rho_i + h + (l/2) sin(theta2_i), stays constant;
 - the motion is non-trivial and two different integrators (CVODE and fixed
   step RK4) agree.
-The bounds are here, not in the report (which shows them in its table when
-given them).
+The bounds are the report's (BOUNDS), which the main job's verdict uses too.
 """
 import pytest
 
-from pkm4puu.validation.comparison import (Bounds, format_table, max_constraint_residual, max_delta_rho1,
+from pkm4puu.validation.comparison import (BOUNDS, checks, format_table, max_constraint_residual, max_delta_rho1,
                                            nonfinite_outputs, run_all, solver_difference, vertical_com_drift,
                                            write_results)
 
-TOL_POS = 1e-8  # m, CVODE vs RK4 and the vertical centre of mass's drift
-TOL_PHI = 1e-7  # rad, CVODE vs RK4
-TOL_CONSTRAINT = 1e-12  # m, max ||C(q)||
-MIN_DELTA_RHO1 = 1e-5  # m, below this the forces barely moved the machine
+TOL_POS, TOL_PHI, TOL_CONSTRAINT, MIN_DELTA_RHO1 = BOUNDS
 
 
 @pytest.fixture(scope="module")
 def runs(plant_fmu):
     out = run_all(plant_fmu)
-    print("\n" + format_table(out, bounds=Bounds(TOL_POS, TOL_PHI, TOL_CONSTRAINT, MIN_DELTA_RHO1)))
+    print("\n" + format_table(out, bounds=BOUNDS))
     return out
 
 
@@ -67,6 +63,17 @@ def test_rk4_agrees_with_cvode(runs):
     print(f"\nCVODE vs RK4: max |delta position| {d_pos:.3e} m, |delta phi| {d_phi:.3e} rad")
     assert d_pos <= TOL_POS, f"CVODE and RK4 differ by {d_pos:.3e} m > {TOL_POS} m"
     assert d_phi <= TOL_PHI, f"CVODE and RK4 differ by {d_phi:.3e} rad > {TOL_PHI} rad"
+
+
+def test_verdict_checks_what_the_tests_check(runs):
+    """The main job's verdict (checks) holds the runs to BOUNDS on the same
+    quantities as the tests above, and the non-trivial motion's check is a
+    lower bound: it fails when the bound is above the measured motion."""
+    lines = checks(runs)
+    assert len(lines) == 2 * len(runs) + 3
+    assert all(c.passed for c in lines), [c for c in lines if not c.passed]
+    moved = max_delta_rho1(runs["CVODE"])
+    assert not all(c.passed for c in checks(runs, BOUNDS._replace(min_delta_rho1=2 * moved)))
 
 
 def test_write_results(runs, results_dir):

@@ -32,9 +32,8 @@ import numpy as np
 import pytest
 from fmpy.util import add_remoting
 
-from pkm4puu.validation.autotest import SOLVERS, half_step_forces, run_case
+from pkm4puu.validation.autotest import BOUNDS, SOLVERS, half_step_forces, run_case
 from pkm4puu.fmu import Fmu
-from test_fmu_autotest import TOL_PHI, TOL_POS  # the auto-test's bounds, as there
 
 PLATFORMS = {2: {"linux64", "win64"}, 3: {"x86_64-linux", "x86_64-windows", "aarch64-linux"}}
 # The Windows binary against linux64, relative to each coordinate's largest
@@ -124,7 +123,7 @@ def run_case_through_remoting(fmu, solver, table):
 def test_windows_binary_auto_test_through_remoting(plant_win64_remoting, plant_fmu, half_step_table, solver):
     win = run_case_through_remoting(plant_win64_remoting, solver, half_step_table)
     assert win.finite()
-    assert win.pos_err.max() <= TOL_POS and win.phi_err.max() <= TOL_PHI
+    assert win.pos_err.max() <= BOUNDS.position and win.phi_err.max() <= BOUNDS.phi
     linux = run_case(plant_fmu, "midpoint", solver, half_step_table)
     _agree(win.pose, linux.pose, PLATFORM_RTOL[solver], f"win64 (wine, remoting) vs linux64, {solver}")
 
@@ -154,7 +153,7 @@ def compiled_plant(dist_fmus, tmp_path_factory):
 @needs_compile
 def test_compiled_source_fmu_reproduces_the_auto_test(compiled_plant, plant_fmu3, half_step_table):
     built = run_case(compiled_plant, "midpoint", "RK4", half_step_table)
-    assert built.pos_err.max() <= TOL_POS and built.phi_err.max() <= TOL_PHI
+    assert built.pos_err.max() <= BOUNDS.position and built.phi_err.max() <= BOUNDS.phi
     binary = run_case(plant_fmu3, "midpoint", "RK4", half_step_table)
     _agree(built.pose, binary.pose, PLATFORM_RTOL["RK4"], "source build (fmpy compile) vs binary, RK4")
 

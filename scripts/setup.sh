@@ -9,25 +9,34 @@
 #                                   Debian packages and, in .venv, fmpy (its
 #                                   FMI headers); ./run_tests.sh installs the
 #                                   rest while it builds
+#   scripts/setup.sh --for-main-job what ./run_autotest.sh needs: the
+#                                   compiler, CMake, Ninja, Eigen, SUNDIALS and
+#                                   Python, and in .venv fmpy, numpy,
+#                                   matplotlib (and wheel) and pkm4puu; a
+#                                   later full run still installs the rest
+#                                   (its stamp file is not written here)
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 log() { echo "setup: $*" >&2; }
-for_build=0
+mode=all
 case "${1:-}" in
-  --for-build) for_build=1 ;;
+  --for-build) mode=build ;;
+  --for-main-job) mode=main-job ;;
   "") ;;
   *) log "unknown argument $1"; exit 2 ;;
 esac
 
 # 1. Debian packages.
-packages=(build-essential cmake ninja-build libeigen3-dev libsundials-dev libgtest-dev
-          python3 python3-venv python3-pip
-          clang libclang-rt-14-dev valgrind  # hardening: libFuzzer + sanitizers (fuzz/), memcheck
-          # every platform (cmake/Platforms.cmake): Windows x64 built with mingw-w64 and run
-          # under wine, Linux aarch64 built with gcc and run under qemu-user; dpkg-dev
-          # unpacks `apt-get source sundials` (scripts/cross_sundials.sh)
-          g++-mingw-w64-x86-64-posix gcc-mingw-w64-x86-64-posix wine wine64
-          g++-aarch64-linux-gnu gcc-aarch64-linux-gnu qemu-user dpkg-dev)
+packages=(build-essential cmake ninja-build libeigen3-dev libsundials-dev python3 python3-venv)
+if [ "$mode" != main-job ]; then
+  packages+=(libgtest-dev python3-pip
+             clang libclang-rt-14-dev valgrind  # hardening: libFuzzer + sanitizers (fuzz/), memcheck
+             # every platform (cmake/Platforms.cmake): Windows x64 built with mingw-w64 and run
+             # under wine, Linux aarch64 built with gcc and run under qemu-user; dpkg-dev
+             # unpacks `apt-get source sundials` (scripts/cross_sundials.sh)
+             g++-mingw-w64-x86-64-posix gcc-mingw-w64-x86-64-posix wine wine64
+             g++-aarch64-linux-gnu gcc-aarch64-linux-gnu qemu-user dpkg-dev)
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
@@ -41,13 +50,15 @@ export DEBIAN_FRONTEND=noninteractive
 # from its deb entries), for `apt-get source sundials`; added only when apt
 # has no deb-src entry at all.
 need_update=0
-if ! ./scripts/deb_src.sh --check; then
-  log "adding deb-src entries for apt's own mirrors"
-  ./scripts/deb_src.sh | "${sudo[@]}" tee /etc/apt/sources.list.d/pkm-deb-src.sources >/dev/null
-  need_update=1
-fi
-if [ -z "$(apt-cache showsrc sundials 2>/dev/null)" ]; then
-  need_update=1
+if [ "$mode" != main-job ]; then  # the cross builds' SUNDIALS only
+  if ! ./scripts/deb_src.sh --check; then
+    log "adding deb-src entries for apt's own mirrors"
+    ./scripts/deb_src.sh | "${sudo[@]}" tee /etc/apt/sources.list.d/pkm-deb-src.sources >/dev/null
+    need_update=1
+  fi
+  if [ -z "$(apt-cache showsrc sundials 2>/dev/null)" ]; then
+    need_update=1
+  fi
 fi
 if [ "${#missing[@]}" -eq 0 ] && [ "$need_update" -eq 0 ]; then
   log "all Debian packages present, nothing missing"
@@ -72,23 +83,50 @@ if [ ! -x .venv/bin/python ]; then
 fi
 req=python_checks/requirements.txt
 stamp=.venv/.requirements.stamp
-if [ "$for_build" -eq 1 ]; then
-  fmpy_pin="$(grep -E '^fmpy==' "$req")"
-  # pip show prints nothing when fmpy is missing: one comparison covers both.
-  if [ "$(.venv/bin/python -m pip show fmpy 2>/dev/null | sed -n 's/^Version: //p')" != "${fmpy_pin#fmpy==}" ]; then
-    log "installing $fmpy_pin (the rest of $req comes with scripts/setup.sh)"
-    .venv/bin/pip install --disable-pip-version-check -q "$fmpy_pin"
+# install_pinned NAME...: installs each NAME at its pin in $req unless that
+# version is installed already (the pins are read from $req, never copied).
+install_pinned() {
+  local pins=() name pin
+  for name in "$@"; do
+    pin="$(grep -E "^${name}(\[[^]]*\])?==" "$req")" || { log "ERROR: no pin for $name in $req"; exit 1; }
+    pins+=("$pin")
+  done
+  # The pins whose version is not the installed one (a missing package included).
+  mapfile -t pins < <(.venv/bin/python - "${pins[@]}" <<'PY'
+import sys
+from importlib.metadata import PackageNotFoundError, version
+for pin in sys.argv[1:]:
+    name, wanted = pin.split("==")
+    try:
+        ok = version(name.split("[")[0]) == wanted
+    except PackageNotFoundError:
+        ok = False
+    if not ok:
+        print(pin)
+PY
+  )
+  if [ "${#pins[@]}" -gt 0 ]; then
+    log "installing ${pins[*]} (the rest of $req comes with scripts/setup.sh)"
+    # --no-compile: Python compiles the modules it imports when it first does,
+    # not every module of numpy and matplotlib now (a third of the install).
+    .venv/bin/pip install --disable-pip-version-check -q --no-compile "${pins[@]}"
   fi
-  log "done (for the build)"
-  exit 0
-fi
-if [ ! -f "$stamp" ] || [ "$req" -nt "$stamp" ]; then
-  log "installing Python requirements from $req"
-  .venv/bin/pip install --disable-pip-version-check -q -r "$req"
-  touch "$stamp"
-else
-  log "Python requirements up to date"
-fi
+}
+case "$mode" in
+  build)
+    install_pinned fmpy
+    log "done (for the build)"
+    exit 0 ;;
+  main-job) install_pinned fmpy numpy matplotlib wheel ;;  # wheel: the editable install of pkm4puu below
+  *)
+    if [ ! -f "$stamp" ] || [ "$req" -nt "$stamp" ]; then
+      log "installing Python requirements from $req"
+      .venv/bin/pip install --disable-pip-version-check -q -r "$req"
+      touch "$stamp"
+    else
+      log "Python requirements up to date"
+    fi ;;
+esac
 # 3. This project's Python package (python/pkm4puu), editable: the checks,
 # examples and benchmarks import it, and it follows the working tree.
 if ! .venv/bin/python -c "import pkm4puu, sys; sys.exit(pkm4puu.__file__ != '$PWD/python/pkm4puu/__init__.py')" 2>/dev/null; then
@@ -97,4 +135,4 @@ if ! .venv/bin/python -c "import pkm4puu, sys; sys.exit(pkm4puu.__file__ != '$PW
 else
   log "pkm4puu package installed"
 fi
-log "done"
+log "done ($mode)"

@@ -14,6 +14,7 @@ COMMANDS = {
     "comparison": ("comparison", "the paper's comparison test (section 5.2) through the plant FMU"),
     "plot-autotest": ("plot_cpp_autotest", "figures of the C++ auto-test's CSV files (pkm_autotest --out DIR)"),
     "engines": ("engine_comparison", "validation against independent Pinocchio and MuJoCo models"),
+    "verdict": ("checks", "the main job's verdict: the checks its stages wrote, PASS/FAIL per bound"),
 }
 
 
@@ -35,9 +36,10 @@ def main(argv=None):
     if not argv:
         ap.print_help(sys.stderr)
         return 2
+    if argv[0] in ("-h", "--help"):
+        ap.parse_args(argv[:1])  # prints the commands, exits 0
     if argv[0].startswith("-"):
-        ap.parse_args(argv[:1])  # --help prints the commands and exits 0; anything else is an error
-        ap.error("the first argument must be a command")
+        ap.error(f"unrecognized option {argv[0]}: the first argument must be a command")
     ap.parse_args(argv[:1])  # an unknown command is an error that lists the commands
     module = importlib.import_module(f"pkm4puu.validation.{COMMANDS[argv[0]][0]}")
     return module.main(argv[1:])

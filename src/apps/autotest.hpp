@@ -45,6 +45,16 @@ struct AutotestResult {
   std::string error;
 };
 
+/// What the round trip must reproduce the path to (MODEL_SPEC "Auto-test"),
+/// with RK4 at 1 ms and with CVODE at rtol 1e-12, atol 1e-14: the bounds of
+/// the tests (tests/core/autotest.cpp) and of pkm_autotest's verdict.
+struct AutotestBounds {
+  double position = 1e-10;    // m, max |x, y, z error|
+  double angle = 1e-10;       // rad, max |phi error|
+  double constraint = 1e-12;  // m, max ||C(q)||
+};
+inline constexpr AutotestBounds kAutotestBounds{};
+
 /// Runs the round trip. Status of the first failure (inverse or forward).
 Status run_autotest(const Model& m, const AutotestOptions& opt, AutotestResult& out);
 

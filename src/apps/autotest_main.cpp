@@ -3,16 +3,27 @@
 // Inverse dynamics along the spec's rest-to-rest path gives F1..F4(t);
 // forward dynamics driven by those forces (open loop, evaluated at the
 // integrator's own stage times) must reproduce the path. Writes one CSV per
-// solver and prints the largest pose errors.
+// solver, prints the largest pose errors and checks them against the
+// bounds (kAutotestBounds): one PASS/FAIL line each, also written to
+// DIR/autotest_checks.csv in the columns of pkm4puu.validation.checks (the
+// main job's verdict reads it); exit status 1 when a check fails.
+// A wrong argument (unknown option, missing value, a value that is not a
+// number or out of range, an --out that cannot be written) fails at once,
+// before anything runs, naming it: exit status 2.
 //
 //   pkm_autotest [--out DIR] [--solver rk4|cvode|both] [--rk4-step S]
 //                [--rtol R] [--atol A] [--formulation 0|1|2]
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <string>
-#include <sys/stat.h>
+#include <vector>
 
 #include "apps/autotest.hpp"
 
@@ -24,9 +35,56 @@ void usage() {
                "                    [--rtol R] [--atol A] [--formulation 0|1|2]\n");
 }
 
+[[noreturn]] void bad_argument(const std::string& why) {
+  std::fprintf(stderr, "pkm_autotest: %s\n", why.c_str());
+  usage();
+  std::exit(2);
+}
+
+/// The value of `option`, a positive finite number, or bad_argument.
+double positive_number(const std::string& option, const char* text) {
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || errno == ERANGE)
+    bad_argument(option + ": '" + text + "' is not a number");
+  if (!std::isfinite(v) || v <= 0) bad_argument(option + ": '" + text + "' must be a positive number");
+  return v;
+}
+
+/// Creates `dir` (with its parents) when missing; why it cannot hold the
+/// results, or "" when it can.
+std::string unwritable(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return "cannot create the directory: " + ec.message();
+  if (!std::filesystem::is_directory(dir, ec)) return "not a directory";
+  if (access(dir.c_str(), W_OK | X_OK) != 0) return std::string("not writable: ") + std::strerror(errno);
+  return "";
+}
+
 void progress(void* user, double t, double t_end) {
   std::fprintf(stderr, "  [%s] t = %5.3f s of %.3f s (%3.0f%%)\n", static_cast<const char*>(user), t, t_end,
                100.0 * t / t_end);
+}
+
+/// One line of the verdict: a measured value against its bound
+/// (pkm4puu.validation.checks's columns).
+struct Check {
+  std::string case_name, quantity;
+  double measured, bound;
+  const char* unit;
+  bool passed() const { return measured <= bound; }  // false for NaN
+};
+
+bool write_checks(const std::string& path, const std::vector<Check>& checks) {
+  FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) return false;
+  std::fprintf(f, "case,quantity,measured,relation,bound,unit,verdict\n");
+  for (const auto& c : checks)
+    std::fprintf(f, "%s,%s,%.6e,<=,%g,%s,%s\n", c.case_name.c_str(), c.quantity.c_str(), c.measured, c.bound,
+                 c.unit, c.passed() ? "PASS" : "FAIL");
+  return std::fclose(f) == 0;
 }
 
 bool write_csv(const std::string& path, const pkm::AutotestResult& r) {
@@ -58,28 +116,28 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        usage();
-        std::exit(2);
-      }
+      if (i + 1 >= argc) bad_argument(a + " needs a value");
       return argv[++i];
     };
     if (a == "--out") out_dir = next();
     else if (a == "--solver") which = next();
-    else if (a == "--rk4-step") base.rk4_step = std::atof(next());
-    else if (a == "--rtol") base.rtol = std::atof(next());
-    else if (a == "--atol") base.atol = std::atof(next());
-    else if (a == "--formulation") base.formulation = static_cast<pkm::Formulation>(std::atoi(next()));
-    else {
+    else if (a == "--rk4-step") base.rk4_step = positive_number(a, next());
+    else if (a == "--rtol") base.rtol = positive_number(a, next());
+    else if (a == "--atol") base.atol = positive_number(a, next());
+    else if (a == "--formulation") {
+      const std::string f = next();
+      if (f != "0" && f != "1" && f != "2") bad_argument("--formulation: '" + f + "' is not 0, 1 or 2");
+      base.formulation = static_cast<pkm::Formulation>(f[0] - '0');
+    } else if (a == "-h" || a == "--help") {
       usage();
-      return 2;
+      return 0;
+    } else {
+      bad_argument("unknown option '" + a + "'");
     }
   }
-  if (which != "rk4" && which != "cvode" && which != "both") {
-    usage();
-    return 2;
-  }
-  mkdir(out_dir.c_str(), 0755);
+  if (which != "rk4" && which != "cvode" && which != "both")
+    bad_argument("--solver: '" + which + "' is not rk4, cvode or both");
+  if (const std::string why = unwritable(out_dir); !why.empty()) bad_argument("--out " + out_dir + ": " + why);
 
   pkm::Model model;
   std::string why;
@@ -91,6 +149,8 @@ int main(int argc, char** argv) {
               "P1 = (0.005 m, -0.005 m, 0.07 m, 4 deg), gravity %.2f m/s^2, formulation: %s\n",
               pkm::RestToRest{}.duration, model.p.g, pkm::formulation_name(base.formulation));
   int failures = 0;
+  std::vector<Check> checks;
+  const pkm::AutotestBounds& bound = pkm::kAutotestBounds;
   for (const char* name : {"rk4", "cvode"}) {
     if (which != "both" && which != name) continue;
     pkm::AutotestOptions opt;
@@ -102,7 +162,14 @@ int main(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
     const pkm::Status s = pkm::run_autotest(model, opt, r);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (s != pkm::Status::Ok) {
+    // A run that failed is checked too, with nothing measured: its lines fail.
+    const std::string case_name = std::string("C++ auto-test ") + (opt.solver.solver == pkm::Solver::Rk4 ? "RK4" : "CVODE");
+    const bool ran = s == pkm::Status::Ok;
+    const double nan = std::nan("");
+    checks.push_back({case_name, "max position error", ran ? r.max_position_error : nan, bound.position, "m"});
+    checks.push_back({case_name, "max phi error", ran ? r.max_angle_error : nan, bound.angle, "rad"});
+    checks.push_back({case_name, "max ||C(q)||", ran ? r.max_constraint_residual : nan, bound.constraint, "m"});
+    if (!ran) {
       std::fprintf(stderr, "pkm_autotest [%s]: %s\n", name, r.error.c_str());
       ++failures;
       continue;
@@ -121,6 +188,17 @@ int main(int argc, char** argv) {
                 "max cond(J) = %.2f, max |F - F_static| = %.4f N, %ld derivative evaluations (with inverse dynamics at each), %.2f s wall -> %s\n",
                 r.max_position_error, r.max_angle_error, r.max_constraint_residual, r.max_jacobian_condition,
                 r.max_dynamic_force, r.rhs_evaluations, wall, csv.c_str());
+  }
+  std::printf("Checks against the bounds:\n");
+  for (const auto& c : checks) {
+    std::printf("  %-40s %10.3e %-3s <= %-8g %s\n", (c.case_name + ": " + c.quantity).c_str(), c.measured, c.unit,
+                c.bound, c.passed() ? "PASS" : "FAIL");
+    if (!c.passed()) ++failures;
+  }
+  const std::string checks_csv = out_dir + "/autotest_checks.csv";
+  if (!write_checks(checks_csv, checks)) {
+    std::fprintf(stderr, "pkm_autotest: cannot write %s\n", checks_csv.c_str());
+    ++failures;
   }
   return failures == 0 ? 0 : 1;
 }

@@ -5,6 +5,7 @@ pkm4puu autotest` and the other reports): progress on stderr, the
 the output in ./results of the current directory by default),
 finding the FMUs with a message that says how to build them, an example's
 main (run_program) and writing the output files."""
+import argparse
 import os
 import platform
 import sys
@@ -56,8 +57,26 @@ def add_build_arg(ap, holding="PKM4PUU.fmu and PKM4PUU_Inverse.fmu"):
                     help=f"build directory holding {holding} {BUILD_HELP}")
 
 
+def writable_dir(text, must_exist=False):
+    """An argparse type: Path(text) when it is a writable directory or, unless
+    `must_exist`, can be created as one (its nearest existing ancestor is a
+    writable directory); otherwise argparse.ArgumentTypeError naming the
+    path and why, so that a wrong --out fails at once, before any run."""
+    path = Path(text)
+    probe = path
+    while not must_exist and not probe.exists() and probe.parent != probe:
+        probe = probe.parent
+    if not probe.exists():
+        raise argparse.ArgumentTypeError(f"{text}: no such directory")
+    if not probe.is_dir():
+        raise argparse.ArgumentTypeError(f"{text}: {probe} is not a directory")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise argparse.ArgumentTypeError(f"{text}: {probe} is not writable")
+    return path
+
+
 def add_out_arg(ap, files="CSV, PNG and GIF files"):
-    ap.add_argument("--out", type=Path, default=DEFAULT_OUT, metavar="DIR",
+    ap.add_argument("--out", type=writable_dir, default=str(DEFAULT_OUT), metavar="DIR",
                     help=f"directory for the {files} (default: ./%(default)s)")
 
 

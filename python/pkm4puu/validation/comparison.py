@@ -3,17 +3,19 @@
 through the plant FMU: 1.5 s from rest at P0, gravity off, F2 = F3 = 0,
 F1(t) = 0.02 N sin(2 pi t / 1.5 s) = -F4(t), midpoint-held at a 1 ms step.
 
-This module holds the runner, the quantities the checks look at and the
-result writers; the checks are in test_fmu_comparison.py. Run as a module it
-is part of the main job (run_autotest.sh): it runs the plant FMU with CVODE
-and with RK4, prints the table of the quantities below and writes to --out DIR:
+This module holds the runner, the quantities the checks look at, their
+bounds (BOUNDS) and the result writers; the checks are in
+test_fmu_comparison.py and in this program's verdict. Run as a module it is
+part of the main job (run_autotest.sh): it runs the plant FMU with CVODE and
+with RK4, prints the table of the quantities below and the checks against
+BOUNDS, exits 1 when one fails, and writes to --out DIR:
 
   comparison.csv             platform pose, rho1..rho4 and delta rho1 (CVODE)
+  comparison_checks.csv      the checks (pkm4puu.validation.checks)
   comparison_pose.png        platform pose over time (the paper's Figs. 9-10)
   comparison_delta_rho1.png  displacement of actuator 1 (the paper's Fig. 11)
 
-The quantities (each bounded by test_fmu_comparison.py, which holds the
-bounds and hands them to the table for display, Bounds):
+The quantities (each bounded, BOUNDS):
 - max ||C(q)||, the loop-closure residual the FMU reports;
 - the drift of the machine's vertical centre of mass: with g = 0 the only
   vertical forces are the actuator forces and F1 + F4 = 0, so from rest it
@@ -32,6 +34,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .checks import check, finish_checks, write_checks
 from .cli import add_common_args, case_table, finish, run_cases, start
 from ..fmu import Fmu, run
 from ..interface import F, POSE, START_P0, indexed_names
@@ -55,12 +58,15 @@ SOLVERS = {"CVODE": {"solver": 0, "rtol": 1e-10, "atol": 1e-12}, "RK4": {"solver
 
 
 class Bounds(NamedTuple):
-    """The bounds a caller holds the runs to (the checks:
-    test_fmu_comparison.py), shown in the table; the report itself holds none."""
+    """The bounds the runs are held to, shown in the table."""
     position: float  # m, CVODE vs RK4 and the vertical centre of mass's drift
     phi: float  # rad, CVODE vs RK4
     constraint: float  # m, max ||C(q)||
     min_delta_rho1: float  # m, the least max |delta rho1| of a non-trivial motion
+
+
+BOUNDS = Bounds(position=1e-8, phi=1e-7, constraint=1e-12,
+                min_delta_rho1=1e-5)  # below this the forces barely moved the machine
 
 
 def midpoint_held(fmu, k, t):
@@ -120,6 +126,24 @@ def solver_difference(a, b):
     d_pos = max(np.abs(a[n] - b[n]).max() for n in ["x", "y", "z"] + indexed_names("rho", 4))
     d_phi = np.abs(a["phi"] - b["phi"]).max()
     return d_pos, d_phi
+
+
+def checks(runs, bounds=BOUNDS):
+    """The Checks of every run's constraint residual and centre-of-mass
+    drift, of CVODE's motion being non-trivial and of CVODE vs RK4, against
+    `bounds`."""
+    out = []
+    for name, r in runs.items():
+        out += [check(f"comparison {name}", "max ||C(q)||", max_constraint_residual(r), bounds.constraint, "m"),
+                check(f"comparison {name}", "vertical COM drift", vertical_com_drift(r), bounds.position, "m")]
+    if "CVODE" in runs:
+        out.append(check("comparison CVODE", "max |delta rho1|", max_delta_rho1(runs["CVODE"]),
+                         bounds.min_delta_rho1, "m", relation=">"))
+    if "CVODE" in runs and "RK4" in runs:
+        d_pos, d_phi = solver_difference(runs["CVODE"], runs["RK4"])
+        out += [check("comparison CVODE vs RK4", "max |delta position|", d_pos, bounds.position, "m"),
+                check("comparison CVODE vs RK4", "max |delta phi|", d_phi, bounds.phi, "rad")]
+    return out
 
 
 def format_table(runs, errors=None, bounds=None):
@@ -198,8 +222,10 @@ def main(argv=None):
     errors = {}
     runs = run_all(plant, log=log, errors=errors)
     bad = [f"{name}: non-finite outputs {nonfinite_outputs(r)}" for name, r in runs.items() if nonfinite_outputs(r)]
-    return finish(log, format_table(runs, errors), errors, bad, len(SOLVERS), "runs",
-                  lambda: write_results(runs, args.out))
+    results = checks(runs)
+    status = finish(log, format_table(runs, errors, BOUNDS), errors, bad, len(SOLVERS), "runs",
+                    lambda: [*write_results(runs, args.out), write_checks(args.out / "comparison_checks.csv", results)])
+    return finish_checks(status, results, log)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,13 @@ from pathlib import Path
 
 import numpy as np
 
+from .checks import read_rows
+from .cli import writable_dir
 from .plots import plot_forces, plot_pose, pyplot, save_figure
+
+
+# The quantities of pkm_autotest's checks drawn with their bounds.
+POSITION, PHI = "max position error", "max phi error"
 
 
 def load(path):
@@ -28,7 +34,18 @@ def pose_columns(d, suffix):
     return np.stack([d[f"{n}{suffix}_{unit(n)}"] for n in ("x", "y", "z", "phi")], axis=1)
 
 
-def plot_errors(runs, out):
+def bounds(results):
+    """{quantity: bound} of the position and phi errors, from the checks
+    pkm_autotest wrote beside its CSV files (autotest_checks.csv); empty
+    when there is no such file."""
+    path = results / "autotest_checks.csv"
+    rows = read_rows(path) if path.exists() else []
+    return {r["quantity"]: float(r["bound"]) for r in rows if r["quantity"] in (POSITION, PHI)}
+
+
+def plot_errors(runs, out, bound=None):
+    """Position and phi error of each run over time; with `bound` ({quantity:
+    bound}, see bounds()), a line at each."""
     plt = pyplot()
     fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     for label, d in runs:
@@ -41,8 +58,9 @@ def plot_errors(runs, out):
     axes[1].set_ylabel("|phi error| (rad)")
     axes[1].set_xlabel("time (s)")
     axes[0].set_title("Auto-test round trip: |p(t) - p'(t)|, open loop")
-    for ax in axes:
-        ax.axhline(1e-10, color="k", ls=":", lw=1, label="test bound 1e-10")
+    for ax, quantity in zip(axes, (POSITION, PHI)):
+        if quantity in (bound or {}):
+            ax.axhline(bound[quantity], color="k", ls=":", lw=1, label=f"test bound {bound[quantity]:g}")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(loc="best", fontsize=8)
     save_figure(fig, out)
@@ -52,7 +70,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(prog="python -m pkm4puu plot-autotest",
                                  description="Plots of the C++ auto-test (pkm_autotest --out RESULTS_DIR) from its "
                                  "autotest_*.csv files, written beside them.")
-    ap.add_argument("results", type=Path, metavar="RESULTS_DIR", help="the directory holding autotest_*.csv")
+    ap.add_argument("results", type=lambda text: writable_dir(text, must_exist=True), metavar="RESULTS_DIR",
+                    help="the directory holding autotest_*.csv, where the figures go")
     res = ap.parse_args(argv).results
     runs = []
     for name, label in (("rk4", "RK4, h = 1 ms"), ("cvode", "CVODE Adams, rtol 1e-12")):
@@ -71,7 +90,7 @@ def main(argv=None):
     plot_pose(t, pose_columns(first, "_ref"), pose_columns(first, ""), "forward dynamics p(t)",
               "Auto-test: prescribed motion and forward dynamics driven by the computed forces",
               res / "autotest_pose.png")
-    plot_errors(runs, res / "autotest_errors.png")
+    plot_errors(runs, res / "autotest_errors.png", bounds(res))
     for f in ("autotest_forces.png", "autotest_pose.png", "autotest_errors.png"):
         print(f"wrote {res / f}")
     return 0
