@@ -35,9 +35,15 @@
 #include "fmi/fmi_functions.h"
 #include "models/models.hpp"
 
-// The instantiation tokens (GUIDs): hashes of the variable tables, as in the model descriptions.
-#define PKM_FMU_PLANT_GUID (pkm_fmi::pkm4puu_definition().guid().c_str())
-#define PKM_FMU_INVERSE_GUID (pkm_fmi::pkm4puu_inverse_definition().guid().c_str())
+// The instantiation tokens (GUIDs): hashes of the variable tables, as in the
+// model descriptions; kept for the program's life, so the pointer never dangles.
+inline const char* pkm_test_guid(const pkm_fmi::ModelDefinition& d) {
+  static const std::string plant = pkm_fmi::pkm4puu_definition().guid();
+  static const std::string inverse = pkm_fmi::pkm4puu_inverse_definition().guid();
+  return &d == &pkm_fmi::pkm4puu_definition() ? plant.c_str() : inverse.c_str();
+}
+#define PKM_FMU_PLANT_GUID (pkm_test_guid(pkm_fmi::pkm4puu_definition()))
+#define PKM_FMU_INVERSE_GUID (pkm_test_guid(pkm_fmi::pkm4puu_inverse_definition()))
 
 namespace pkm_test {
 

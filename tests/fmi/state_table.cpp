@@ -63,7 +63,8 @@ struct Any {
   FmuLibrary& lib = plant_library();
 
   Any(int v, bool model_exchange, bool logging_on = true) : version(v), me(model_exchange) {
-    const char* guid = PKM_FMU_PLANT_GUID;
+    const std::string token = pkm_fmi::pkm4puu_definition().guid();  // alive through the calls below
+    const char* guid = token.c_str();
     if (v == 2) {
       c = lib.fmi2Instantiate("table", me ? fmi2ModelExchange : fmi2CoSimulation, guid, "", &functions, fmi2False,
                               logging_on ? fmi2True : fmi2False);
