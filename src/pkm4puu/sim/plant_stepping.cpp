@@ -49,8 +49,14 @@ unsigned Plant::contact_mode_at(const Vec10& x, const Vec4& rho) const {
 int Plant::cvode_roots(double t, const Vec10& x, double* g, void* self) {
   (void)t;
   const auto* me = static_cast<const Plant*>(self);
-  Vec4 rho, rhod;
-  if (me->joint_motion(x.head<8>(), rho, rhod) == Status::Ok) {
+  Vec4 rho, rhod = Vec4::Zero();
+  // With no stop held the clamps' indicators do not depend on the rates:
+  // the actuator positions alone (the legs' lanes, the same bits as
+  // joint_motion's rho) save the legs' velocities at every root evaluation.
+  const bool held = (me->stops_ & ((1u << kStopIndicators) - 1u)) != 0u;
+  const Status s =
+      held ? me->joint_motion(x.head<8>(), rho, rhod) : pkm::actuator_positions(me->model_, x.head<4>(), rho);
+  if (s == Status::Ok) {
     pkm::contact_indicators(me->model_.p, rho, rhod, me->stops_, g);
   } else {
     for (int k = 0; k < kContactIndicators; ++k) g[k] = 1.0;  // off the workspace: the rhs reports it
