@@ -54,3 +54,27 @@ install(FILES "${PROJECT_SOURCE_DIR}/LICENSE" "${PROJECT_SOURCE_DIR}/CHANGELOG.m
         DESTINATION "${CMAKE_INSTALL_DATADIR}/doc/pkm4puu")
 install(FILES "${PKM_LICENSES_DIR}/SUNDIALS.txt" "${PKM_LICENSES_DIR}/Eigen.txt"
         DESTINATION "${CMAKE_INSTALL_DATADIR}/doc/pkm4puu/licenses")
+
+# The Python wheel (PKM_WHEEL, set by pyproject.toml): component Wheel, with
+# destinations relative to the wheel's platlib, inside the package pkm4puu
+# that scikit-build-core copies there from python/: libpkm as
+# pkm4puu/lib/libpkm.so (one file, the name pkm4puu.locate.LIBRARY; ctypes
+# opens it by path), the host's FMU archives as pkm4puu/fmus/fmi2|fmi3/, and
+# the notices of what libpkm links as pkm4puu/licenses/ (the project's
+# LICENSE goes into the wheel's .dist-info; each FMU carries its own). The
+# target pkm_wheel builds only these (pyproject.toml's build.targets).
+if(PKM_WHEEL)
+  install(FILES "$<TARGET_FILE:pkm>" DESTINATION pkm4puu/lib RENAME libpkm.so COMPONENT Wheel)
+  install(FILES "${PKM_LICENSES_DIR}/SUNDIALS.txt" "${PKM_LICENSES_DIR}/Eigen.txt"
+          DESTINATION pkm4puu/licenses COMPONENT Wheel)
+  add_custom_target(pkm_wheel DEPENDS pkm)
+  if(NOT _pkm_pack_python)
+    message(FATAL_ERROR "PKM_WHEEL: the wheel holds the FMU archives, which take a Python to pack (PKM_FMU_PYTHON)")
+  endif()
+  get_property(_pkm_models GLOBAL PROPERTY PKM_FMU_MODELS)
+  foreach(_id IN LISTS _pkm_models)
+    install(FILES "${PROJECT_BINARY_DIR}/${_id}.fmu" DESTINATION pkm4puu/fmus/fmi2 COMPONENT Wheel)
+    install(FILES "${PROJECT_BINARY_DIR}/fmi3/${_id}.fmu" DESTINATION pkm4puu/fmus/fmi3 COMPONENT Wheel)
+    add_dependencies(pkm_wheel ${_id}_fmu ${_id}_fmu3)
+  endforeach()
+endif()

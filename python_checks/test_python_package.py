@@ -15,7 +15,7 @@ import pytest
 
 import pkm4puu as pkm
 from conftest import REPO
-from pkm4puu import locate
+from pkm4puu import capi, locate
 from pkm4puu.__main__ import COMMANDS
 
 MARKER = "The auto-test in a few lines:"
@@ -111,6 +111,42 @@ def test_build_directory_from_argument_environment_or_cwd(tmp_path, monkeypatch)
     assert locate.build_dir(tmp_path / "arg") == tmp_path / "arg"
 
 
+
+def test_files_from_the_asked_build_else_the_package_else_cwd_build(tmp_path, monkeypatch):
+    """locate.fmu_path and library_path (find_fmu, capi.load): the build
+    directory when one is asked for (argument, else $PKM_BUILD_DIR), else the
+    package's own copies (a wheel's pkm4puu/fmus and pkm4puu/lib), else
+    ./build."""
+    pkg, cwd = tmp_path / "pkg", tmp_path / "cwd"
+    for rel in ("fmus/fmi2/PKM4PUU.fmu", "fmus/fmi3/PKM4PUU.fmu", locate.LIBRARY):
+        (pkg / rel).parent.mkdir(parents=True, exist_ok=True)
+        (pkg / rel).write_bytes(b"")
+    (cwd / "build").mkdir(parents=True)
+    monkeypatch.chdir(cwd)
+    monkeypatch.delenv(locate.BUILD_ENV, raising=False)
+    monkeypatch.setattr(locate, "PACKAGE_DIR", pkg)
+    assert pkm.find_fmu("PKM4PUU", 2) == pkg / "fmus/fmi2/PKM4PUU.fmu"
+    assert pkm.find_fmu("PKM4PUU", 3) == pkg / "fmus/fmi3/PKM4PUU.fmu"
+    assert capi.library_path() == pkg / locate.LIBRARY
+    # not packaged: ./build's
+    assert locate.fmu_path("PKM4PUU_Inverse", 3) == cwd / "build/fmi3/PKM4PUU_Inverse.fmu"
+    # asked for: the build directory's, packaged or not
+    assert locate.fmu_path("PKM4PUU", 2, tmp_path / "arg") == tmp_path / "arg/PKM4PUU.fmu"
+    monkeypatch.setenv(locate.BUILD_ENV, str(tmp_path / "env"))
+    assert locate.fmu_path("PKM4PUU", 3) == tmp_path / "env/fmi3/PKM4PUU.fmu"
+    assert capi.library_path() == tmp_path / "env" / locate.LIBRARY
+    assert locate.fmu_path("PKM4PUU", 2, tmp_path / "arg") == tmp_path / "arg/PKM4PUU.fmu"
+
+
+def test_checks_run_the_build_trees_files(plant_fmu, plant_fmu3, pkm_library):
+    """This package is the development install (python/pyproject.toml): it
+    holds no FMUs nor libpkm of its own, so the checks test the build
+    tree's ($PKM_BUILD_DIR, conftest.py), whatever is asked."""
+    assert not (locate.PACKAGE_DIR / locate.PACKAGED_FMUS).exists()
+    assert locate.packaged(locate.LIBRARY) is None
+    assert pkm.find_fmu("PKM4PUU", 2) == plant_fmu and pkm.find_fmu("PKM4PUU", 3) == plant_fmu3
+    assert capi.library_path() == pkm_library
+
 def run_cli(*args, **kwargs):
     return subprocess.run([sys.executable, "-m", "pkm4puu", *args], capture_output=True, text=True, **kwargs)
 
@@ -158,3 +194,19 @@ def test_wheel_carries_the_version_and_the_licence(tmp_path):
     assert f"\nVersion: {pkm.__version__}\n" in meta
     assert "\nLicense: BSD-2-Clause\n" in meta
     assert re.fullmatch(r"\d+\.\d+\.\d+", pkm.__version__)
+
+
+def test_the_wheel_and_the_development_install_declare_the_same_package():
+    """pyproject.toml (the wheel, with the binaries) and python/pyproject.toml
+    (the editable development install) declare one package: the same name,
+    Python, licence, dependencies, extras and console command, the version
+    from the same _version.py; the command is __main__'s main."""
+    import tomllib
+    root = tomllib.loads((REPO / "pyproject.toml").read_text())
+    dev = tomllib.loads((REPO / "python" / "pyproject.toml").read_text())
+    keys = ("name", "dynamic", "requires-python", "license", "dependencies", "optional-dependencies", "scripts")
+    assert {k: root["project"].get(k) for k in keys} == {k: dev["project"].get(k) for k in keys}
+    assert root["project"]["scripts"] == {"pkm4puu": "pkm4puu.__main__:main"}
+    assert root["tool"]["scikit-build"]["metadata"]["version"]["input"] == "python/pkm4puu/_version.py"
+    assert root["tool"]["scikit-build"]["wheel"]["packages"] == ["python/pkm4puu"]
+    assert (REPO / "python" / "pkm4puu" / "py.typed").is_file()

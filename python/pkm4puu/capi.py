@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """ctypes binding of this project's C API (pkm.h), for the engine
-comparisons. The library is locate.LIBRARY in the build directory (the
-`build` argument, else $PKM_BUILD_DIR, else ./build: see locate).
+comparisons. The library is locate.LIBRARY of the build directory when one
+is asked for (the `build` argument, else $PKM_BUILD_DIR), else the
+installed package's own (a wheel's), else ./build's: see locate.
 
     lib = load()                      # or load(path)
     with Plant(lib) as m:             # spec defaults; Plant(lib, g=0.0) etc.
@@ -15,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .locate import LIBRARY, build_path
+from . import locate
 
 PKM_OK = 0
 PKM_SOLVER_CVODE, PKM_SOLVER_RK4 = 0, 1
@@ -84,8 +85,9 @@ TORQUE_FN = ct.CFUNCTYPE(None, ct.c_void_p, ct.c_double, ct.POINTER(ct.c_double)
 
 
 def library_path(build=None):
-    """libpkm.so in the build directory (locate.build_path)."""
-    return build_path(LIBRARY, build)
+    """libpkm.so: the asked-for build directory's, else the package's, else
+    ./build's (locate.library_path)."""
+    return locate.library_path(build)
 
 
 def load(path=None):

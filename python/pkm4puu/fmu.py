@@ -27,8 +27,10 @@ MODELS = ("PKM4PUU", "PKM4PUU_Inverse")
 
 def find_fmu(model: str = "PKM4PUU", fmi: int = 2, build: PathLike = None) -> Path:
     """The archive of `model` (PKM4PUU, the plant, or PKM4PUU_Inverse) for FMI
-    version `fmi` (2 or 3) in `build` (default: locate.build_dir());
-    FileNotFoundError saying how to build it when it is not there."""
+    version `fmi` (2 or 3): in the build directory `build` or
+    $PKM_BUILD_DIR when given, else the installed package's own (a
+    wheel's), else in ./build (locate.fmu_path); FileNotFoundError saying how
+    to build it when it is not there."""
     if model not in MODELS:
         raise ValueError(f"unknown model {model!r}: one of {', '.join(MODELS)}")
     if fmi not in (2, 3):

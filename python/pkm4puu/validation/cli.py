@@ -48,7 +48,7 @@ def machine_description():
 
 
 DEFAULT_OUT = Path("results")  # relative to the current directory
-BUILD_HELP = f"(default: ${BUILD_ENV}, else ./{DEFAULT_BUILD})"
+BUILD_HELP = f"(default: ${BUILD_ENV}, else the installed package's own, else ./{DEFAULT_BUILD})"
 
 
 def add_build_arg(ap, holding="PKM4PUU.fmu and PKM4PUU_Inverse.fmu"):
