@@ -9,9 +9,12 @@
 2. The FMU reference pages come from the build: <build>/docs/generated/<id>.md,
    written by <id>_files --markdown from the variable tables (the same source
    as the model descriptions and the FMUs' documentation/index.html).
-3. The figures the pages quote come from runs of this build: pkm_autotest
-   (the paper's auto-test with the C++ core, --autotest) writes its checks'
-   CSV, turned here into <build>/docs/generated/autotest_cpp.md.
+3. The figures the pages quote come from runs of this build, in
+   <build>/docs/runs/: pkm_autotest (the paper's auto-test with the C++ core,
+   --autotest) and `python -m pkm4puu autotest|comparison` (the paper's tests
+   through the FMUs), as the main job runs them; their printed tables, their
+   checks (measured, bound, verdict) and their plots become Markdown files
+   of <build>/docs/generated/ that the pages include.
 4. sphinx-build -W --keep-going, on a fresh environment (-E) so that every
    page is read and every warning shows on every run.
 Exit status 1 on any warning or error; prints the wall time of each step.
@@ -19,6 +22,7 @@ Needs docs/requirements.txt and doxygen (scripts/setup.sh --for-build).
 """
 import argparse
 import csv
+import re
 import os
 import shutil
 import subprocess
@@ -66,6 +70,37 @@ def write_checks_table(csv_path, md_path, program):
     md_path.write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
+def write_text(path, text):
+    path.write_text(text, encoding="utf-8")
+
+
+def report_table(stdout, start):
+    """The table a report prints: from the line starting with `start` to the
+    first line of its progress log ("name [  t s]: ...") or its checks."""
+    lines = stdout.splitlines()
+    first = next((i for i, line in enumerate(lines) if line.startswith(start)), None)
+    if first is None:
+        sys.exit(f"build_docs: no table starting {start!r} in:\n{stdout}")
+    table = [lines[first]]
+    for line in lines[first + 1:]:
+        if re.match(r"^\w+ \[\s*[0-9.]+ s\]:", line) or line.startswith("  "):
+            break
+        table.append(line)
+    return "\n".join(table)
+
+
+def write_images(md_path, folder, images):
+    """Markdown images of a run's figures, by their path relative to docs/
+    (Sphinx copies them into the site)."""
+    lines = []
+    for name, alt in images:
+        path = folder / name
+        if not path.is_file():
+            sys.exit(f"build_docs: the run wrote no {path}")
+        lines.append(f"![{alt}]({Path(os.path.relpath(path, DOCS)).as_posix()})")
+    write_text(md_path, "\n\n".join(lines) + "\n")
+
+
 def step(name, fn):
     t0 = time.monotonic()
     fn()
@@ -104,19 +139,49 @@ def main():
     if not autotest.is_file():
         sys.exit(f"build_docs: no {autotest}: build it first (cmake --build {build} --target pkm_autotest)")
 
-    def run_autotest():
-        out = work / "autotest"
-        out.mkdir(parents=True, exist_ok=True)
+    runs = work / "runs"
+
+    def report(args, cwd_out):
+        """python -m pkm4puu ARGS (the checkout's package), its output printed on failure."""
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), os.environ.get("PYTHONPATH", "")]),
+                   MPLBACKEND="Agg")
+        r = subprocess.run([sys.executable, "-m", "pkm4puu", *args], capture_output=True, text=True, env=env)
+        if r.returncode != 0:
+            sys.exit(f"build_docs: python -m pkm4puu {' '.join(args)} failed (exit {r.returncode}):\n"
+                     f"{r.stdout}{r.stderr}")
+        return r.stdout
+
+    def run_figures():
+        # The C++ auto-test (the main job's program) and its figures.
+        out = runs / "autotest"
+        shutil.rmtree(out, ignore_errors=True)
+        out.mkdir(parents=True)
         r = subprocess.run([str(autotest), "--out", str(out)], capture_output=True, text=True)
         if r.returncode != 0:
             sys.exit(f"build_docs: {autotest} failed (exit {r.returncode}):\n{r.stdout}{r.stderr}")
-        write_checks_table(out / "autotest_checks.csv", generated / "autotest_cpp.md", autotest.name)
-        # The run's own summary (one line per integrator), as it printed it.
         summary = [line.strip() for line in r.stdout.splitlines() if "max |position error|" in line]
         if not summary:
             sys.exit(f"build_docs: {autotest} printed no summary line:\n{r.stdout}")
-        (generated / "autotest_cpp_run.md").write_text(
-            "```text\n" + "\n".join(summary) + "\n```\n", encoding="utf-8")
+        write_text(generated / "autotest_cpp_run.md", "```text\n" + "\n".join(summary) + "\n```\n")
+        write_checks_table(out / "autotest_checks.csv", generated / "autotest_cpp.md", autotest.name)
+        report(["plot-autotest", str(out)], out)
+        write_images(generated / "autotest_cpp_plots.md", out, [
+            ("autotest_forces.png", "actuator forces"), ("autotest_pose.png", "prescribed and simulated motion"),
+            ("autotest_errors.png", "round-trip error")])
+        # The paper's two tests through the FMUs (the main job's reports).
+        for name, table_start, images in (
+                ("autotest", "FMU auto-test (paper", [("fmu_autotest_errors.png", "auto-test through the FMUs")]),
+                ("comparison", "FMU comparison test (paper", [
+                    ("comparison_pose.png", "comparison test: platform pose"),
+                    ("comparison_delta_rho1.png", "comparison test: delta rho1")])):
+            out = runs / f"fmu_{name}"
+            shutil.rmtree(out, ignore_errors=True)
+            out.mkdir(parents=True)
+            text = report([name, "--build", str(build), "--out", str(out)], out)
+            write_text(generated / f"fmu_{name}_run.md", "```text\n" + report_table(text, table_start) + "\n```\n")
+            checks = "fmu_autotest_checks.csv" if name == "autotest" else "comparison_checks.csv"
+            write_checks_table(out / checks, generated / f"fmu_{name}.md", f"python -m pkm4puu {name}")
+            write_images(generated / f"fmu_{name}_plots.md", out, images)
 
     def run_doxygen():
         shutil.rmtree(xml, ignore_errors=True)
@@ -136,7 +201,7 @@ def main():
         step("doxygen (pkm.h to XML)", run_doxygen)
     except subprocess.CalledProcessError as e:
         sys.exit(f"build_docs: doxygen failed (exit {e.returncode}); its warnings are errors")
-    step("pkm_autotest (the figures)", run_autotest)
+    step("the figures (pkm_autotest, python -m pkm4puu autotest and comparison)", run_figures)
     step("sphinx-build -W", run_sphinx)
     print(f"build_docs: site in {out}/index.html, {time.monotonic() - total:.1f} s in all")
 
