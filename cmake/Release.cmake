@@ -4,7 +4,9 @@
 # MANIFEST.txt says), the wheel, the sdist, the installed C package and
 # SHA256SUMS (cmake/make_release.py; ctest distribution_release checks one).
 include_guard(GLOBAL)
-if(NOT _pkm_pack_python OR CMAKE_CROSSCOMPILING)
+# Only in this project's own build: a project that adds this one
+# (add_subdirectory, FetchContent) keeps the target name `release` for itself.
+if(NOT _pkm_pack_python OR CMAKE_CROSSCOMPILING OR NOT _pkm_top_level)
   return()
 endif()
 set(_pkm_release_fmus pkm_fmus)
