@@ -18,7 +18,7 @@
 // (exact for inputs that are smooth within each step).
 //
 // A second table, ARKODE's explicit Runge-Kutta (ERKStep) on the same ODE,
-// was a one-off study; its conclusion is in the README ("CVODE across
+// was a one-off study; its conclusion is in docs/performance.md ("CVODE across
 // communication points").
 #include <algorithm>
 #include <chrono>

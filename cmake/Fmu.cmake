@@ -155,15 +155,20 @@ function(pkm_add_fmu id)
   target_link_libraries(${id}_files PRIVATE pkm_model_${id} pkm_version pkm::sundials pkm::options)
   pkm_without_lto(${id}_files)
   set(generated_md "${PROJECT_BINARY_DIR}/modelDescription")
+  # ... and the documentation site's reference page of the model (docs/fmus.md
+  # includes docs/generated/<id>.md of the build tree).
+  set(generated_doc "${PROJECT_BINARY_DIR}/docs/generated/${id}.md")
   add_custom_command(
-    OUTPUT "${generated_md}/fmi2/${id}.xml" "${generated_md}/fmi3/${id}.xml"
+    OUTPUT "${generated_md}/fmi2/${id}.xml" "${generated_md}/fmi3/${id}.xml" "${generated_doc}"
     COMMAND ${CMAKE_COMMAND} -E make_directory "${generated_md}/fmi2" "${generated_md}/fmi3"
+            "${PROJECT_BINARY_DIR}/docs/generated"
     COMMAND ${id}_files --xml "${generated_md}"
+    COMMAND ${id}_files --markdown "${generated_doc}"
     DEPENDS ${id}_files
-    COMMENT "Generating ${id}'s model descriptions from its variable table"
+    COMMENT "Generating ${id}'s model descriptions and reference page from its variable table"
     VERBATIM)
   add_custom_target(${id}_model_descriptions ALL
-                    DEPENDS "${generated_md}/fmi2/${id}.xml" "${generated_md}/fmi3/${id}.xml")
+                    DEPENDS "${generated_md}/fmi2/${id}.xml" "${generated_md}/fmi3/${id}.xml" "${generated_doc}")
   # `cmake --build build --target update_model_descriptions` writes them into
   # the model's folder (commit them); the test model_descriptions_up_to_date
   # compares the two.

@@ -23,7 +23,7 @@ Checked:
   extrapolation 2 x(h/2) - x(h) removes it down to the second-order rest.
 - The inverse FMU: the forces at a pose equal fmpy's.
 fmi-sim sets scalar variables only (--init-values name=value): the FMI 3.0
-FMUs declare scalars with the FMI 2.0 names (README, "The FMUs").
+FMUs declare scalars with the FMI 2.0 names (docs/fmus.md, "FMI 3.0: scalars, held inputs").
 """
 import csv
 import os

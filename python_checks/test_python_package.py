@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""The Python package pkm4puu (python/pkm4puu): the README's session runs as
-written, and the wrapper opens the FMUs by name, runs them with named inputs
+"""The Python package pkm4puu (python/pkm4puu): the getting-started page's
+session and the README's first look run as written, and the wrapper opens the FMUs by name, runs them with named inputs
 and outputs, and says clearly what is wrong with a bad request; the library
 imports without matplotlib, finds the build directory from what it is given
 (not from where it is installed), and python -m pkm4puu runs the reports."""
@@ -18,29 +18,43 @@ from conftest import REPO
 from pkm4puu import capi, locate
 from pkm4puu.__main__ import COMMANDS
 
-MARKER = "The auto-test in a few lines:"
+# The getting-started page's Python session (docs/getting_started.md includes
+# the file) and the README's first look, both run as written.
+AUTOTEST_SNIPPET = REPO / "docs" / "snippets" / "first_python.py"
+README_MARKER = "## A first look from Python"
 
 
 def readme_session():
     text = (REPO / "README.md").read_text()
-    m = re.search(re.escape(MARKER) + r"\s*```python\n(.*?)```", text, re.S)
-    assert m, f"README.md has no python block after {MARKER!r}"
+    m = re.search(re.escape(README_MARKER) + r"\s*```python\n(.*?)```", text, re.S)
+    assert m, f"README.md has no python block after {README_MARKER!r}"
     return m.group(1)
 
 
-def test_readme_session_runs_the_auto_test(plant_fmu, inverse_fmu, capsys, monkeypatch):
+def test_getting_started_session_runs_the_auto_test(plant_fmu, inverse_fmu, capsys, monkeypatch):
     """Executed as written (plt.show on a non-interactive backend); the error
-    it prints is the FMU auto-test's bound (MODEL_SPEC: the pose follows the
+    it prints is the FMU auto-test's bound (docs/model.md: the pose follows the
     prescribed path to 5e-8 with midpoint-held forces, test_fmu_autotest)."""
     matplotlib.use("Agg")
     monkeypatch.setenv("PKM_BUILD_DIR", str(plant_fmu.parent))
     scope = {}
-    exec(compile(readme_session(), "README.md session", "exec"), scope)
+    exec(compile(AUTOTEST_SNIPPET.read_text(), str(AUTOTEST_SNIPPET), "exec"), scope)
     out = capsys.readouterr().out
     m = re.search(r"largest position error (\S+) m", out)
     assert m, out
     assert float(m.group(1)) < 5e-8
     assert scope["run"].t[-1] == pytest.approx(pkm.T_MOVE)
+
+
+def test_readme_first_look_holds_the_platform_at_home(plant_fmu, capsys, monkeypatch):
+    """The README's block: the static forces of docs/model.md hold the plant at
+    P0, so the last pose it prints is P0 to within the integration's rounding."""
+    monkeypatch.setenv("PKM_BUILD_DIR", str(plant_fmu.parent))
+    scope = {}
+    exec(compile(readme_session(), "README.md first look", "exec"), scope)
+    assert scope["run"].t[-1] == pytest.approx(1.0)
+    assert np.abs(scope["run"].values[-1] - pkm.P0).max() < 1e-9
+    assert capsys.readouterr().out.strip()
 
 
 def test_open_by_name_and_version(plant_fmu, plant_fmu3):

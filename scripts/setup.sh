@@ -6,9 +6,11 @@
 # Idempotent and non-interactive (CI-safe).
 #   scripts/setup.sh                everything
 #   scripts/setup.sh --for-build    what configuring and building need: the
-#                                   Debian packages and, in .venv, fmpy (its
-#                                   FMI headers); ./run_tests.sh installs the
-#                                   rest while it builds
+#                                   Debian packages (doxygen for the docs
+#                                   among them) and, in .venv, fmpy (its FMI
+#                                   headers) and docs/requirements.txt (the
+#                                   ctest docs_build); ./run_tests.sh installs
+#                                   the rest while it builds
 #   scripts/setup.sh --for-main-job what ./run_autotest.sh needs: the
 #                                   compiler, CMake, Ninja, Eigen, SUNDIALS and
 #                                   Python, and in .venv fmpy, numpy,
@@ -30,6 +32,7 @@ esac
 packages=(build-essential cmake ninja-build libeigen3-dev libsundials-dev python3 python3-venv)
 if [ "$mode" != main-job ]; then
   packages+=(libgtest-dev python3-pip
+             doxygen  # the documentation site's C API page (docs/build_docs.py)
              clang libclang-rt-14-dev valgrind  # hardening: libFuzzer + sanitizers (fuzz/), memcheck
              # every platform (cmake/Platforms.cmake): Windows x64 built with mingw-w64 and run
              # under wine, Linux aarch64 built with gcc and run under qemu-user; dpkg-dev
@@ -112,9 +115,34 @@ PY
     .venv/bin/pip install --disable-pip-version-check -q --no-compile "${pins[@]}"
   fi
 }
+# install_docs: docs/requirements.txt (Sphinx and its extensions, ctest
+# docs_build) unless every pin of it is installed already.
+install_docs() {
+  local docs_req=docs/requirements.txt
+  if ! .venv/bin/python - "$docs_req" <<'PY'
+import sys
+from importlib.metadata import PackageNotFoundError, version
+ok = True
+for line in open(sys.argv[1]):
+    line = line.split("#")[0].strip()
+    if not line:
+        continue
+    name, wanted = line.split("==")
+    try:
+        ok &= version(name) == wanted
+    except PackageNotFoundError:
+        ok = False
+sys.exit(0 if ok else 1)
+PY
+  then
+    log "installing the documentation's requirements from $docs_req"
+    .venv/bin/pip install --disable-pip-version-check -q --no-compile -r "$docs_req"
+  fi
+}
 case "$mode" in
   build)
     install_pinned fmpy
+    install_docs
     log "done (for the build)"
     exit 0 ;;
   main-job) install_pinned fmpy numpy matplotlib wheel ;;  # wheel: the editable install of pkm4puu below
@@ -125,7 +153,8 @@ case "$mode" in
       touch "$stamp"
     else
       log "Python requirements up to date"
-    fi ;;
+    fi
+    install_docs ;;
 esac
 # 3. This project's Python package (python/pkm4puu), editable: the checks,
 # examples and benchmarks import it, and it follows the working tree.

@@ -26,7 +26,7 @@
  * force (MODEL_SPEC "A check anyone can derive") plus on F[1] the ramp 0.2 t N
  * given as value and slope each tick, so the inputs continue and CVODE keeps
  * its history across ticks (a held input that jumps every tick restarts it:
- * see the README's continuation table). Timings: --batches B (default 7)
+ * see docs/performance.md's continuation table). Timings: --batches B (default 7)
  * batches of 1 simulated second per cell, the cells interleaved batch by
  * batch; the median, and the minimum in parentheses.
  *

@@ -2,7 +2,7 @@
 """ctypes binding of this project's C API (pkm.h), for the engine
 comparisons. The library is locate.LIBRARY of the build directory when one
 is asked for (the `build` argument, else $PKM_BUILD_DIR), else the
-installed package's own (a wheel's), else ./build's: see locate.
+installed package's own (a wheel's), else ./build's: see locate::
 
     lib = load()                      # or load(path)
     with Plant(lib) as m:             # spec defaults; Plant(lib, g=0.0) etc.

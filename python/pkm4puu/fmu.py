@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Opening and driving the project's FMUs from Python: a thin, always
 cleaning-up wrapper around fmpy's FMU2Slave and FMU3Slave that speaks the
-interface's names.
+interface's names::
 
     from pkm4puu import Fmu
     with Fmu.open("PKM4PUU", start={"solver": 1}) as plant:

@@ -3,7 +3,7 @@
 // FMI function as a method over the model's table and hooks. The thin front
 // ends (fmi2_functions.cpp, fmi3_functions.cpp) translate the C calls.
 //
-// Error policy (README "Error policy"): every check runs before anything
+// Error policy (docs/robustness.md, "Error policy"): every check runs before anything
 // changes. A call with wrong arguments or in the wrong state, parameters
 // that cannot be used (ExitInitializationMode: the instance stays in
 // initialization mode, where they can be corrected), a step beyond the work

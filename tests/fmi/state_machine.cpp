@@ -464,7 +464,7 @@ TEST_F(StateMachine, InstantiateWithBadArguments) {
             "nothing to lose yet");
 }
 
-// The error policy (README "Error policy", instance.hpp) as a table: each
+// The error policy (docs/robustness.md "Error policy", instance.hpp) as a table: each
 // refusal, its status, and what the instance can still do without Reset.
 // Errors found before anything changed leave the instance as it was,
 // wherever they come from (FMI 2.0.4 allows an importer to give up after
