@@ -43,6 +43,7 @@ class FourierTrajectory:
     b: np.ndarray                  # (4, harmonics)
     center: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 0.06, 0.0]))
     condition: float = float("nan")  # of the stacked base regressor (unit-norm columns)
+    start_condition: float = float("nan")  # the same at the optimisation's random start
 
     @property
     def harmonics(self):
@@ -88,12 +89,14 @@ class _Problem:
             return self._cache[key]
         pose, vel, acc = self.trajectory(x).evaluate(self.t)
         L = self.limits
-        box = np.concatenate([L.xy - np.abs(pose[:, 0]), L.xy - np.abs(pose[:, 1]), pose[:, 2] - L.z[0],
-                              L.z[1] - pose[:, 2], L.phi - np.abs(pose[:, 3])])
+        # Every margin at every sample, relative to its own limit (SLSQP sees
+        # them alike): >= 0 within the limits.
+        box = np.concatenate([1.0 - np.abs(pose[:, :2]).ravel() / L.xy, (pose[:, 2] - L.z[0]) / (L.z[1] - L.z[0]),
+                              (L.z[1] - pose[:, 2]) / (L.z[1] - L.z[0]), 1.0 - np.abs(pose[:, 3]) / L.phi])
         try:
             Y, F0, rho, drho = self.plant.regressor_poses(pose, vel, acc)
         except capi.PkmError:
-            val = (1e3, np.concatenate([[box.min()], -np.ones(4)]))
+            val = (1e3, np.concatenate([box, -np.ones(16 * len(self.t))]))
         else:
             W = Y[:, :, self.base.independent].reshape(-1, len(self.base.independent))
             norms = np.linalg.norm(W, axis=0)
@@ -103,17 +106,49 @@ class _Problem:
                 s = np.linalg.svd(W / norms, compute_uv=False)
                 cond = np.log10(s[0] / s[-1])
             F = np.einsum("nij,j->ni", Y, self.pi) + F0
-            val = (cond, np.array([box.min(), (rho - self.rho_min - L.stop_margin).min(),
-                                   (self.rho_max - L.stop_margin - rho).min(), L.speed - np.abs(drho).max(),
-                                   L.force - np.abs(F).max()]))
+            travel = self.rho_max - self.rho_min
+            val = (cond, np.concatenate([box, ((rho - self.rho_min - L.stop_margin) / travel).ravel(),
+                                         ((self.rho_max - L.stop_margin - rho) / travel).ravel(),
+                                         (1.0 - np.abs(drho) / L.speed).ravel(), (1.0 - np.abs(F) / L.force).ravel()]))
         if len(self._cache) > 4096:
             self._cache.clear()
         self._cache[key] = val
         return val
 
 
-def optimise_excitation(lib=None, *, period=2.5, harmonics=5, limits=None, model=None, samples=200, seed=0,
-                        maxiter=150, center=(0.0, 0.0, 0.06, 0.0)) -> FourierTrajectory:
+def _feasible_start(prob, limits, period, harmonics, seed):
+    """Seeded random coefficients within the limits: amplitudes a fraction
+    of the workspace's, shrunk until every constraint holds."""
+    rng = np.random.default_rng(seed)
+    k = np.arange(1, harmonics + 1) * (2 * np.pi / period)
+    amp = np.array([limits.xy, limits.xy, 0.5 * (limits.z[1] - limits.z[0]), limits.phi])
+    for attempt in range(20):
+        shrink = 0.4 * 0.8 ** attempt
+        a = rng.uniform(-1, 1, (4, harmonics)) * (shrink * amp)[:, None] * k / np.sqrt(harmonics)
+        b = rng.uniform(-1, 1, (4, harmonics)) * (shrink * amp)[:, None] * k / np.sqrt(harmonics)
+        x0 = np.concatenate([a.ravel(), b.ravel()])
+        if np.all(prob.evaluate(x0)[1] >= 0):
+            return x0
+    raise RuntimeError("no starting trajectory within the limits: widen them")
+
+
+def random_trajectory(lib=None, *, period=3.0, harmonics=4, limits=None, model=None, samples=100, seed=1,
+                      center=(0.0, 0.0, 0.06, 0.0)) -> FourierTrajectory:
+    """A Fourier trajectory with seeded random coefficients within `limits`
+    (not optimised): a validation trajectory unlike the excitation."""
+    lib = lib or capi.load()
+    limits = limits or Limits()
+    with make_plant(lib, model) as plant:
+        base = base_parameters(plant)
+        prob = _Problem(plant, base, plant.regressor_params(), limits, period, harmonics, center, samples)
+        x = _feasible_start(prob, limits, period, harmonics, seed)
+        traj = prob.trajectory(x)
+        traj.condition = float(10 ** prob.evaluate(x)[0])
+    return traj
+
+
+def optimise_excitation(lib=None, *, period=2.5, harmonics=5, limits=None, model=None, samples=100, seed=0,
+                        maxiter=60, center=(0.0, 0.0, 0.06, 0.0)) -> FourierTrajectory:
     """The Fourier coefficients (a, b per axis and harmonic) that minimise the
     condition number of the stacked base regressor at `samples` points of
     one period, its columns scaled to unit norm, subject to `limits`
@@ -128,26 +163,20 @@ def optimise_excitation(lib=None, *, period=2.5, harmonics=5, limits=None, model
         base = base_parameters(plant)
         pi = plant.regressor_params()
         prob = _Problem(plant, base, pi, limits, period, harmonics, center, samples)
-        rng = np.random.default_rng(seed)
-        w = 2 * np.pi / period
-        k = np.arange(1, harmonics + 1) * w
-        amp = np.array([limits.xy, limits.xy, 0.5 * (limits.z[1] - limits.z[0]), limits.phi])
-        best = None
-        for attempt in range(20):  # a start within the limits
-            shrink = 0.4 * 0.8 ** attempt
-            a = rng.uniform(-1, 1, (4, harmonics)) * (shrink * amp)[:, None] * k / np.sqrt(harmonics)
-            b = rng.uniform(-1, 1, (4, harmonics)) * (shrink * amp)[:, None] * k / np.sqrt(harmonics)
-            x0 = np.concatenate([a.ravel(), b.ravel()])
-            if np.all(prob.evaluate(x0)[1] >= 0):
-                best = x0
-                break
-        if best is None:
-            raise RuntimeError("no starting trajectory within the limits: widen them")
+        best = _feasible_start(prob, limits, period, harmonics, seed)
         res = minimize(lambda x: prob.evaluate(x)[0], best, method="SLSQP",
                        constraints=[{"type": "ineq", "fun": lambda x: prob.evaluate(x)[1]}],
                        options={"maxiter": maxiter, "ftol": 1e-6})
-        x = res.x if np.all(prob.evaluate(res.x)[1] >= -1e-9) else best
+        # The last iterate may end slightly outside the limits: back off
+        # towards the feasible start until it is inside.
+        x = best
+        for alpha in 0.5 ** np.arange(0, 12):
+            trial = best + alpha * (res.x - best)
+            if np.all(prob.evaluate(trial)[1] >= 0.0):
+                x = trial
+                break
         cond, _ = prob.evaluate(x)
         traj = prob.trajectory(x)
         traj.condition = float(10 ** cond)
+        traj.start_condition = float(10 ** prob.evaluate(best)[0])
     return traj
