@@ -122,9 +122,10 @@ def identify(t, rho, F, *, cutoff=20.0, order=4, trim=None, model=None, physical
     physical: constrain the base parameters to their physical bounds
       (positive masses and inertias, friction >= 0, the rod's triangle
       inequalities), so that the start values are a valid parameter set.
-    rank_tol: a base parameter whose column in the (unit-norm scaled)
-      stacked regressor lies within this relative distance of the others'
-      span is not identifiable from the data: IdentificationError names it.
+    rank_tol: a base parameter whose column in the stacked regressor (each
+      column relative to its size under generic motions) lies within this
+      relative distance of the others' span is not identifiable from the
+      data: IdentificationError names it.
     """
     from scipy.linalg import qr
 
@@ -165,22 +166,20 @@ def identify(t, rho, F, *, cutoff=20.0, order=4, trim=None, model=None, physical
     y = (F[keep] - F0).reshape(-1)
     n_rows = len(y)
 
-    # Identifiability: the unit-norm columns' pivoted QR (docs/calibration.md).
-    norms = np.linalg.norm(W, axis=0)
-    zero = [base.names[j] for j in np.where(norms == 0.0)[0]]
-    if zero:
-        raise IdentificationError(f"the data do not excite {', '.join(zero)} (their regressor columns are zero): "
-                                  f"not identifiable; use an exciting trajectory (pkm4puu.calibration.excitation)")
-    Ws = W / norms
-    R, piv = qr(Ws, mode="r", pivoting=True)
+    # Identifiability: the pivoted QR of the columns, each relative to its
+    # size under generic motions (BaseParameters.typical), so that a column
+    # the data leave near zero counts as zero (docs/calibration.md).
+    Wt = W / (base.typical * np.sqrt(n_rows))
+    R, piv = qr(Wt, mode="r", pivoting=True)
     d = np.abs(np.diag(R))
-    weak = [base.names[piv[j]] for j in range(nb) if d[j] <= rank_tol * d[0]]
+    weak = [base.names[piv[j]] for j in range(nb) if not d[j] > rank_tol * d[0]]
     if weak:
         raise IdentificationError(
             f"the regressor is rank-deficient ({nb - len(weak)} of {nb}): the data do not separate "
-            f"{', '.join(weak)} from the other parameters, which are not identifiable; use a longer or more "
+            f"{', '.join(weak)} from the other parameters: not identifiable; use a longer or more "
             f"exciting trajectory (pkm4puu.calibration.excitation)")
-    s = np.linalg.svd(Ws, compute_uv=False)
+    norms = np.linalg.norm(W, axis=0)
+    s = np.linalg.svd(W / norms, compute_uv=False)
     condition = float(s[0] / s[-1])
 
     # Ordinary, then leg-weighted least squares (each leg's noise its own).

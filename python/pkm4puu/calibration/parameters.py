@@ -69,6 +69,7 @@ class BaseParameters:
     independent: list   # indices into pi of the base parameters' leading terms
     dependent: list     # indices into pi of the parameters folded into them
     K: np.ndarray       # (n_base, n_pi)
+    typical: np.ndarray  # RMS of each base parameter's regressor entries over the random motions
 
     @property
     def names(self):
@@ -145,4 +146,5 @@ def base_parameters(plant, samples=120, seed=0, tol=1e-9):
         near_int = np.abs(beta - np.round(beta)) < 1e-9
         beta[near_int] = np.round(beta[near_int])
         K[:, dependent] = beta
-    return BaseParameters(names, units, kept, dependent, K)
+    typical = norms[kept] / np.sqrt(W.shape[0])
+    return BaseParameters(names, units, kept, dependent, K, typical)
