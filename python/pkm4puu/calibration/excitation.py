@@ -153,8 +153,9 @@ def optimise_excitation(lib=None, *, period=2.5, harmonics=5, limits=None, model
     condition number of the stacked base regressor at `samples` points of
     one period, its columns scaled to unit norm, subject to `limits`
     (Limits) with the nominal parameters `model` (FMU names over the spec's).
-    SLSQP from a seeded random start inside the limits; raises RuntimeError
-    if no trajectory within the limits was found."""
+    SLSQP from a seeded random start inside the limits; the result holds
+    them also on a grid ten times finer. Raises RuntimeError if no
+    trajectory within the limits was found."""
     from scipy.optimize import minimize
 
     lib = lib or capi.load()
@@ -167,14 +168,19 @@ def optimise_excitation(lib=None, *, period=2.5, harmonics=5, limits=None, model
         res = minimize(lambda x: prob.evaluate(x)[0], best, method="SLSQP",
                        constraints=[{"type": "ineq", "fun": lambda x: prob.evaluate(x)[1]}],
                        options={"maxiter": maxiter, "ftol": 1e-6})
-        # The last iterate may end slightly outside the limits: back off
-        # towards the feasible start until it is inside.
+        # The last iterate may end slightly outside the limits, or between
+        # the samples: back off towards the start until it is inside on a
+        # grid ten times finer.
+        fine = _Problem(plant, base, pi, limits, period, harmonics, center, 10 * samples)
         x = best
-        for alpha in 0.5 ** np.arange(0, 12):
+        for alpha in np.append(0.5 ** np.arange(0, 12), 0.0):
             trial = best + alpha * (res.x - best)
-            if np.all(prob.evaluate(trial)[1] >= 0.0):
+            if np.all(prob.evaluate(trial)[1] >= 0.0) and np.all(fine.evaluate(trial)[1] >= 0.0):
                 x = trial
                 break
+        else:
+            raise RuntimeError("the excitation's random start leaves the limits between its samples: "
+                               "use more samples")
         cond, _ = prob.evaluate(x)
         traj = prob.trajectory(x)
         traj.condition = float(10 ** cond)

@@ -65,22 +65,29 @@ def parser():
     return ap
 
 
-def main(argv=None):
-    args = parser().parse_args(argv)
+def parse_model(ap, items):
+    """{name: value} from --model NAME=VALUE items (ap.error otherwise)."""
     model = {}
-    for item in args.model:
+    for item in items:
         name, sep, value = item.partition("=")
         try:
             model[name] = float(value)
         except ValueError:
             sep = ""
         if not sep:
-            parser().error(f"--model {item!r}: expected NAME=VALUE with a number")
+            ap.error(f"--model {item!r}: expected NAME=VALUE with a number")
+    return model
+
+
+def main(argv=None):
+    ap = parser()
+    args = ap.parse_args(argv)
+    model = parse_model(ap, args.model)
     from ..calibration import IdentificationError, identify
     try:
         t, rho, F = read_log(args.log)
         r = identify(t, rho, F, cutoff=args.cutoff, model=model, physical=not args.no_physical)
-    except (LogError, IdentificationError) as e:
+    except (LogError, IdentificationError, KeyError) as e:
         print(f"python -m pkm4puu identify: error: {e}", file=sys.stderr)
         return 1
     print(r.table())
