@@ -76,7 +76,7 @@ def _check_data(t, rho, F, min_samples):
                                       f"{where}: remove or interpolate them")
     if len(t) < min_samples:
         raise IdentificationError(f"too short: {len(t)} samples, the identification needs at least {min_samples} "
-                                  f"(the filter's edges and 3 rows per base parameter)")
+                                  f"(3 rows per base parameter and more)")
     dt = np.diff(t)
     if np.any(dt <= 0):
         k = int(np.argmax(dt <= 0))
@@ -122,6 +122,8 @@ def identify(t, rho, F, *, cutoff=20.0, order=4, trim=None, model=None, physical
     physical: constrain the base parameters to their physical bounds
       (positive masses and inertias, friction >= 0, the rod's triangle
       inequalities), so that the start values are a valid parameter set.
+    guess: the platform pose (x, y, z, phi) the forward kinematics starts
+      from at the first sample (default the home pose 0, 0, 0.05 m, 0).
     rank_tol: a base parameter whose column in the stacked regressor (each
       column relative to its size under generic motions) lies within this
       relative distance of the others' span is not identifiable from the
@@ -138,12 +140,12 @@ def identify(t, rho, F, *, cutoff=20.0, order=4, trim=None, model=None, physical
     with plant:
         base = base_parameters(plant)
         nb = len(base.independent)
-        h_guess = None
-        if len(np.shape(t)) == 1 and len(t) > 1:
-            h_guess = (t[-1] - t[0]) / (len(t) - 1) if np.all(np.isfinite([t[0], t[-1]])) else None
-        trim_n = trim if trim is not None else (int(np.ceil(2.0 / (cutoff * h_guess))) if h_guess and h_guess > 0
-                                                else 0)
-        t, rho, F, h = _check_data(t, rho, F, min_samples=2 * trim_n + 3 * nb + 30)
+        t, rho, F, h = _check_data(t, rho, F, min_samples=3 * nb + 30)
+        trim_n = int(trim) if trim is not None else int(np.ceil(2.0 / (cutoff * h)))
+        if len(t) < 2 * trim_n + 3 * nb + 30:
+            raise IdentificationError(f"too short: {len(t)} samples, the identification needs at least "
+                                      f"{2 * trim_n + 3 * nb + 30} (the filter's edges, {trim_n} at each end, "
+                                      f"and 3 rows per base parameter)")
         rho_min, rho_max = plant.machine.rho_min, plant.machine.rho_max
         outside = np.argwhere((rho < rho_min) | (rho > rho_max))
         if len(outside):
