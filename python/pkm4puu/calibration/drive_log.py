@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from fmpy.fmi1 import FMICallException
 
 from ..fmu import Fmu, find_fmu
 from ..interface import ACC, DRHO, F, POSE, RHO, VEL
@@ -63,7 +64,7 @@ def replay(forces, t, params, pose0, vel0, build=None, plant=None):
             fmu.set_derivatives(F, (forces[k + 1] - forces[k]) / h)
             try:
                 fmu.do_step(t[k], h)
-            except Exception:
+            except FMICallException:  # the FMU refused the step (its guards): the motion left the workspace
                 return rho, t[k]
             rho[k + 1] = fmu.get(RHO)
     return rho, t[-1]
