@@ -49,6 +49,17 @@ def test_a_good_log_identifies_the_parameters(good, lib):
     with make_plant(lib, MODEL) as p:
         truth = r.base.K @ p.regressor_params()
     assert np.all(np.abs(r.values_ls - truth) < 3 * r.std + 1e-12)
+    # No payload in the model and none in the data: its first moments are
+    # insignificant and the start values have none.
+    assert not r.warnings
+    assert r.start_values["payload_mass"] == 0.0 and r.start_values["payload_com[1]"] == 0.0
+
+
+def test_a_model_parameter_that_does_not_exist_is_named(good, lib):
+    with pytest.raises(IdentificationError, match="'m_sliders' is no parameter of the model"):
+        identify(*good, model={"m_sliders": 0.1}, lib=lib)
+    with pytest.raises(IdentificationError, match="screw_lead"):
+        identify(*good, model={"screw_lead": -1.0}, lib=lib)
 
 
 def test_too_short(good, lib):
