@@ -37,6 +37,7 @@
 #include "apps/autotest.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
+#include "pkm4puu/dynamics/regressor.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
 #include "pkm4puu/dynamics/state_derivative.hpp"
 #include "pkm4puu/sim/plant.hpp"
@@ -350,6 +351,59 @@ double derivatives_section(Bench& b) {
               fmt_time(idd.min).c_str(), idd.median / id_plain.median);
   rule();
   return jac_ratio;
+}
+
+// ----------------------------------------- 1c. calibration regressor
+// The regressor Y (4 x 14) of the forces in the dynamic parameters
+// (regressor.hpp) at the same motion as one cold inverse_dynamics, both
+// measured here in the same run; and from the sliders' measurements
+// (forward kinematics from the previous pose, as the identification calls
+// it). Returns regressor / inverse dynamics (target <= 2).
+double regressor_section(Bench& b) {
+  Pose pk = b.p;
+  long k = 0;
+  const char* what = "regressor";
+  pkm::RegressorSample rs;
+  pkm::InverseDynamicsResult r;
+  const Figure reg = time_checked(b, what, [&](double& acc) {
+    const Status s = pkm::regressor(b.model, nudge(pk, b.p, k++), b.pd, b.pdd, Wrench::Zero(), rs);
+    acc += rs.Y(0, 0);
+    return s;
+  });
+  const Figure id = time_checked(b, what, [&](double& acc) {  // the baseline, right beside it
+    const Status s = pkm::inverse_dynamics(b.model, nudge(pk, b.p, k++), b.pd, b.pdd, Wrench::Zero(), r, false);
+    acc += r.F[0];
+    return s;
+  });
+  // The sliders' positions, rates and accelerations of the same motion.
+  pkm::RegressorSample at;
+  Vec4 rho = Vec4::Zero(), rhod = Vec4::Zero(), rhodd = Vec4::Zero();
+  if (pkm::inverse_dynamics(b.model, b.p, b.pd, b.pdd, Wrench::Zero(), r, false) == Status::Ok) {
+    for (int i = 0; i < pkm::kLegs; ++i) {
+      rho[i] = r.q[pkm::leg_offset(i)];
+      rhod[i] = r.qd[pkm::leg_offset(i)];
+      rhodd[i] = r.qdd[pkm::leg_offset(i)];
+    }
+  }
+  Vec4 rk = rho;
+  const Figure joints = time_checked(b, what, [&](double& acc) {
+    at.pose = b.p;  // the previous sample's pose, 1e-12 m away
+    const Status s = pkm::joint_regressor(b.model, nudge(rk, rho, k++), rhod, rhodd, Wrench::Zero(), at);
+    acc += at.Y(0, 0);
+    return s;
+  });
+  const double ratio = reg.median / id.median;
+  std::printf("1c. Calibration regressor at the same motion (regressor.hpp)\n");
+  std::printf("   %-44s %12s %12s %10s %16s\n", "evaluation", "median/call", "min/call", "ratio", "target");
+  std::printf("   %-44s %12s %12s %10s\n", "inverse_dynamics (cold, baseline)", fmt_time(id.median).c_str(),
+              fmt_time(id.min).c_str(), "1.00x");
+  std::printf("   %-44s %12s %12s %9.2fx %16s\n", "regressor: Y 4x14, F0 from the platform motion",
+              fmt_time(reg.median).c_str(), fmt_time(reg.min).c_str(), ratio,
+              (std::string("<= 2x  ") + ok_mark(ratio, 2.0)).c_str());
+  std::printf("   %-44s %12s %12s %9.2fx\n", "joint_regressor: from rho, drho, ddrho", fmt_time(joints.median).c_str(),
+              fmt_time(joints.min).c_str(), joints.median / id.median);
+  rule();
+  return ratio;
 }
 
 // ------------------------------------------------------- 2. inverse dynamics
@@ -751,8 +805,8 @@ void allocations_section(Bench& b) {
 }
 
 // ------------------------------------------------------- machine-independent ratios
-void ratios_section(const StateDerivativeFigures& sd, double jac_ratio, const InverseDynamicsFigures& id,
-                    const AutotestFigures& a) {
+void ratios_section(const StateDerivativeFigures& sd, double jac_ratio, double reg_ratio,
+                    const InverseDynamicsFigures& id, const AutotestFigures& a) {
   const double sd0 = sd[0].median;
   std::printf("Machine-independent ratios (medians)\n");
   std::printf("   sd(NullSpaceQR) / sd(LegPartitioned)                 %8.2f\n", sd[1].median / sd0);
@@ -761,6 +815,7 @@ void ratios_section(const StateDerivativeFigures& sd, double jac_ratio, const In
               id.cold.median / sd0, id.warm.median / sd0, id.same.median / sd0, id.stages.median / sd0);
   std::printf("   ID warm (0.5 ms away) / ID cold                      %8.2f\n", id.warm.median / id.cold.median);
   std::printf("   Jacobians A, B / sd(LegP) (same run, item 1b)        %8.2f   (target <= 3)\n", jac_ratio);
+  std::printf("   regressor / ID cold (same run, item 1c)              %8.2f   (target <= 2)\n", reg_ratio);
   std::printf("   RK4 forward run / (8000 x sd(LegP))                  %8.2f   (integrator + input overhead)\n",
               a.rk4_fwd.fig.median / (8000.0 * sd0));
   std::printf("   RK4 bare round trip / forward only                   %8.2f   (~ 1 + ID[**] / sd = %.2f)\n",
@@ -785,10 +840,11 @@ int main() {
   print_header();
   const StateDerivativeFigures sd = state_derivative_section(b);
   const double jac_ratio = derivatives_section(b);
+  const double reg_ratio = regressor_section(b);
   const InverseDynamicsFigures id = inverse_dynamics_section(b, sd[0]);
   const AutotestFigures a = autotest_section(b, sd[0]);
   allocations_section(b);
-  ratios_section(sd, jac_ratio, id, a);
+  ratios_section(sd, jac_ratio, reg_ratio, id, a);
   if (b.failures) std::printf("%d measurement(s) FAILED (see the marks above)\n", b.failures);
   return b.failures ? 1 : 0;
 }

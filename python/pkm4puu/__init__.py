@@ -9,8 +9,9 @@ The library: spec (MODEL_SPEC's numbers and geometry), motions (the test
 motions), interface (variable names), locate (the build directory and the
 paths in it), fmu (the wrapper), capi (a ctypes binding of the C API,
 pkm.h), linearization (the plant's Jacobians through Model Exchange),
-closed_loop (the sampled loop the control examples share). It needs
-numpy and fmpy only.
+closed_loop (the sampled loop the control examples share), calibration
+(identification of the dynamic parameters from a drive log,
+pkm4puu.identify; it needs scipy). The rest needs numpy and fmpy only.
 
 The reports (the paper's tests through the FMUs, the engine comparison
 against the independent Pinocchio and MuJoCo models, figures) are in
@@ -27,4 +28,4 @@ from .spec import P0, P1, STATIC_FORCE_P0, STEP, T_MOVE
 __all__ = ["__version__", "Fmu", "Result", "build_dir", "find_fmu", "inverse_forces", "run", "ACC", "DRHO", "F", "POSE", "RHO",
            "RK4", "START_P0", "THETA1", "THETA2", "VEL", "WRENCH", "indexed_names", "start_pose", "autotest_motion",
            "blend", "comparison_forces", "motion", "pose_at", "velocity_at", "acceleration_at", "P0", "P1",
-           "STATIC_FORCE_P0", "STEP", "T_MOVE"]
+           "STATIC_FORCE_P0", "STEP", "T_MOVE", "identify"]

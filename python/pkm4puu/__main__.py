@@ -15,6 +15,8 @@ COMMANDS = {
     "plot-autotest": ("plot_cpp_autotest", "figures of the C++ auto-test's CSV files (pkm_autotest --out DIR)"),
     "engines": ("engine_comparison", "validation against independent Pinocchio and MuJoCo models"),
     "verdict": ("checks", "the main job's verdict: the checks its stages wrote, PASS/FAIL per bound"),
+    "excitation": ("excitation", "an exciting trajectory for the identification: its condition number, CSV"),
+    "identify": ("identify", "the dynamic parameters from a drive log (CSV of t, rho, F): FMU start values"),
 }
 
 

@@ -136,7 +136,29 @@ def load(path=None):
     lib.pkm_forward_derivatives.restype = i
     lib.pkm_inverse_derivatives.argtypes = [vp, dp, dp, dp, dp, dp, dp]
     lib.pkm_inverse_derivatives.restype = i
+    # calibration: the regressor of the forces in the dynamic parameters
+    sz = ct.c_size_t
+    lib.pkm_regressor_param_count.argtypes = []
+    lib.pkm_regressor_param_count.restype = i
+    for f in (lib.pkm_regressor_param_name, lib.pkm_regressor_param_unit):
+        f.argtypes = [i]
+        f.restype = ct.c_char_p
+    lib.pkm_regressor_params.argtypes = [vp, dp]
+    lib.pkm_regressor_params.restype = i
+    lib.pkm_regressor.argtypes = [vp, dp, dp, dp, dp, dp, dp]
+    lib.pkm_regressor.restype = i
+    lib.pkm_regressor_poses.argtypes = [vp, sz, dp, dp, dp, dp, dp, dp, dp]
+    lib.pkm_regressor_poses.restype = i
+    lib.pkm_regressor_joints.argtypes = [vp, sz, dp, dp, dp, dp, dp, dp, dp, P(sz)]
+    lib.pkm_regressor_joints.restype = i
     return lib
+
+
+def regressor_params(lib):
+    """[(name, unit)] of the regressor's parameter vector pi (pkm.h's
+    pkm_regressor_param_name/unit), in pi's order."""
+    return [(lib.pkm_regressor_param_name(j).decode(), lib.pkm_regressor_param_unit(j).decode())
+            for j in range(lib.pkm_regressor_param_count())]
 
 
 _DP = ct.POINTER(ct.c_double)
@@ -294,6 +316,52 @@ class Plant:
                                                      _d4(wrench), F.ctypes.data_as(_DP), dF.ctypes.data_as(_DP)),
                     "pkm_inverse_derivatives")
         return F, dF
+
+    def regressor_params(self):
+        """pkm_regressor_params: the model's own parameter vector pi."""
+        pi = np.empty(self.lib.pkm_regressor_param_count())
+        self._check(self.lib.pkm_regressor_params(self.handle, pi.ctypes.data_as(_DP)), "pkm_regressor_params")
+        return pi
+
+    def regressor(self, pose, velocity, acceleration, wrench=None):
+        """pkm_regressor: (Y (4, n_pi), F0 (4,)) with F = Y pi + F0."""
+        Y, F0 = np.empty((4, self.lib.pkm_regressor_param_count())), np.empty(4)
+        self._check(self.lib.pkm_regressor(self.handle, _d4(pose), _d4(velocity), _d4(acceleration), _d4(wrench),
+                                           Y.ctypes.data_as(_DP), F0.ctypes.data_as(_DP)), "pkm_regressor")
+        return Y, F0
+
+    def regressor_poses(self, pose, velocity, acceleration):
+        """pkm_regressor_poses over (n, 4) arrays: (Y (n, 4, n_pi), F0, rho, drho (n, 4))."""
+        P, V, A = (np.ascontiguousarray(a, dtype=float).reshape(-1, 4) for a in (pose, velocity, acceleration))
+        n = len(P)
+        if len(V) != n or len(A) != n:
+            raise ValueError("pose, velocity and acceleration need the same number of rows")
+        Y = np.empty((n, 4, self.lib.pkm_regressor_param_count()))
+        F0, rho, drho = np.empty((n, 4)), np.empty((n, 4)), np.empty((n, 4))
+        self._check(self.lib.pkm_regressor_poses(self.handle, n, *(a.ctypes.data_as(_DP) for a in (P, V, A, Y, F0, rho,
+                                                                                                  drho))),
+                    "pkm_regressor_poses")
+        return Y, F0, rho, drho
+
+    def regressor_joints(self, rho, drho, ddrho, guess=None):
+        """pkm_regressor_joints over (n, 4) arrays of the sliders' positions,
+        rates, accelerations: (Y (n, 4, n_pi), F0 (n, 4), pose (n, 4)). On a
+        failure PkmError says which sample; its attribute `sample` holds it."""
+        R, V, A = (np.ascontiguousarray(a, dtype=float).reshape(-1, 4) for a in (rho, drho, ddrho))
+        n = len(R)
+        if len(V) != n or len(A) != n:
+            raise ValueError("rho, drho and ddrho need the same number of rows")
+        Y = np.empty((n, 4, self.lib.pkm_regressor_param_count()))
+        F0, pose = np.empty((n, 4)), np.empty((n, 4))
+        done = ct.c_size_t(0)
+        s = self.lib.pkm_regressor_joints(self.handle, n, R.ctypes.data_as(_DP), V.ctypes.data_as(_DP),
+                                          A.ctypes.data_as(_DP), _d4(guess), Y.ctypes.data_as(_DP),
+                                          F0.ctypes.data_as(_DP), pose.ctypes.data_as(_DP), ct.byref(done))
+        if s != PKM_OK:
+            err = PkmError(f"pkm_regressor_joints: status {s}: {self.lib.pkm_last_error(self.handle).decode()}")
+            err.sample, err.status = done.value, s
+            raise err
+        return Y, F0, pose
 
     def outputs(self, F=None, wrench=None):
         o = Outputs()

@@ -13,6 +13,7 @@
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/dynamics/regressor.hpp"
 #include "pkm4puu/sim/plant.hpp"
 #include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
 
@@ -424,3 +425,82 @@ pkm_status pkm_energy(pkm_model* m, double* kinetic, double* potential) {
 }
 
 }  // extern "C"
+
+static_assert(PKM_REGRESSOR_PARAMS == pkm::kParams, "pkm.h's parameter count is the core's");
+
+int pkm_regressor_param_count(void) { return PKM_REGRESSOR_PARAMS; }
+
+const char* pkm_regressor_param_name(int j) { return pkm::regressor_param_info(j).name; }
+
+const char* pkm_regressor_param_unit(int j) { return pkm::regressor_param_info(j).unit; }
+
+pkm_status pkm_regressor_params(pkm_model* m, double pi[PKM_REGRESSOR_PARAMS]) {
+  if (!m || !pi) return PKM_ERR_INVALID_ARGUMENT;
+  copy<pkm::kParams>(pkm::parameter_vector(m->plant.model().p), pi);
+  return PKM_OK;
+}
+
+namespace {
+
+using RowRegressor = Eigen::Matrix<double, 4, pkm::kParams, Eigen::RowMajor>;
+
+pkm_status regressor_failure(pkm_model* m, Status s, const char* what, size_t k, size_t n, const double* at,
+                             const char* at_name) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%s: sample %zu of %zu (%s %.9g, %.9g, %.9g, %.9g): %s", what, k, n, at_name,
+                at[0], at[1], at[2], at[3], pkm::status_name(s));
+  m->error = buf;
+  return to_c(s);
+}
+
+}  // namespace
+
+pkm_status pkm_regressor(pkm_model* m, const double pose[4], const double velocity[4], const double acceleration[4],
+                         const double wrench[4], double* Y, double F0[4]) {
+  if (!m || !pose || !velocity || !acceleration || !Y) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::RegressorSample r;
+  const Status s = pkm::regressor(m->plant.model(), vec4(pose), vec4(velocity), vec4(acceleration), vec4(wrench), r);
+  if (s != Status::Ok) {
+    m->error = std::string("pkm_regressor: ") + pkm::status_name(s);
+    return to_c(s);
+  }
+  Eigen::Map<RowRegressor> Y_out(Y);
+  Y_out = r.Y;
+  if (F0) copy(r.F0, F0);
+  return PKM_OK;
+}
+
+pkm_status pkm_regressor_poses(pkm_model* m, size_t n, const double* pose, const double* velocity,
+                               const double* acceleration, double* Y, double* F0, double* rho, double* drho) {
+  if (!m || (n > 0 && (!pose || !velocity || !acceleration || !Y))) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::RegressorSample r;
+  for (size_t k = 0; k < n; ++k) {
+    const Status s = pkm::regressor(m->plant.model(), vec4(pose + 4 * k), vec4(velocity + 4 * k),
+                                    vec4(acceleration + 4 * k), pkm::Wrench::Zero(), r);
+    if (s != Status::Ok) return regressor_failure(m, s, "pkm_regressor_poses", k, n, pose + 4 * k, "pose");
+    Eigen::Map<RowRegressor>(Y + 4 * pkm::kParams * k, 4, pkm::kParams) = r.Y;
+    if (F0) copy(r.F0, F0 + 4 * k);
+    if (rho) copy(r.rho, rho + 4 * k);
+    if (drho) copy(r.rhod, drho + 4 * k);
+  }
+  return PKM_OK;
+}
+
+pkm_status pkm_regressor_joints(pkm_model* m, size_t n, const double* rho, const double* drho, const double* ddrho,
+                                const double guess[4], double* Y, double* F0, double* pose, size_t* done) {
+  if (done) *done = 0;
+  if (!m || (n > 0 && (!rho || !drho || !ddrho || !Y))) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::RegressorSample r;
+  r.pose = guess ? vec4(guess) : pkm::Pose(0.0, 0.0, 0.05, 0.0);
+  for (size_t k = 0; k < n; ++k) {
+    const Status s =
+        pkm::joint_regressor(m->plant.model(), vec4(rho + 4 * k), vec4(drho + 4 * k), vec4(ddrho + 4 * k),
+                             pkm::Wrench::Zero(), r);
+    if (s != Status::Ok) return regressor_failure(m, s, "pkm_regressor_joints", k, n, rho + 4 * k, "rho");
+    Eigen::Map<RowRegressor>(Y + 4 * pkm::kParams * k, 4, pkm::kParams) = r.Y;
+    if (F0) copy(r.F0, F0 + 4 * k);
+    if (pose) copy(r.pose, pose + 4 * k);
+    if (done) *done = k + 1;
+  }
+  return PKM_OK;
+}

@@ -249,6 +249,45 @@ PKM_API pkm_status pkm_inverse_derivatives(pkm_model* m, const double pose[4], c
                                            const double acceleration[4], const double wrench[4], double F[4],
                                            double dF[64]);
 
+/* ---- Calibration (docs/calibration.md): the actuator forces are linear in
+ * the dynamic parameters, F = Y pi + F0, with pi the PKM_REGRESSOR_PARAMS
+ * entries named by pkm_regressor_param_name (masses, first moments and
+ * inertias of slider, rod, platform and payload, rotor inertia, viscous and
+ * Coulomb friction for the model's friction_velocity) and F0 what does not
+ * depend on them (the wrench, and an end stop's force beyond it). Y is
+ * row-major, 4 x PKM_REGRESSOR_PARAMS per sample. ---- */
+#define PKM_REGRESSOR_PARAMS 14
+
+PKM_API int pkm_regressor_param_count(void);
+/* Name (the FMU's parameter name where pi's entry is one), unit; NULL
+ * outside 0..PKM_REGRESSOR_PARAMS-1. */
+PKM_API const char* pkm_regressor_param_name(int j);
+PKM_API const char* pkm_regressor_param_unit(int j);
+
+/* The model's own pi (its parameters' values). */
+PKM_API pkm_status pkm_regressor_params(pkm_model* m, double pi[PKM_REGRESSOR_PARAMS]);
+
+/* Y (4 x PKM_REGRESSOR_PARAMS, row-major) and F0[4] (may be NULL) at a
+ * platform pose, velocity and acceleration with the wrench (may be NULL). */
+PKM_API pkm_status pkm_regressor(pkm_model* m, const double pose[4], const double velocity[4],
+                                 const double acceleration[4], const double wrench[4], double* Y, double F0[4]);
+
+/* pkm_regressor for n samples (arrays of n x 4, sample-major; Y n x 4 x
+ * PKM_REGRESSOR_PARAMS), no wrench; F0, rho and drho (the sliders' positions
+ * and rates, n x 4) may be NULL. On failure pkm_last_error names the sample. */
+PKM_API pkm_status pkm_regressor_poses(pkm_model* m, size_t n, const double* pose, const double* velocity,
+                                       const double* acceleration, double* Y, double* F0, double* rho,
+                                       double* drho);
+
+/* The same from the sliders' positions, rates and accelerations (n x 4),
+ * through the forward kinematics: each sample starts from the previous
+ * sample's pose, the first from guess[4] (NULL: the home pose 0, 0, 0.05 m,
+ * 0). pose (n x 4, may be NULL) receives the platform's poses; *done (may be
+ * NULL) the number of samples computed, also on failure. */
+PKM_API pkm_status pkm_regressor_joints(pkm_model* m, size_t n, const double* rho, const double* drho,
+                                        const double* ddrho, const double guess[4], double* Y, double* F0,
+                                        double* pose, size_t* done);
+
 #ifdef __cplusplus
 }
 #endif

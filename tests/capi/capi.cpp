@@ -272,3 +272,44 @@ TEST(CApi, InverseDerivativesAreRowMajorOverPoseRatesAccelerationsWrench) {
   }
   EXPECT_EQ(pkm_inverse_derivatives(h.m, x, x + 4, x + 8, nullptr, F, nullptr), PKM_ERR_INVALID_ARGUMENT);
 }
+
+// Calibration: Y pi + F0 is the machine's inverse dynamics; the batch
+// functions give the single sample's Y; a slider position out of reach is
+// an error that names the sample.
+TEST(CApi, RegressorTimesTheModelsParametersIsTheInverseDynamics) {
+  MachineHandle h;
+  ASSERT_EQ(pkm_regressor_param_count(), PKM_REGRESSOR_PARAMS);
+  EXPECT_STREQ(pkm_regressor_param_name(0), "m_slider");
+  EXPECT_STREQ(pkm_regressor_param_unit(PKM_REGRESSOR_PARAMS - 1), "N");
+  EXPECT_EQ(pkm_regressor_param_name(PKM_REGRESSOR_PARAMS), nullptr);
+  double pi[PKM_REGRESSOR_PARAMS];
+  ASSERT_EQ(pkm_regressor_params(h.m, pi), PKM_OK);
+  EXPECT_DOUBLE_EQ(pi[8], 0.3 * 0.02);  // payload_mx = payload_mass payload_com[1]
+  const double x[16] = {0.004, -0.003, 0.06, 0.05, 0.1, -0.05, 0.08, 0.7, 0.8, -0.5, 1.1, 6.0, 0.3, -0.2, 0.5, 0.01};
+  double Y[4 * PKM_REGRESSOR_PARAMS], F0[4];
+  ASSERT_EQ(pkm_regressor(h.m, x, x + 4, x + 8, x + 12, Y, F0), PKM_OK);
+  pkm_inverse_machine_result r;
+  ASSERT_EQ(pkm_inverse_dynamics_machine(h.m, x, x + 4, x + 8, x + 12, &r), PKM_OK);
+  for (int i = 0; i < 4; ++i) {
+    double F = F0[i];
+    for (int j = 0; j < PKM_REGRESSOR_PARAMS; ++j) F += Y[PKM_REGRESSOR_PARAMS * i + j] * pi[j];  // row-major
+    EXPECT_NEAR(F, r.F[i], 1e-12 * std::fabs(r.F[i]) + 1e-13) << "leg " << i + 1;
+  }
+  // The batch over two samples, without wrench, and back from the sliders.
+  const double poses[8] = {x[0], x[1], x[2], x[3], 0.0, 0.0, 0.05, 0.0};
+  const double vel[8] = {x[4], x[5], x[6], x[7], 0, 0, 0, 0}, acc[8] = {x[8], x[9], x[10], x[11], 0, 0, 0, 0};
+  double Yb[8 * PKM_REGRESSOR_PARAMS], rho[8], drho[8], Ys[4 * PKM_REGRESSOR_PARAMS];
+  ASSERT_EQ(pkm_regressor_poses(h.m, 2, poses, vel, acc, Yb, nullptr, rho, drho), PKM_OK);
+  ASSERT_EQ(pkm_regressor(h.m, poses, vel, acc, nullptr, Ys, nullptr), PKM_OK);
+  for (int k = 0; k < 4 * PKM_REGRESSOR_PARAMS; ++k) EXPECT_EQ(Yb[k], Ys[k]);
+  double ddrho[8] = {}, Yj[8 * PKM_REGRESSOR_PARAMS], pose[8];
+  size_t done = 99;
+  ASSERT_EQ(pkm_regressor_joints(h.m, 1, rho + 4, drho + 4, ddrho, nullptr, Yj, nullptr, pose, &done), PKM_OK);
+  EXPECT_EQ(done, 1u);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(pose[i], kHome[i], 1e-14);
+  double bad_rho[8] = {rho[0], rho[1], rho[2], rho[3], -0.2, 0.1, 0.1, 0.1};
+  EXPECT_NE(pkm_regressor_joints(h.m, 2, bad_rho, drho, drho, nullptr, Yj, nullptr, pose, &done), PKM_OK);
+  EXPECT_EQ(done, 1u);
+  EXPECT_NE(std::string(pkm_last_error(h.m)).find("sample 1 of 2"), std::string::npos) << pkm_last_error(h.m);
+  EXPECT_EQ(pkm_regressor(h.m, x, x + 4, nullptr, nullptr, Y, F0), PKM_ERR_INVALID_ARGUMENT);
+}
