@@ -22,10 +22,11 @@ AXES = ("x", "y", "z", "phi")
 
 @dataclass
 class Limits:
-    """Where and how hard the trajectory may go. xy: |x|, |y| of P (m);
-    z: (lowest, highest) z of P (m); phi: |phi| (rad); stop_margin: distance
-    kept from each end stop (m); speed: |drho| (m/s) and force: |F| (N) of
-    each drive, the force with the nominal parameters."""
+    """Where and how hard the trajectory may go. xy: bound on ``abs(x)`` and
+    ``abs(y)`` of P (m); z: (lowest, highest) z of P (m); phi: bound on
+    ``abs(phi)`` (rad); stop_margin: distance kept from each end stop (m);
+    speed: bound on ``abs(drho)`` (m/s) and force: on ``abs(F)`` (N) of each
+    drive, the force with the nominal parameters."""
     xy: float = 0.010
     z: tuple = (0.045, 0.075)
     phi: float = 0.12

@@ -113,21 +113,27 @@ def identify(t, rho, F, *, cutoff=20.0, order=4, trim=None, model=None, physical
     """The base parameters from a log of the sliders' positions rho (m) and
     the actuator forces F (N), n x 4 each, at the times t (s, evenly spaced).
 
-    cutoff: the low-pass's cut-off (Hz), above the motion's bandwidth and
-      below the encoder noise's; order: the Butterworth order.
-    trim: samples dropped at either end (default: two periods of the cut-off).
-    model: FMU parameter name -> value for what is known (geometry, g,
-      screw_lead, friction_velocity, stops, the mounted payload); the
-      spec's values otherwise.
-    physical: constrain the base parameters to their physical bounds
-      (positive masses and inertias, friction >= 0, the rod's triangle
-      inequalities), so that the start values are a valid parameter set.
-    guess: the platform pose (x, y, z, phi) the forward kinematics starts
-      from at the first sample (default the home pose 0, 0, 0.05 m, 0).
-    rank_tol: a base parameter whose column in the stacked regressor (each
-      column relative to its size under generic motions) lies within this
-      relative distance of the others' span is not identifiable from the
-      data: IdentificationError names it.
+    cutoff
+        the low-pass's cut-off (Hz), above the motion's bandwidth and below
+        the encoder noise's; order: the Butterworth order.
+    trim
+        samples dropped at either end (default: two periods of the cut-off).
+    model
+        FMU parameter name -> value for what is known (geometry, g,
+        screw_lead, friction_velocity, stops, the mounted payload); the
+        spec's values otherwise.
+    physical
+        constrain the base parameters to their physical bounds (positive
+        masses and inertias, friction >= 0, the rod's triangle
+        inequalities), so that the start values are a valid parameter set.
+    guess
+        the platform pose (x, y, z, phi) the forward kinematics starts from
+        at the first sample (default the home pose 0, 0, 0.05 m, 0).
+    rank_tol
+        a base parameter whose column in the stacked regressor (each column
+        relative to its size under generic motions) lies within this
+        relative distance of the others' span is not identifiable from the
+        data: IdentificationError names it.
     """
     from scipy.linalg import qr
 
