@@ -5,7 +5,8 @@
 #include "pkm4puu/dynamics/reduced_dynamics.hpp"
 
 // The AVX variant beside the baseline, as leg_lanes.cpp.
-#if PKM_LANES_VECTOR_EXTENSIONS && defined(__x86_64__) && !defined(_WIN32) && !defined(__AVX__)
+#if PKM_LANES_VECTOR_EXTENSIONS && defined(__x86_64__) && !defined(__AVX__) && \
+    (!defined(_WIN32) || defined(PKM_UNALIGNED_VECTOR_MOVES))
 #define PKM_LANES_AVX_DISPATCH 1
 #else
 #define PKM_LANES_AVX_DISPATCH 0
