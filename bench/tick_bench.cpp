@@ -17,6 +17,11 @@
 // inputs integrated with CVODE at rtol 1e-12, restarted at every step
 // (exact for inputs that are smooth within each step).
 //
+// --ticks: the same runs without the reference, one line per run,
+//   tick;<run>;<us/step>;<x>;<y>;<z>;<phi>  (the pose after 1 s, %.17g),
+// for bench/platform_ticks.py, which runs one such program built for each
+// platform (Linux, Windows under wine) in one run and prints the ratios.
+//
 // A second table, ARKODE's explicit Runge-Kutta (ERKStep) on the same ODE,
 // was a one-off study; its conclusion is in docs/performance.md ("CVODE across
 // communication points").
@@ -24,6 +29,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <vector>
 
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
@@ -50,6 +56,7 @@ struct Result {
   double median_us = 0, rhs_mean = 0, cvode_steps_mean = 0, max_dev = 0;
   long rhs_max = 0;
   bool ok = true;
+  Pose last = Pose::Zero();  // the pose after the last run's second
 };
 
 /// The inputs of step k (header comment).
@@ -118,6 +125,7 @@ Result measure_runs(Run run, const std::vector<Pose>& reference) {
   if (!r.ok) return r;
   std::sort(times.begin(), times.end());
   r.median_us = 1e6 * times[times.size() / 2] / kSteps;
+  if (!traj.empty()) r.last = traj.back();
   for (size_t k = 0; k < traj.size() && k < reference.size(); ++k)
     r.max_dev = std::max(r.max_dev, (traj[k] - reference[k]).head<3>().lpNorm<Eigen::Infinity>());
   return r;
@@ -131,7 +139,12 @@ Result measure(const pkm::Model& model, const pkm::SolverSettings& st, Inputs ki
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  const bool ticks = argc > 1 && std::strcmp(argv[1], "--ticks") == 0;
+  if (argc > 1 && !ticks) {
+    std::fprintf(stderr, "usage: pkm_tick_bench [--ticks]\n");
+    return 2;
+  }
   pkm::Model model;
   if (pkm::make_model(pkm::Params{}, model) != Status::Ok) return 1;
   pkm::InverseDynamicsResult id;
@@ -148,19 +161,22 @@ int main() {
   rk4.solver = pkm::Solver::Rk4;
   rk4.rk4_step = kH;
 
+  if (!ticks) {
   std::printf("pkm_tick_bench: 1-ms communication steps of the core's Plant, 1 s from the home pose\n");
   std::printf("inputs on F[1], beyond the static force: ramp %.1f t N (value and slope per step); sampled %.1f cos(2 pi "
               "3 t) N\n(value and slope per step); held: the same at the step's midpoint\n\n",
               kAmplitude, kAmplitude);
   std::printf("%-44s %9s %9s %9s %9s %12s\n", "run", "us/step", "rhs/step", "rhs max", "steps/step",
               "max|dxyz| m");
+  }
   int failures = 0;
   const Inputs kinds[] = {Inputs::Ramp, Inputs::Sampled, Inputs::Held};
   const char* knames[] = {"ramp", "sampled", "held"};
   for (int ki = 0; ki < 3; ++ki) {
     const Inputs kind = kinds[ki];
     const char* kname = knames[ki];
-    const std::vector<Pose> reference = run_once(model, tight, kind, false, F_static, nullptr, nullptr);
+    const std::vector<Pose> reference =
+        ticks ? std::vector<Pose>() : run_once(model, tight, kind, false, F_static, nullptr, nullptr);
     struct Case {
       const char* name;
       const pkm::SolverSettings* st;
@@ -174,8 +190,13 @@ int main() {
       char name[64];
       std::snprintf(name, sizeof name, "%s: %s", kname, c.name);
       if (!r.ok) {
-        std::printf("%-44s FAILED\n", name);
+        std::printf(ticks ? "tick;%s;FAILED\n" : "%-44s FAILED\n", name);
         ++failures;
+        continue;
+      }
+      if (ticks) {
+        std::printf("tick;%s;%.6f;%.17g;%.17g;%.17g;%.17g\n", name, r.median_us, r.last[0], r.last[1], r.last[2],
+                    r.last[3]);
         continue;
       }
       if (c.st == &cvode && !c.cont) restart_us = r.median_us;
@@ -185,6 +206,7 @@ int main() {
       std::printf("\n");
     }
   }
+  if (ticks) return failures ? 1 : 0;
   std::printf("\nreference: CVODE rtol 1e-12, restarted every step, the same inputs. Continuing across the jumps of\n"
               "sampled or held inputs costs accuracy: the FMU continues only where the inputs continue (pkm4puu.cpp).\n");
   return failures ? 1 : 0;

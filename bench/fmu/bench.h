@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench: what its subcommands (step.c, latency.c, cost.c,
- * compare.c) share beyond harness.h: the options, the loaded plant FMU with
+ * compare.c, jacobian.c) share beyond harness.h: the options, the loaded plant FMU with
  * its model description, an instance set up for a solver, and the median of
  * a run's timings. main.c defines these and dispatches. */
 #ifndef PKM_BENCH_FMU_BENCH_H
@@ -47,7 +47,7 @@ typedef struct {
   const char* options; /* the subcommand's own options beyond --fmu, --xml, --batches ("--seconds", ...) */
 } Subcommand;
 
-extern const Subcommand step_subcommand, latency_subcommand, cost_subcommand, compare_subcommand;
+extern const Subcommand step_subcommand, latency_subcommand, cost_subcommand, compare_subcommand, jacobian_subcommand;
 
 /* fmi2Instantiate (Co-Simulation) + fmi2SetupExperiment + fmi2SetInteger(solver)
  * + fmi2SetReal of n parameters + Enter/ExitInitializationMode, then, if home

@@ -21,7 +21,7 @@
 #include "bench.h"
 
 static const Subcommand* const subcommands[] = {&step_subcommand, &latency_subcommand, &cost_subcommand,
-                                                &compare_subcommand};
+                                                &compare_subcommand, &jacobian_subcommand};
 #define N_SUBCOMMANDS (sizeof subcommands / sizeof subcommands[0])
 
 static void usage(FILE* fp) {

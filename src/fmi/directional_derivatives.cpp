@@ -16,10 +16,8 @@ namespace pkm_fmi {
 namespace {
 
 bool depends_on(const ModelDefinition& def, const Variable& unknown, const Variable* const knowns[], std::size_t nk) {
-  const Dependencies deps = dependencies_of(def, unknown);
   for (std::size_t j = 0; j < nk; ++j)
-    for (const std::uint32_t vr : deps.knowns)
-      if (vr == knowns[j]->vr) return true;
+    if (is_dependency(def, unknown, *knowns[j])) return true;
   return false;
 }
 

@@ -298,24 +298,25 @@ std::string exact_text(double v) {
   return buf;
 }
 
+bool is_dependency(const ModelDefinition& d, const Variable& v, const Variable& k) {
+  if (v.depends & kOnOwnState) return k.vr == v.vr;
+  // der(position) = rate: each depends on its own rate state only, with factor 1.
+  const int half = static_cast<int>(d.n_position_states);
+  if (v.state_of >= 0 && v.state_of < half) return k.state == v.state_of + half;
+  const bool known = k.state >= 0 || k.causality == Causality::Input;
+  return known && (k.kind & v.depends) != 0;
+}
+
 Dependencies dependencies_of(const ModelDefinition& d, const Variable& v) {
   Dependencies deps;
-  const int half = static_cast<int>(d.n_position_states);
   if (v.depends & kOnOwnState) {
     deps.knowns.push_back(v.vr);
     deps.constant = true;
     return deps;
   }
-  for (std::size_t i = 0; i < d.n_variables; ++i) {
-    const Variable& k = d.variables[i];
-    const bool known = k.state >= 0 || k.causality == Causality::Input;
-    if (known && (k.kind & v.depends) != 0) deps.knowns.push_back(k.vr);
-  }
-  // der(position) = rate: each depends on its own rate state only, with factor 1.
-  if (v.state_of >= 0 && v.state_of < half) {
-    deps.knowns.assign(1, state_variable(d, v.state_of + half)->vr);
-    deps.constant = true;
-  }
+  for (std::size_t i = 0; i < d.n_variables; ++i)
+    if (is_dependency(d, v, d.variables[i])) deps.knowns.push_back(d.variables[i].vr);
+  deps.constant = v.state_of >= 0 && v.state_of < static_cast<int>(d.n_position_states);
   return deps;
 }
 

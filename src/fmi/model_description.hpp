@@ -27,6 +27,9 @@ struct Dependencies {
   bool constant = false;
 };
 Dependencies dependencies_of(const ModelDefinition& def, const Variable& v);
+/// Whether `known` is among dependencies_of(def, v)'s (the same rule,
+/// without building the list: the directional derivatives' per-call check).
+bool is_dependency(const ModelDefinition& def, const Variable& v, const Variable& known);
 /// What an InitialUnknown depends on in Initialization Mode (knowns: inputs
 /// and parameters): a state its initial-value parameter (energy integrals,
 /// which start at 0, nothing); any other the inputs it depends on, the

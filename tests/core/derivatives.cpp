@@ -14,6 +14,7 @@
 #include "pkm4puu/kinematics/actuator_positions.hpp"
 #include "pkm4puu/dynamics/state_derivative.hpp"
 #include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
+#include "pkm4puu/dynamics/leg_lanes_derivatives.hpp"
 #include "pkm4puu/integrators/rk4.hpp"
 #include "test_support.hpp"
 
@@ -148,6 +149,90 @@ TEST(ForwardDerivatives, PushingEndStopMatchesRichardsonDifferences) {
   const Model m = model_of(p);
   ASSERT_GT(std::fabs(stop_force(m.p, rho[0], 0.0)), 0.0);
   check_forward(m, c, 0.05);  // steps of at most 50 um in the pose
+}
+
+namespace {
+
+/// The Jacobians leg by leg, as state_derivative_jacobians computed them
+/// before the lanes: reduced_terms, the solve and residual_partials (the
+/// inverse dynamics' derivatives still use it), an independent assembly of
+/// the same formulas.
+void leg_by_leg_jacobians(const Model& m, const Vec8& y, const Vec16& f, Pose& pdd, Mat8& A, Mat8x12& B,
+                          JointJacobians& joints) {
+  ReducedDynamics rd;
+  ASSERT_EQ(reduced_terms(m, y, f, kStopsFromState, rd), Status::Ok);
+  ASSERT_EQ(rd.solve_platform(m, f.segment<4>(kPlatform), pdd), Status::Ok);
+  ResidualPartials P;
+  residual_partials(m, rd, y.tail<4>(), pdd, Vec4::Zero(), kStopsFromState, P);
+  const Eigen::PartialPivLU<Mat4> lu(P.Mr);
+  A.setZero();
+  A.topRightCorner<4, 4>().setIdentity();
+  A.bottomLeftCorner<4, 4>() = -lu.solve(P.dp);
+  A.bottomRightCorner<4, 4>() = -lu.solve(P.dpd);
+  B.setZero();
+  B.block<4, 4>(4, 0) = lu.solve(P.J_rho.transpose());
+  B.block<4, 4>(4, 4) = lu.solve(Mat4::Identity());
+  B.block<4, 4>(4, 8) = m.drive_ratio * B.block<4, 4>(4, 0);
+  joints.J_rho = P.J_rho;
+  joints.drhod_dp = P.drhod_dp;
+}
+
+/// Largest |a - b| over the largest |b| (the Jacobians' entries span many
+/// orders of magnitude; their scale is the matrix's).
+template <class M1, class M2>
+double relative_to_largest(const M1& a, const M2& b) {
+  return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff();
+}
+
+}  // namespace
+
+TEST(ForwardDerivatives, LanesMatchTheLegByLegAssemblyToRounding) {
+  for (const Model& m : {default_model(), model_of(machine_params())}) {
+    for (const Case& c : kCases) {
+      SCOPED_TRACE(c.name);
+      Vec8 y;
+      y << c.pose, c.vel;
+      Vec8 ydot;
+      Mat8 A, A_ref;
+      Mat8x12 B, B_ref;
+      JointJacobians joints, joints_ref;
+      Pose pdd_ref;
+      ASSERT_EQ(state_derivative_jacobians(m, y, kF, kTau, kWe, kStopsFromState, ydot, A, B, &joints), Status::Ok);
+      leg_by_leg_jacobians(m, y, generalized_forces(m, kF, kTau, kWe), pdd_ref, A_ref, B_ref, joints_ref);
+      EXPECT_EQ(ydot.tail<4>(), pdd_ref) << "the reduced system's solve, bit for bit";
+      const double eA = relative_to_largest(A.bottomRows<4>(), A_ref.bottomRows<4>());
+      const double eB = relative_to_largest(B.bottomRows<4>(), B_ref.bottomRows<4>());
+      const double eJ = relative_to_largest(joints.J_rho, joints_ref.J_rho);
+      const double eR = relative_to_largest(joints.drhod_dp, joints_ref.drhod_dp);
+      std::printf("%s: lanes vs leg by leg, A %.2e, B %.2e, J_rho %.2e, d rhod/dp %.2e\n", c.name, eA, eB, eJ, eR);
+      EXPECT_LT(eA, 1e-12);
+      EXPECT_LT(eB, 1e-12);
+      EXPECT_LT(eJ, 1e-12);
+      EXPECT_LT(eR, 1e-12);
+    }
+  }
+}
+
+TEST(ForwardDerivatives, EveryLaneVariantGivesTheSameBits) {
+  // The same template for one leg, SSE2/NEON pairs and AVX, no contraction.
+  const Model m = model_of(machine_params());
+  for (const Case& c : kCases) {
+    SCOPED_TRACE(c.name);
+    const Vec16 f = generalized_forces(m, kF, kTau, kWe);
+    LegPartialSums ref;
+    ASSERT_EQ(leg_partial_sums(m, platform_config(c.pose), c.vel, f, kStopsFromState, ref, LegLanes::Scalar),
+              Status::Ok);
+    for (LegLanes kind : {LegLanes::Generic, LegLanes::Avx, LegLanes::Best}) {
+      if (!lanes_available(kind)) continue;
+      LegPartialSums out;
+      ASSERT_EQ(leg_partial_sums(m, platform_config(c.pose), c.vel, f, kStopsFromState, out, kind), Status::Ok);
+      EXPECT_EQ(out.pdd, ref.pdd);
+      EXPECT_EQ(out.dp, ref.dp);
+      EXPECT_EQ(out.dpd, ref.dpd);
+      EXPECT_EQ(out.J_rho, ref.J_rho);
+      EXPECT_EQ(out.drhod_dp, ref.drhod_dp);
+    }
+  }
 }
 
 TEST(InverseDerivatives, MatchRichardsonDifferencesOfTheInverseDynamics) {

@@ -4,6 +4,7 @@
 // the analytic Jacobians against finite differences.
 #include <cmath>
 
+#include "pkm4puu/base/sin_cos.hpp"
 #include "reference_model.hpp"
 #include "test_support.hpp"
 #include "apps/trajectory.hpp"
@@ -202,4 +203,31 @@ TEST(Kinematics, AutotestPathIsWellConditioned) {
   }
   EXPECT_LT(worst, 26.0);
   EXPECT_GT(worst, 1.0);
+}
+
+TEST(Kinematics, SinCosSeriesIsWithinTwoUlpOfLibm) {
+  // base/sin_cos.hpp's series (Windows' platform angle) against std::sin and
+  // std::cos: the platform's range, many turns, and up to the fallback.
+  auto ulps = [](double got, double want) {
+    const double ulp = std::nextafter(std::fabs(want), INFINITY) - std::fabs(want);
+    return std::fabs(got - want) / ulp;
+  };
+  double worst = 0.0;
+  for (int i = -200000; i <= 200000; ++i) {
+    for (const double scale : {1e-5, 1e-3, 0.4}) {  // |x| up to 2 rad, 200 rad, 8e4 rad
+      const double x = scale * i + 1e-7 * (i % 7);
+      double s, c;
+      pkm::sin_cos_series(x, s, c);
+      worst = std::max({worst, ulps(s, std::sin(x)), ulps(c, std::cos(x))});
+    }
+  }
+  std::printf("sin_cos_series: largest error %.2f ulp\n", worst);
+  EXPECT_LE(worst, 2.0);
+  double s, c;
+  pkm::sin_cos_series(0.0, s, c);
+  EXPECT_EQ(s, 0.0);
+  EXPECT_EQ(c, 1.0);
+  pkm::sin_cos_series(1e6, s, c);  // the fallback
+  EXPECT_EQ(s, std::sin(1e6));
+  EXPECT_EQ(c, std::cos(1e6));
 }

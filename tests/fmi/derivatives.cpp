@@ -127,6 +127,34 @@ TEST(FmuDerivatives, ModelExchangeJacobianMatchesRichardsonDifferencesOfTheFmu) 
   pkm_test::expect_columns_match("FMU d(der, outputs)/d(states, inputs)", an, fd, err, 1e-7);
 }
 
+TEST(FmuDerivatives, RepeatedCallsFollowEveryChangeOfStateAndInput) {
+  // One evaluation serves every seed at the same point (plant_data.hpp's
+  // JacobianCache); after a change of a state or an input the Jacobian must
+  // be that of a fresh instance set to the new point directly.
+  MeFmu me;
+  PlantFmu& f = me.fmu;
+  const std::vector<fmi2ValueReference> u = vrs(f, kUnknowns), k = vrs(f, kKnowns);
+  const Eigen::MatrixXd J0 = fmi2_jacobian(f, u, k);
+  EXPECT_EQ(fmi2_jacobian(f, u, k), J0) << "the same point, the same Jacobian";
+  double x[kStates];
+  std::copy(kState, kState + kStates, x);
+  x[0] += 1e-3;  // 1 mm in x
+  x[7] -= 0.2;   // and 0.2 rad/s in dphi
+  ASSERT_EQ(f.lib.fmi2SetContinuousStates(f.c, x, kStates), fmi2OK);
+  ASSERT_EQ(f.set("F[2]", 3.1), fmi2OK);
+  const Eigen::MatrixXd J1 = fmi2_jacobian(f, u, k);
+  MeFmu fresh;
+  PlantFmu& g = fresh.fmu;
+  ASSERT_EQ(g.lib.fmi2SetContinuousStates(g.c, x, kStates), fmi2OK);
+  ASSERT_EQ(g.set("F[2]", 3.1), fmi2OK);
+  EXPECT_EQ(J1, fmi2_jacobian(g, u, k));
+  EXPECT_GT((J1 - J0).cwiseAbs().maxCoeff(), 0.0) << "the new point differs";
+  // Back to the first state: the first Jacobian again, bit for bit.
+  ASSERT_EQ(f.lib.fmi2SetContinuousStates(f.c, kState, kStates), fmi2OK);
+  ASSERT_EQ(f.set("F[2]", 2.5), fmi2OK);
+  EXPECT_EQ(fmi2_jacobian(f, u, k), J0);
+}
+
 TEST(FmuDerivatives, Fmi3DirectionalAndAdjointAgreeWithFmi2) {
   MeFmu me;
   PlantFmu& f = me.fmu;

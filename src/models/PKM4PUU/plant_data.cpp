@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-2-Clause
 #include "models/PKM4PUU/plant_data.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <iterator>
@@ -77,6 +78,7 @@ Status PlantData::build(Context& ctx, const char* function) {
     return Status::Error;
   }
   plant = std::move(p);
+  jacobian_cache.valid = false;
   contact_events = plant->contact_events();
   logged_stops = plant->stops();
   may_continue = false;
@@ -347,6 +349,12 @@ Status PlantData::get_derivatives(Context& ctx, double dx[]) {
 // der(dissipated_energy) (machine.hpp, dissipated_power_slopes), the states
 // as outputs, rho[i] and drho[i]. The other computed variables are refused
 // with Error (not differentiated yet).
+bool PlantData::JacobianCache::holds(const pkm::Vec8& y_now, const double u_now[], unsigned stops_now) const {
+  // Bitwise: the same point, not merely a close one.
+  return valid && stops == stops_now && std::memcmp(y.data(), y_now.data(), sizeof(double) * 8) == 0 &&
+         std::memcmp(u, u_now, sizeof u) == 0;
+}
+
 Status PlantData::partial_derivatives(Context& ctx, const Variable* const unknowns[], std::size_t nu,
                                       const Variable* const knowns[], std::size_t nk, double J[]) {
   const char* fn = "GetDirectionalDerivative";
@@ -354,22 +362,31 @@ Status PlantData::partial_derivatives(Context& ctx, const Variable* const unknow
   if (st != Status::OK) return st;
   const pkm::Vec4 F(u[0], u[1], u[2], u[3]), we(u[4], u[5], u[6], u[7]), tau(u[8], u[9], u[10], u[11]);
   const pkm::Vec8& y = plant->state();
-  pkm::Vec8 ydot;
-  pkm::Mat8 A;
-  pkm::Mat8x12 B;
-  pkm::JointJacobians joints;
-  const pkm::Status s =
-      pkm::state_derivative_jacobians(plant->model(), y, F, tau, we, plant->stops(), ydot, A, B, &joints);
-  if (s != pkm::Status::Ok) {
-    ctx.log.error("%s: the derivatives at t = %.17g cannot be evaluated: %s", fn, plant->time(), pkm::status_name(s));
-    return Status::Error;
+  JacobianCache& c = jacobian_cache;
+  if (!c.holds(y, u, plant->stops())) {
+    c.valid = false;
+    pkm::Vec8 ydot;
+    const pkm::Status s =
+        pkm::state_derivative_jacobians(plant->model(), y, F, tau, we, plant->stops(), ydot, c.A, c.B, &c.joints);
+    if (s != pkm::Status::Ok) {
+      ctx.log.error("%s: the derivatives at t = %.17g cannot be evaluated: %s", fn, plant->time(),
+                    pkm::status_name(s));
+      return Status::Error;
+    }
+    if (pkm::actuator_positions(plant->model(), y.head<4>(), c.rho) != pkm::Status::Ok) {
+      ctx.log.error("%s: the actuator positions at t = %.17g cannot be evaluated", fn, plant->time());
+      return Status::Error;
+    }
+    c.y = y;
+    std::copy(u, u + kInputs, c.u);
+    c.stops = plant->stops();
+    c.valid = true;
   }
+  const pkm::Mat8& A = c.A;
+  const pkm::Mat8x12& B = c.B;
+  const pkm::JointJacobians& joints = c.joints;
+  const pkm::Vec4& rho = c.rho;
   const pkm::Vec4 rhod = joints.J_rho * y.tail<4>();
-  pkm::Vec4 rho;
-  if (pkm::actuator_positions(plant->model(), y.head<4>(), rho) != pkm::Status::Ok) {
-    ctx.log.error("%s: the actuator positions at t = %.17g cannot be evaluated", fn, plant->time());
-    return Status::Error;
-  }
   // One row over [the 10 states, the 12 inputs u] per unknown.
   Eigen::Matrix<double, 1, kStates + kInputs> row;
   for (std::size_t i = 0; i < nu; ++i) {
@@ -477,6 +494,7 @@ void PlantData::save(StateWriter& w) const {
 bool PlantData::load(StateReader& r, Context& ctx) {
   if (r.u8() == 0) {
     plant.reset();
+    jacobian_cache.valid = false;
     return r.ok();
   }
   const double t = r.f64();
@@ -507,6 +525,7 @@ bool PlantData::load(StateReader& r, Context& ctx) {
     return false;
   }
   if (fresh) plant = std::move(fresh);
+  jacobian_cache.valid = false;
   contact_events = plant->contact_events();  // the count continues from here
   logged_stops = stops;
   may_continue = false;  // the integrator restarts here, as the original run does after saving

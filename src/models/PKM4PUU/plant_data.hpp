@@ -48,6 +48,7 @@
 
 #include "models/common/dependencies.hpp"
 #include "models/common/mechanism_parameters.hpp"
+#include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
 #include "pkm4puu/sim/plant.hpp"
 
 namespace pkm_fmi {
@@ -117,9 +118,27 @@ struct PlantData final : MechanismData {
   bool may_continue = false;
   // The simulated machine (nullptr before initialisation).
   std::unique_ptr<pkm::Plant> plant;
+  // The state derivative's Jacobians at (y, u, contact mode) of the last
+  // partial_derivatives: an importer builds a full Jacobian with one
+  // directional derivative per seed (FMI 2: one column a call), and every
+  // such call at the same point reuses one evaluation. Invalid whenever the
+  // plant is replaced.
+  struct JacobianCache {
+    bool valid = false;
+    pkm::Vec8 y;
+    double u[kInputs];
+    unsigned stops = 0;
+    pkm::Mat8 A;
+    pkm::Mat8x12 B;
+    pkm::JointJacobians joints;
+    pkm::Vec4 rho;
+    /// Whether it holds the Jacobians at exactly this point.
+    bool holds(const pkm::Vec8& y_now, const double u_now[], unsigned stops_now) const;
+  } jacobian_cache;
 
   void reset() override {
     plant.reset();
+    jacobian_cache.valid = false;
     may_continue = false;
   }
   void state_saved() override { may_continue = false; }

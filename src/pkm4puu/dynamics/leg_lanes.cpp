@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
 #include "pkm4puu/dynamics/leg_lanes.hpp"
+#include "pkm4puu/dynamics/leg_lanes_kernel.hpp"
 
 #include "pkm4puu/base/lanes.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
@@ -8,9 +9,13 @@
 #include "pkm4puu/machine/passive_force.hpp"
 
 // x86-64 with GCC or Clang: an AVX variant of the legs' lanes beside the
-// SSE2 baseline, taken where Model::avx (make_model asks CPUID). Not on Windows: MinGW-w64's GCC
-// does not keep 32-byte stack alignment for AVX spills (GCC PR 54412).
-#if PKM_LANES_VECTOR_EXTENSIONS && defined(__x86_64__) && !defined(_WIN32) && !defined(__AVX__)
+// SSE2 baseline, taken where Model::avx (make_model asks CPUID). On Windows
+// only with PKM_UNALIGNED_VECTOR_MOVES: MinGW-w64's GCC does not keep the
+// 32-byte stack alignment its aligned AVX spills assume (GCC PR 54412), so
+// the build has the assembler make every vector move unaligned
+// (CMakeLists.txt).
+#if PKM_LANES_VECTOR_EXTENSIONS && defined(__x86_64__) && !defined(__AVX__) && \
+    (!defined(_WIN32) || defined(PKM_UNALIGNED_VECTOR_MOVES))
 #define PKM_LANES_AVX_DISPATCH 1
 #else
 #define PKM_LANES_AVX_DISPATCH 0
@@ -19,197 +24,8 @@
 namespace pkm {
 namespace {
 
+using namespace leg_lanes_kernel;
 
-// One leg (T = double) or the four legs as lanes (T = lanes::Pack): the
-// arithmetic of leg_inverse_kinematics, prepare_leg_kinematics,
-// leg_velocity and add_leg with the zeros and ones of J_i^{-1}, A_i and M_i
-// written out, each expression in the same order (so the same bits lane by
-// lane). `first` is the leg in lane 0.
-template <class T>
-struct LegInputs {
-  T Bx, By, Bz;    // B_i
-  T cb, sb;        // cos, sin beta_i
-  T rx, ry;        // r_Qi (x, y)
-  T f_rho;         // applied force on rho_i
-};
-
-template <class T>
-struct LegContribution {
-  T mr[10];  // A^T M A, upper triangle by rows: (0,0..3), (1,1..3), (2,2..3), (3,3)
-  T rhs[4];  // A^T r
-  T rho, rhod;
-};
-
-// The passive joint force (friction, end stops) per lane: the scalar
-// function itself (its tanh and branches), so the same bits; for the lanes
-// its plain case written lane-wise.
-PKM_LANES_INLINE double passive_force(const Params& p, int first, unsigned stops, double rho, double rhod) {
-  return passive_joint_force(p, first, stops, rho, rhod);
-}
-PKM_LANES_INLINE lanes::Pack passive_force(const Params& p, int first, unsigned stops, const lanes::Pack& rho,
-                                           const lanes::Pack& rhod) {
-  // Without Coulomb friction and with no stop acting on any leg (all
-  // within their travel, or none held): friction_force's -b rhod plus
-  // stop_contact's 0.0, lane-wise, with no calls to spill around.
-  if (p.friction_coulomb == 0.0 &&
-      (stops == kStopsFromState
-           ? !lanes::any(lanes::either(lanes::lt(rho, p.rho_min), lanes::gt(rho, p.rho_max)))
-           : (stops & ((1u << (2 * kLegs)) - 1u)) == 0u))
-    return -p.friction_viscous * rhod + 0.0;
-  double F[lanes::kWidth];
-  for (int i = 0; i < lanes::kWidth; ++i)
-    F[i] = passive_joint_force(p, first + i, stops, lanes::lane(rho, i), lanes::lane(rhod, i));
-  return lanes::pack(F[0], F[1], F[2], F[3]);
-}
-
-// leg_inverse_kinematics per lane (with rotated_attachment): the
-// derivative's legs and actuator_positions. out_of_reach: the lanes it
-// reports Unreachable for (their other members are meaningless).
-template <class T>
-struct LegPosition {
-  T ax, ay;          // Rz(phi) r_Qi (its z is 0)
-  T c1, s1, c2, s2;  // the leg's angles' cosines and sines
-  T rho;
-  decltype(lanes::not_ge(T(), 0.0)) out_of_reach;
-};
-
-template <class T>
-PKM_LANES_INLINE LegPosition<T> leg_position(const Params& p, const PlatformConfig& pc, const LegInputs<T>& in) {
-  LegPosition<T> o;
-  // rotated_attachment: Rz(phi) r_Qi (its z is 0).
-  o.ax = pc.cphi * in.rx - pc.sphi * in.ry;
-  o.ay = pc.sphi * in.rx + pc.cphi * in.ry;
-  // leg_inverse_kinematics: q~ = Rz(beta_i)^T (p + attach - B_i), then the
-  // elbow-down branch.
-  const T vx = (pc.pose[0] + o.ax) - in.Bx;
-  const T vy = (pc.pose[1] + o.ay) - in.By;
-  const T qz = (pc.pose[2] + 0.0) - in.Bz;
-  const T qx = in.cb * vx + in.sb * vy;
-  const T qy = -in.sb * vx + in.cb * vy;
-  const T r2 = qx * qx + qy * qy;
-  const T A2 = r2 - p.h_prime * p.h_prime;
-  const auto below = lanes::not_ge(A2, 0.0);  // also catches NaN
-  const T A = lanes::sqrt(lanes::zero_where(below, A2));
-  o.out_of_reach = lanes::either(below, lanes::not_le(A, p.l));
-  o.c1 = (qx * A - qy * p.h_prime) / r2;
-  o.s1 = (qy * A + qx * p.h_prime) / r2;
-  o.c2 = A / p.l;
-  const T s2sq = 1.0 - o.c2 * o.c2;
-  o.s2 = -lanes::sqrt(lanes::select(lanes::gt(s2sq, 0.0), s2sq, 0.0));  // elbow-down
-  o.rho = qz - p.h - p.l * o.s2;
-  return o;
-}
-
-template <class T>
-PKM_LANES_INLINE Status leg_contribution(const Model& m, int first, const PlatformConfig& pc, const Pose& pd,
-                                         unsigned stops, const LegInputs<T>& in, LegContribution<T>& out) {
-  const Params& p = m.p;
-  const LegPosition<T> lp = leg_position(p, pc, in);
-  const T ax = lp.ax, ay = lp.ay, c1 = lp.c1, s1 = lp.s1, c2 = lp.c2, s2 = lp.s2, rho = lp.rho;
-  const auto& out_of_reach = lp.out_of_reach;
-  // leg_singularity_measure.
-  const auto singular = lanes::lt(lanes::abs(c2 * s2), kLegSingularFloor);
-  if (lanes::any(lanes::either(out_of_reach, singular))) {
-    for (int i = 0; i < lanes::Traits<T>::width; ++i) {  // the first failing leg's status
-      if (lanes::lane(out_of_reach, i)) return Status::Unreachable;
-      if (lanes::lane(singular, i)) return Status::Singular;
-    }
-  }
-  // prepare_leg_kinematics: J_i^{-1} (its third column is e_0) and
-  // L_i^{-1} = J_i^{-1} Rz(beta_i)^T (third column e_0 too).
-  const T a = -p.l * s1 * c2 + p.h_prime * c1, b = p.l * c1 * c2 + p.h_prime * s1;
-  const T e = -p.l * c1 * s2, f = -p.l * s1 * s2, g = p.l * c2;
-  const T inv_D = 1.0 / (a * f - b * e);
-  const T j00 = b * g * inv_D, j01 = -a * g * inv_D;
-  const T j10 = f * inv_D, j11 = -e * inv_D;
-  const T j20 = -b * inv_D, j21 = a * inv_D;
-  const T cb = in.cb, sb = in.sb;
-  const T l00 = cb * j00 - sb * j01, l10 = cb * j10 - sb * j11, l20 = cb * j20 - sb * j21;
-  const T l01 = sb * j00 + cb * j01, l11 = sb * j10 + cb * j11, l21 = sb * j20 + cb * j21;
-  // A_i = [L_i^{-1}, L_i^{-1} (e_z x attach)]: rows (l_k0, l_k1, [k == 0], a_k3).
-  const T a03 = l01 * ax - l00 * ay;
-  const T a13 = l11 * ax - l10 * ay;
-  const T a23 = l21 * ax - l20 * ay;
-  // leg_velocity: qd_i = A_i pd.
-  const double phid = pd[3];
-  const T rd0 = l00 * pd[0] + l01 * pd[1] + pd[2] + a03 * phid;
-  const T th1d = l10 * pd[0] + l11 * pd[1] + a13 * phid;
-  const T th2d = l20 * pd[0] + l21 * pd[1] + a23 * phid;
-  // add_leg: gamma = Rz(beta_i) leg_point_quadratic + attach phid^2.
-  const double l = p.l, hp = p.h_prime;
-  const T q0 = (-l * c1 * c2 - hp * s1) * th1d * th1d + 2 * l * s1 * s2 * th1d * th2d - l * c1 * c2 * th2d * th2d;
-  const T q1 = (-l * s1 * c2 + hp * c1) * th1d * th1d - 2 * l * c1 * s2 * th1d * th2d - l * s1 * c2 * th2d * th2d;
-  const T q2 = -l * s2 * th2d * th2d;
-  const double w2 = phid * phid;
-  const T gamma0 = (cb * q0 - sb * q1) + ax * w2;
-  const T gamma1 = (sb * q0 + cb * q1) + ay * w2;
-  const T gamma2 = q2 + 0.0 * w2;
-  const T b0 = -(l00 * gamma0 + l01 * gamma1 + gamma2);
-  const T b1 = -(l10 * gamma0 + l11 * gamma1);
-  const T b2 = -(l20 * gamma0 + l21 * gamma1);
-  // leg_mass_matrix (M01 = M12 = 0), leg_coriolis, leg_gravity.
-  const double mr = p.m_rod;
-  const double m00 = p.m_slider + mr + m.reflected_mass;
-  const T m02 = 0.5 * mr * l * c2;
-  const T m11 = 0.25 * mr * l * l * c2 * c2 + p.I_rod[0] * s2 * s2 + p.I_rod[1] * c2 * c2;
-  const double m22 = 0.25 * mr * l * l + p.I_rod[2];
-  const T dM13 = -0.5 * p.m_rod * p.l * s2;  // leg_mass_slopes
-  const double k = p.I_rod[0] - p.I_rod[1] - 0.25 * p.m_rod * p.l * p.l;
-  const T dM22 = 2.0 * k * s2 * c2;
-  const T V0 = dM13 * th2d * th2d, V1 = dM22 * th1d * th2d, V2 = -0.5 * dM22 * th1d * th1d;
-  const double G0 = (p.m_slider + p.m_rod) * p.g;
-  const T G2 = 0.5 * p.m_rod * p.g * p.l * c2;
-  const T F = in.f_rho + passive_force(p, first, stops, rho, rd0);
-  const T r0 = F - V0 - G0 - (m00 * b0 + m02 * b2);
-  const T r1 = -V1 - m11 * b1;
-  const T r2_ = -V2 - G2 - (m02 * b0 + m22 * b2);
-  // A^T M A, upper triangle; M A's rows, with A's column 2 = e_0.
-  const T one = lanes::Traits<T>::constant(1.0), zero = lanes::Traits<T>::constant(0.0);
-  const T Am[3][4] = {{l00, l01, one, a03}, {l10, l11, zero, a13}, {l20, l21, zero, a23}};
-  T MA[3][4];
-  for (int c = 0; c < 4; ++c) {
-    MA[0][c] = m00 * Am[0][c] + m02 * Am[2][c];
-    MA[1][c] = m11 * Am[1][c];
-    MA[2][c] = m02 * Am[0][c] + m22 * Am[2][c];
-  }
-  int n = 0;
-  for (int j = 0; j < 4; ++j) {
-    for (int c = j; c < 4; ++c, ++n) {
-      if (j == 2) {  // A's column 2 is e_0
-        out.mr[n] = MA[0][c];
-        continue;
-      }
-      out.mr[n] = Am[0][j] * MA[0][c] + Am[1][j] * MA[1][c] + Am[2][j] * MA[2][c];
-    }
-  }
-  out.rhs[0] = l00 * r0 + l10 * r1 + l20 * r2_;
-  out.rhs[1] = l01 * r0 + l11 * r1 + l21 * r2_;
-  out.rhs[2] = r0;
-  out.rhs[3] = a03 * r0 + a13 * r1 + a23 * r2_;
-  out.rho = rho;
-  out.rhod = rd0;
-  return Status::Ok;
-}
-
-LegInputs<double> leg_inputs(const Model& m, int leg, double f_rho) {
-  return {m.B[leg].x(), m.B[leg].y(), m.B[leg].z(), m.cos_beta[leg], m.sin_beta[leg],
-          m.r_Q[leg].x(), m.r_Q[leg].y(), f_rho};
-}
-
-// The four legs' geometry as lanes (f_rho left 0).
-PKM_LANES_INLINE LegInputs<lanes::Pack> lane_inputs(const Model& m) {
-  using lanes::pack;
-  LegInputs<lanes::Pack> in;
-  in.Bx = pack(m.B[0].x(), m.B[1].x(), m.B[2].x(), m.B[3].x());
-  in.By = pack(m.B[0].y(), m.B[1].y(), m.B[2].y(), m.B[3].y());
-  in.Bz = pack(m.B[0].z(), m.B[1].z(), m.B[2].z(), m.B[3].z());
-  in.cb = pack(m.cos_beta[0], m.cos_beta[1], m.cos_beta[2], m.cos_beta[3]);
-  in.sb = pack(m.sin_beta[0], m.sin_beta[1], m.sin_beta[2], m.sin_beta[3]);
-  in.rx = pack(m.r_Q[0].x(), m.r_Q[1].x(), m.r_Q[2].x(), m.r_Q[3].x());
-  in.ry = pack(m.r_Q[0].y(), m.r_Q[1].y(), m.r_Q[2].y(), m.r_Q[3].y());
-  in.f_rho = lanes::broadcast(0.0);
-  return in;
-}
 
 // The four legs' actuator positions as lanes; on failure the first failing
 // leg's status (Unreachable, as leg_inverse_kinematics leg by leg), rho untouched.
@@ -244,16 +60,7 @@ PKM_LANES_INLINE Status legs_as_lanes(const Model& m, const PlatformConfig& pc, 
   LegContribution<lanes::Pack> c;
   const Status s = leg_contribution(m, 0, pc, pd, stops, in, c);
   if (s != Status::Ok) return s;
-  for (int n = 0; n < 10; ++n)
-    sums.mr[n] = (((0.0 + lanes::lane(c.mr[n], 0)) + lanes::lane(c.mr[n], 1)) + lanes::lane(c.mr[n], 2)) +
-                 lanes::lane(c.mr[n], 3);
-  for (int n = 0; n < 4; ++n)
-    sums.rhs[n] = (((0.0 + lanes::lane(c.rhs[n], 0)) + lanes::lane(c.rhs[n], 1)) + lanes::lane(c.rhs[n], 2)) +
-                  lanes::lane(c.rhs[n], 3);
-  for (int i = 0; i < kLegs; ++i) {
-    sums.rho[i] = lanes::lane(c.rho, i);
-    sums.rhod[i] = lanes::lane(c.rhod, i);
-  }
+  sum_lanes(c, sums);
   return Status::Ok;
 }
 

@@ -14,7 +14,7 @@ namespace pkm {
 /// The variants of the legs' lanes: the same template, the same bits;
 /// tests run each of them explicitly.
 enum class LegLanes {
-  Best,     // Avx where m.avx (x86-64 GCC/Clang off Windows), else Generic
+  Best,     // Avx where m.avx (x86-64 GCC/Clang; on Windows with unaligned moves), else Generic
   Scalar,   // one leg at a time (the same template for double)
   Generic,  // the baseline instruction set (SSE2 pairs on x86-64, NEON on aarch64)
   Avx,      // AVX; Status::InvalidArgument where unavailable

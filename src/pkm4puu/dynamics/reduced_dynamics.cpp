@@ -123,7 +123,25 @@ Status ReducedDynamics::platform_derivative(const Model& m, const PlatformConfig
   if (s != Status::Ok) return s;
   if (rho) *rho = Vec4(sums.rho[0], sums.rho[1], sums.rho[2], sums.rho[3]);
   if (rhod) *rhod = Vec4(sums.rhod[0], sums.rhod[1], sums.rhod[2], sums.rhod[3]);
-  return solve_reduced(m, f.segment<4>(kPlatform), sums.mr, sums.rhs, pc.cphi, pc.sphi, pd[3], pdd);
+  return solve_leg_sums(m, f.segment<4>(kPlatform), sums, pc, pd[3], pdd);
+}
+
+Status ReducedDynamics::solve_leg_sums(const Model& m, const Wrench& we, const LegSums& sums,
+                                       const PlatformConfig& pc, double phid, Pose& pdd) {
+  return solve_reduced(m, we, sums.mr, sums.rhs, pc.cphi, pc.sphi, phid, pdd);
+}
+
+Mat4 ReducedDynamics::reduced_mass(const Model& m, const LegSums& sums, const PlatformConfig& pc) {
+  const PlatformInertia pi = platform_inertia(m, pc.cphi, pc.sphi);
+  Mat4 Mr;
+  int n = 0;
+  for (int j = 0; j < 4; ++j)
+    for (int k = j; k < 4; ++k) Mr(j, k) = sums.mr[n++];
+  Mr.diagonal() += Vec4(pi.mass, pi.mass, pi.mass, pi.Izz);
+  Mr(0, 3) -= pi.mwy;
+  Mr(1, 3) += pi.mwx;
+  Mr.triangularView<Eigen::StrictlyLower>() = Mr.transpose();
+  return Mr;
 }
 
 void ReducedDynamics::reduced_system(const Model& m, const Wrench& we, Mat4& Mr, Vec4& rhs) const {

@@ -63,6 +63,13 @@ class ReducedDynamics {
                                     unsigned stops, Vec4* rho, Vec4* rhod, Pose& pdd,
                                     LegLanes kind = LegLanes::Best);
 
+  /// platform_derivative's solve: pdd from the legs' sums (leg_sums) with
+  /// the platform, its payload and the external wrench; the same bits.
+  static Status solve_leg_sums(const Model& m, const Wrench& we, const LegSums& sums, const PlatformConfig& pc,
+                               double phid, Pose& pdd);
+  /// The reduced mass matrix Mr of the same sums (reduced_system's, full).
+  static Mat4 reduced_mass(const Model& m, const LegSums& sums, const PlatformConfig& pc);
+
   struct Leg {
     LegConfig c;
     Vec3 attach;  // Rz(phi) r_Qi

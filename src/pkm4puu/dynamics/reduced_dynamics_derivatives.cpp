@@ -3,6 +3,7 @@
 
 #include "pkm4puu/dynamics/lagrangian.hpp"
 #include "pkm4puu/dynamics/lagrangian_derivatives.hpp"
+#include "pkm4puu/dynamics/leg_lanes_derivatives.hpp"
 #include "pkm4puu/kinematics/leg_kinematics_derivatives.hpp"
 #include "pkm4puu/machine/passive_force.hpp"
 #include "pkm4puu/dynamics/state_derivative.hpp"
@@ -88,20 +89,27 @@ void residual_partials(const Model& m, const ReducedDynamics& rd, const Pose& pd
 Status state_derivative_jacobians(const Model& m, const Vec8& y, const Vec4& F, const Vec4& tau, const Wrench& we,
                                   unsigned stops, Vec8& ydot, Mat8& A, Mat8x12& B, JointJacobians* joints) {
   if (!y.allFinite() || !F.allFinite() || !tau.allFinite() || !we.allFinite()) return Status::NonFinite;
-  ReducedDynamics rd;
-  Status s = reduced_terms(m, y, generalized_forces(m, F, tau, we), stops, rd);
-  if (s != Status::Ok) return s;
-  Pose pdd;
-  s = rd.solve_platform(m, we, pdd);
-  if (s != Status::Ok) return s;
+  // The legs as lanes (leg_lanes_derivatives.hpp): the state derivative's
+  // own kernel keeps its intermediates, one solve, then the legs' partials;
+  // residual_partials' sums leg by leg, plus the platform's terms here.
+  const PlatformConfig pc = platform_config(y.head<4>());
   const Pose pd = y.tail<4>();
-  ResidualPartials P;
-  residual_partials(m, rd, pd, pdd, Vec4::Zero(), stops, P);
+  LegPartialSums P;
+  const Status s = leg_partial_sums(m, pc, pd, generalized_forces(m, F, tau, we), stops, P);
+  if (s != Status::Ok) return s;
+  const Pose& pdd = P.pdd;
+  const double phid = pd[3];
+  const PlatformInertia pi = platform_inertia(m, pc.cphi, pc.sphi);
+  P.dp(0, 3) += -pi.mwx * pdd[3] + pi.mwy * phid * phid;
+  P.dp(1, 3) += -pi.mwy * pdd[3] - pi.mwx * phid * phid;
+  P.dp(3, 3) += -pi.mwx * pdd[0] - pi.mwy * pdd[1];
+  P.dpd(0, 3) -= 2.0 * pi.mwx * phid;
+  P.dpd(1, 3) -= 2.0 * pi.mwy * phid;
   // dpdd/dx = -Mr^{-1} dR/dx; dR/dF = -J_rho^T, dR/dtau = -(2 pi/p) J_rho^T, dR/dwe = -I.
   // Mr is symmetric positive definite (solve_platform's LDL^T succeeded) and
   // 4x4: its explicit inverse (cofactors) is far cheaper than a
   // factorisation with 20 right-hand sides.
-  const Mat4 Mr_inv = P.Mr.inverse();
+  const Mat4 Mr_inv = ReducedDynamics::reduced_mass(m, P.sums, pc).inverse();
   ydot << pd, pdd;
   A.topRows<4>().setZero();
   A.topRightCorner<4, 4>().setIdentity();

@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "pkm4puu/base/sin_cos.hpp"
+
 namespace pkm {
 
 LegConfig leg_config(double rho, double theta1, double theta2) {
@@ -18,8 +20,7 @@ LegConfig leg_config(double rho, double theta1, double theta2) {
 PlatformConfig platform_config(const Pose& pose) {
   PlatformConfig pc;
   pc.pose = pose;
-  pc.cphi = std::cos(pose[3]);
-  pc.sphi = std::sin(pose[3]);
+  sin_cos(pose[3], pc.sphi, pc.cphi);  // base/sin_cos.hpp: libm's, but not MinGW's slow one
   return pc;
 }
 

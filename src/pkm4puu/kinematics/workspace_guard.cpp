@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "pkm4puu/base/sin_cos.hpp"
 #include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/kinematics/leg_kinematics.hpp"
 
@@ -22,7 +23,8 @@ namespace {
 // kConditionLength) and the squared leg measures (cos theta2 sin theta2)^2.
 int actuator_rows(const Model& m, const Pose& pose, Mat4& J, Vec4& measure2) {
   const Params& p = m.p;
-  const double cphi = std::cos(pose[3]), sphi = std::sin(pose[3]);
+  double cphi, sphi;
+  sin_cos(pose[3], sphi, cphi);
   const double inv_l2 = 1.0 / (p.l * p.l);
   for (int i = 0; i < kLegs; ++i) {
     const Vec3& rq = m.r_Q[i];
