@@ -16,7 +16,10 @@
    checks (measured, bound, verdict) and their plots become Markdown files
    of <build>/docs/generated/ that the pages include.
    `python -m pkm4puu engines` (the comparison against Pinocchio and MuJoCo)
-   gives the validation page its engine tables and plots.
+   gives the validation page its engine tables and plots; the examples that
+   print figures (examples/*.py) give the examples page their results and
+   plots; a few cheap tests (pytest -s, gtest programs) print the figures of
+   the machine, derivatives and robustness checks.
 4. The performance page's tables come from the benchmarks of this build,
    run short (pkm_bench --quick, pkm_tick_bench, pkm_fmu_bench step, latency
    and cost with few batches, bench/engines_bench.py --quick), each printed
@@ -260,7 +263,8 @@ def main():
     # that a generator that cannot run leaves a missing include (an error),
     # never an older run's numbers.
     def clear_figures():
-        for pattern in ("autotest_cpp*.md", "fmu_autotest*.md", "fmu_comparison*.md", "engines_*.md", "perf_*.md"):
+        for pattern in ("autotest_cpp*.md", "fmu_autotest*.md", "fmu_comparison*.md", "engines_*.md", "perf_*.md",
+                        "example_*.md", "tests_*.md"):
             for f in generated.glob(pattern):
                 f.unlink()
 
@@ -290,6 +294,73 @@ def main():
             ("engines_pose.png", "comparison test against the engines: platform pose"),
             ("engines_delta_rho1.png", "comparison test against the engines: delta rho1"),
             ("engines_differences.png", "differences from Pinocchio and constraint violations")])
+
+    # The examples that print figures, each run as a user runs it; their
+    # printed results and their plots go onto the examples page.
+    examples = [("closed_loop_control", ["closed_loop_tracking.png"]), ("linearize_lqr", ["linearize_lqr.png"]),
+                ("drive_sizing", ["drive_sizing.png"]), ("ssp_cosim", ["ssp_autotest_errors.png"])]
+
+    def run_examples():
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), os.environ.get("PYTHONPATH", "")]),
+                   MPLBACKEND="Agg")
+        for name, images in examples:
+            out = runs / "examples" / name
+            shutil.rmtree(out, ignore_errors=True)
+            out.mkdir(parents=True)
+            r = subprocess.run([sys.executable, str(ROOT / "examples" / f"{name}.py"), "--build", str(build),
+                                "--out", str(out)], capture_output=True, text=True, env=env)
+            if r.returncode != 0:
+                sys.exit(f"build_docs: examples/{name}.py failed (exit {r.returncode}):\n{r.stdout}{r.stderr}")
+            # its results: what it printed, without its progress log ("name [  t s]: ...")
+            results = [line.rstrip() for line in r.stdout.splitlines()
+                       if line.strip() and not re.match(rf"^{name} \[\s*[0-9.]+ s\]:", line)
+                       and not re.match(r"^\[\d{4}-\d\d-\d\d ", line)]
+            if not results:
+                sys.exit(f"build_docs: examples/{name}.py printed no results:\n{r.stdout}")
+            write_text(generated / f"example_{name}_run.md", "```text\n" + "\n".join(results) + "\n```\n")
+            write_images(generated / f"example_{name}_plots.md", out, [(i, f"{name}: {i}") for i in images])
+
+    # Tests whose printed figures the pages quote (the tests assert the
+    # bounds; these runs print what they measured). Cheap ones only.
+    pytest_figures = [
+        ("tests_machine.md", ["python_checks/test_fmu_machine.py"]),
+        ("tests_derivatives.md", ["python_checks/test_fmu_derivatives.py",
+                                  "python_checks/test_engines_derivatives.py"]),
+    ]
+    gtest_figures = [  # (generated file, test program, gtest filter)
+        ("tests_long_run.md", "core_long_run", "HardeningLongRun.*"),
+        ("tests_prediction.md", "core_derivatives", "ForwardDerivatives.LinearisationPredicts*"),
+    ]
+
+    def run_tests_figures():
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), os.environ.get("PYTHONPATH", "")]),
+                   PKM_BUILD_DIR=str(build), MPLBACKEND="Agg")
+        for md_name, files in pytest_figures:
+            cmd = [sys.executable, "-m", "pytest", "-q", "-s", "-p", "no:cacheprovider", *files]
+            r = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
+            if r.returncode != 0:
+                sys.exit(f"build_docs: {' '.join(files)} failed (exit {r.returncode}):\n{r.stdout}{r.stderr}")
+            # pytest -q -s: the tests' lines, with pytest's progress dots and summary around them
+            lines = [re.sub(r"^[.sx]+", "", line).rstrip() for line in r.stdout.splitlines()]
+            lines = [line for line in lines if line and not re.match(r"^\d+ passed", line)]
+            if not lines:
+                sys.exit(f"build_docs: {' '.join(files)} printed no figures:\n{r.stdout}")
+            write_text(generated / md_name, f"<!-- Generated by docs/build_docs.py from pytest -s {' '.join(files)}; "
+                       "do not edit. -->\n\n```text\n" + "\n".join(lines) + "\n```\n")
+        for md_name, program, gfilter in gtest_figures:
+            exe = build / "tests" / program
+            if not exe.is_file():
+                sys.exit(f"build_docs: no {exe}: build it first (cmake --build {build} --target {program})")
+            r = subprocess.run([str(exe), f"--gtest_filter={gfilter}"], capture_output=True, text=True)
+            if r.returncode != 0:
+                sys.exit(f"build_docs: {program} --gtest_filter={gfilter} failed (exit {r.returncode}):\n{r.stdout}")
+            lines = [line.rstrip() for line in r.stdout.splitlines()
+                     if line.strip() and not line.startswith(("[", "|", "Running main()"))
+                     and not line.startswith("Note: Google Test filter")]
+            if not lines:
+                sys.exit(f"build_docs: {program} printed no figures:\n{r.stdout}")
+            write_text(generated / md_name, f"<!-- Generated by docs/build_docs.py from {program} "
+                       f"--gtest_filter={gfilter}; do not edit. -->\n\n```text\n" + "\n".join(lines) + "\n```\n")
 
     def bench(name, cmd, md_name, env=None):
         """Runs a benchmark; its whole printed output becomes generated/md_name."""
@@ -343,6 +414,8 @@ def main():
     engines_python = engines_available()
     step("the figures (pkm_autotest, python -m pkm4puu autotest and comparison)", run_figures)
     step("the engine comparison (python -m pkm4puu engines)", run_engines)
+    step("the examples (closed_loop_control, linearize_lqr, drive_sizing, ssp_cosim)", run_examples)
+    step("the tests' printed figures (machine, derivatives, long run)", run_tests_figures)
     step("the benchmarks (pkm_bench, pkm_tick_bench, pkm_fmu_bench, engines_bench.py), short", run_benchmarks)
     step("sphinx-build -W", run_sphinx)
     print(f"build_docs: site in {out}/index.html, {time.monotonic() - total:.1f} s in all")
