@@ -41,7 +41,7 @@ are printed against their targets (15x and 10x MuJoCo's mj_step). Both sides
 are C loops (the C harness, mujoco.rollout), so neither pays Python's
 per-call overhead.
 
-usage: .venv/bin/python bench/engines_bench.py [--build DIR] [--rounds R] [--batches B] [--markdown FILE]
+usage: .venv/bin/python bench/engines_bench.py [--build DIR] [--rounds R] [--batches B] [--markdown FILE] [--quick]
 """
 import argparse
 import csv
@@ -225,7 +225,7 @@ class PinocchioBench:
 
 
 # --- derivatives -----------------------------------------------------------------------------------------------
-def derivatives_comparison(build, median):
+def derivatives_comparison(build, median, bench_args=()):
     """The cost of the dynamics' derivatives over the cost of the dynamics:
     Pinocchio's computeConstraintDynamicsDerivatives after constraintDynamics
     (this run, Python calls), and this project's state_derivative_jacobians
@@ -238,7 +238,7 @@ def derivatives_comparison(build, median):
     if not exe.exists():
         print(f"derivatives, this project: {exe} not built")
         return
-    out = subprocess.run([str(exe)], capture_output=True, text=True, check=False).stdout
+    out = subprocess.run([str(exe), *bench_args], capture_output=True, text=True, check=False).stdout
     rows = [line.strip() for line in out.splitlines()
             if "state_derivative (LegPartitioned, baseline)" in line or "state_derivative_jacobians:" in line]
     for line in rows:
@@ -277,6 +277,9 @@ def main(argv=None):
     ap.add_argument("--batches", type=int, default=5,
                     help="timed batches of 1 simulated second per case and round (default 5)")
     ap.add_argument("--markdown", type=Path, help="also write the table, in Markdown, to this file")
+    ap.add_argument("--quick", action="store_true",
+                    help="a short run (the documentation build's): pkm_bench --quick for the derivatives' row; "
+                         "give small --rounds and --batches with it")
     args = ap.parse_args(argv)
     log = prefixed_log(prog)
     build = find_build(args.build, log)
@@ -345,7 +348,7 @@ def main(argv=None):
     print()
     print(table)
     print()
-    derivatives_comparison(build, median)
+    derivatives_comparison(build, median, ["--quick"] if args.quick else [])
     for key in ("capi_rk4", "capi_cvode", "capi_cvode_tight", "capi_cvode_one_call"):
         ratio = t_mj / median[key]
         # ||C|| <= 1e-12 m is a test's verdict (python_checks/test_fmu_comparison.py, test_engines_forward.py)

@@ -235,7 +235,8 @@ void print_header() {
               "gcc",
 #endif
               __VERSION__, EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION, SUNDIALS_VERSION);
-  std::printf("           timing: steady_clock; median and min over 31 batches of N calls (N: a batch >= 4 ms)\n");
+  std::printf("           timing: steady_clock; median and min over %d batches of N calls (N: a batch >= %g ms)%s\n",
+              bench::effort.batches, 1e3 * bench::effort.batch_s, bench::effort.batches < 31 ? " (--quick)" : "");
   std::printf("           allocation counter: %s\n", PKM_BENCH_COUNTS_ALLOCATIONS
                                                         ? "malloc family incl. operator new (glibc interposition)"
                                                         : "none in this build (glibc, no sanitizers)");
@@ -834,7 +835,15 @@ void ratios_section(const StateDerivativeFigures& sd, double jac_ratio, double r
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {  // --quick: the documentation build's short run (timing.hpp, Effort)
+    if (std::string(argv[i]) == "--quick") {
+      bench::set_quick();
+    } else {
+      std::fprintf(stderr, "pkm_bench: unknown option %s (usage: pkm_bench [--quick])\n", argv[i]);
+      return 2;
+    }
+  }
   Bench b;
   if (!set_up(b)) return 1;
   print_header();

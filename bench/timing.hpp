@@ -18,6 +18,19 @@ using Clock = std::chrono::steady_clock;
 
 inline double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
+/// How long each figure is measured: the defaults below, or a short run
+/// (--quick: fewer and shorter batches, noisier medians, the same rows), as
+/// the documentation build runs the benchmarks.
+struct Effort {
+  int batches = 31;          // batches per per-call figure
+  double batch_s = 4e-3;     // a per-call batch lasts at least this
+  int max_runs = 31;         // whole runs: at most, at least, and the wall-time budget
+  int min_runs = 5;
+  double runs_budget_s = 6.0;
+};
+inline Effort effort;
+inline void set_quick() { effort = Effort{7, 2e-3, 7, 3, 1.0}; }
+
 struct Figure {
   double median = NAN;  // s per call
   double min = NAN;
@@ -39,7 +52,7 @@ inline Figure summarise(std::vector<double> v, long per_batch) {
 /// Per-call time of body(): N calls per batch (N calibrated so that a batch
 /// lasts at least target_s), `batches` batches.
 template <class Body>
-Figure time_per_call(Body&& body, int batches = 31, double target_s = 4e-3) {
+Figure time_per_call(Body&& body, int batches = effort.batches, double target_s = effort.batch_s) {
   long n = 1;
   for (;;) {
     const auto t0 = Clock::now();
@@ -63,7 +76,8 @@ Figure time_per_call(Body&& body, int batches = 31, double target_s = 4e-3) {
 /// outside); repeated up to `max_runs` times or until about `budget_s` of
 /// wall time is spent (at least `min_runs`).
 template <class Run>
-Figure time_runs(Run&& run, int max_runs = 31, int min_runs = 5, double budget_s = 6.0) {
+Figure time_runs(Run&& run, int max_runs = effort.max_runs, int min_runs = effort.min_runs,
+                 double budget_s = effort.runs_budget_s) {
   std::vector<double> v;
   const auto start = Clock::now();
   run();  // warm-up (caches, page faults, lazy binding)

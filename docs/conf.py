@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: BSD-2-Clause
 # Sphinx configuration of the documentation site. Built by docs/build_docs.py
-# (ctest docs_build, `cmake --build build --target docs`), which runs Doxygen
+# (ctest docs_build), which runs Doxygen
 # on pkm.h first and passes the build tree's generated files through the
 # environment: PKM_DOCS_DOXYGEN_XML (Doxygen's XML of pkm.h) and
-# PKM_DOCS_GENERATED (the FMU reference pages and the figures of this build).
+# PKM_DOCS_GENERATED (the FMU reference pages and the figures of this build's runs).
 import os
 import sys
 from pathlib import Path

@@ -310,7 +310,7 @@ static int compare_run(const Plant* plant, const Options* o) {
   cvode_tight.rtol = 1e-12;
   cvode_tight.atol = 1e-14;
 
-  printf("pkm_fmu_bench compare: one simulated second of the comparison test (MODEL_SPEC; g = 0,\n"
+  printf("pkm_fmu_bench compare: one simulated second of the comparison test (docs/model.md; g = 0,\n"
          "F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s)) at a 1 ms step; median of %d batches after 1 warm-up\n",
          batches);
   print_machine();

@@ -11,13 +11,17 @@ the build's generated folder (config value pkm_generated_dir, from
 PKM_DOCS_GENERATED): the FMU reference that <id>_files --markdown writes
 from the variable tables, and the figure tables that docs/build_docs.py
 writes from this build's runs. (A line starting with % is a MyST comment, so
-the marker shows nothing by itself.) A missing file is an error, never an
-empty section.
+the marker shows nothing by itself.) A missing file is a warning (an error
+under -W, as the site is built) and a visible gap, never an older run's
+numbers.
 """
 import re
 from pathlib import Path
 
 from sphinx.errors import ExtensionError
+from sphinx.util import logging
+
+logger = logging.getLogger(__name__)
 
 MARKER = re.compile(r"^% pkm-generated (\S+)[ \t]*$", re.M)
 
@@ -30,7 +34,10 @@ def _substitute(app, docname, source):
                                  "(build the site with docs/build_docs.py)")
         path = Path(base) / m.group(1)
         if not path.is_file():
-            raise ExtensionError(f"{docname}: pkm-generated: {path} does not exist (was it built?)")
+            # a warning (an error under -W) and a visible gap, never an older run's numbers
+            logger.warning(f"pkm-generated: {path} does not exist (its generator did not run)",
+                           location=docname, type="pkm", subtype="generated")
+            return f"```{{warning}}\nNot generated in this build: {m.group(1)}.\n```\n"
         app.env.note_dependency(str(path))
         return path.read_text(encoding="utf-8")
 
