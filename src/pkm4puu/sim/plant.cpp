@@ -11,6 +11,7 @@
 #include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/kinematics/servo_kinematics.hpp"
 #include "pkm4puu/machine/passive_force.hpp"
+#include "pkm4puu/sim/fixed_step_stability.hpp"
 
 namespace pkm {
 
@@ -20,6 +21,11 @@ Status Plant::set_solver(const SolverSettings& s, std::string* error) {
   const std::string why = validate(s);
   if (!why.empty()) {
     if (error) *error = why;
+    return Status::InvalidArgument;
+  }
+  const std::string unstable = fixed_step_refusal(model_, s);
+  if (!unstable.empty()) {
+    if (error) *error = unstable;
     return Status::InvalidArgument;
   }
   settings_ = s;

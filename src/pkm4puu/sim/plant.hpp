@@ -187,7 +187,16 @@ class Plant {
   /// Creates CVODE's objects (once, when it is the solver), so that no step
   /// allocates: at initialize() and restore().
   Status prepare_cvode();
-  Status advance_rk4(double t_end);
+  /// RK4 or ROS2 (settings_.solver) on whole grid steps of at most rk4_step.
+  Status advance_fixed(double t_end);
+  /// Kinetic plus potential energy at y (J).
+  Status mechanical_energy(const Vec8& y, double& e) const;
+  /// ROS2's dissipated energy over the grid step to x: the balance of the
+  /// work and of the mechanical energy (e_mech at its start, updated);
+  /// with energy_tolerance, a step that gains more energy than that fails.
+  Status rosenbrock_dissipation(Vec10& x, double& e_mech, double t0, double t1);
+  /// kinetic + potential - actuator_work + dissipated at the current state (J).
+  Status energy_audit(double& value) const;
   Status advance_cvode(double t_end, bool continuous);
   /// check_configuration of y's pose against the settings' limits; on
   /// failure error_ describes it.
