@@ -93,6 +93,8 @@ struct PlantData final : MechanismData {
   double atol = kDefaultSolver.atol;
   std::int32_t cvode_method = static_cast<std::int32_t>(kDefaultSolver.cvode_method);
   std::int32_t formulation = static_cast<std::int32_t>(kDefaultSolver.formulation);
+  double work_budget = kDefaultSolver.work_budget;
+  double energy_tolerance = kDefaultSolver.energy_tolerance;
   // Inputs u = [F1..F4, Fe1..Fe3, Me_z, tau1..tau4] at the current time, and du/dt.
   double u[kInputs] = {kHoldingForce, kHoldingForce, kHoldingForce, kHoldingForce};
   double du[kInputs] = {};
