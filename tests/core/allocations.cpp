@@ -98,9 +98,12 @@ TEST_F(AllocationsTest, AnalyticDerivatives) {
   EXPECT_EQ(alloc_count() - before, 0);
 }
 
-TEST_F(AllocationsTest, Rk4AdvanceAfterInitialisation) {
+class FixedStepAllocations : public AllocationsTest, public ::testing::WithParamInterface<pkm::Solver> {};
+
+// RK4 and ROS2 (its Jacobian and the 8x8 LU are fixed-size).
+TEST_P(FixedStepAllocations, AdvanceAfterInitialisation) {
   pkm::SolverSettings rk4;
-  rk4.solver = pkm::Solver::Rk4;
+  rk4.solver = GetParam();
   rk4.rk4_step = 1e-3;
   pkm::PathForces forces;
   forces.model = &model;
@@ -117,5 +120,7 @@ TEST_F(AllocationsTest, Rk4AdvanceAfterInitialisation) {
   EXPECT_EQ(alloc_count() - before, 0);
   EXPECT_EQ(s, Status::Ok);
 }
+
+INSTANTIATE_TEST_SUITE_P(Solvers, FixedStepAllocations, ::testing::Values(pkm::Solver::Rk4, pkm::Solver::Rosenbrock));
 
 }  // namespace
