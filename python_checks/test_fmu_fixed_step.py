@@ -13,10 +13,10 @@ The bounds (docs/solvers.md, "Accuracy"): RK4 keeps h |lambda| <= 0.1 on
 its stiff modes: at most (0.1)^5/120 = 8.3e-8 of their amplitude per
 sub-step, contracted by R(-0.1) = 0.905 per later sub-step, so 8.8e-7 in
 all; with CVODE's rtol and a factor 10 for the non-stiff part, 1e-5 of
-max |dz|. ROS2: the issue's target, 1 % of max |dz|, from the 10th step on
-(the initial layer of the fast modes started from rest, which a 1 ms step
-does not resolve and ROS2 damps, is past), and through a contact only
-where ROS2 resolves the stop's ringing (its sub-steps, h omega <= 0.1).
+max |dz|. ROS2: the issue's target, 1 % of max |dz|, at every step (its
+graded steps after the start and after every switch of the contact mode
+resolve the fast transients, its sub-steps a ringing stop). Where CVODE
+itself fails (the stiffest stops' impact) the steps it answered are compared.
 """
 import math
 import time
@@ -31,7 +31,6 @@ from pkm4puu.fmu import Fmu
 H = 1e-3
 REFERENCE = {"solver": 0, "cvode_method": 1, "rtol": 1e-10, "atol": 1e-12}
 BOUND = {1: 1e-5, 2: 1e-2}
-LAYER = {1: 1, 2: 10}
 
 # Issue 28's cases.
 CASES = {
@@ -80,27 +79,6 @@ def run(archive, start, steps):
     return np.array(dz), status, slowest, first_contact
 
 
-G = 9.81
-
-
-def resolved(params, solver):
-    """Whether the bound applies (docs/solvers.md, "Limits"). ROS2 is right
-    where each term is either resolved by the step or so stiff that it
-    settles within one (L-stability): not where (a) the friction's tanh is
-    sharper than a step's velocity change (friction_velocity < g h with
-    F = 0: the breakaway is placed only to a step or two) or (b) a stop's
-    damping rate d / m_slider lies between 0.1 / h and 10 / h (a transient of
-    one step's length), and (c) in the steps after an impact, which start a
-    new initial layer. There the run must still be physical: never faster
-    than free fall, its error printed."""
-    if solver != 2:
-        return True
-    if params.get("friction_coulomb", 0.0) > 0 and params.get("friction_velocity", 1e-3) < G * H:
-        return False
-    rate = params.get("stop_damping", 100.0) / params.get("m_slider", 0.09331)
-    return not (0.1 / H < rate < 10.0 / H)
-
-
 def check(archive, params, solver, steps, capfd, rk4_step=H):
     """One run against the reference: every OK step within the bound, every
     refusal with a message; returns a one-line summary."""
@@ -115,22 +93,15 @@ def check(archive, params, solver, steps, capfd, rk4_step=H):
         else:
             assert status == 2, f"{params}, solver {solver}: a failed step must be a Discard, not {status}"
             assert "work budget" in log or "could not" in log or "beyond" in log or "energy" in log, log[-1500:]
-    n_all = n = min(len(dz), len(ref))
-    if solver == 2 and contact is not None:
-        n = min(n, contact)  # (c): up to the first impact
-    layer = LAYER[solver]
-    worst = worst_all = 0.0
-    if n >= layer:
-        scale = np.abs(ref[:n_all]).max()
-        worst = np.abs(dz[layer - 1:n] - ref[layer - 1:n]).max() / scale if scale > 0 else 0.0
-        worst_all = np.abs(dz[layer - 1:n_all] - ref[layer - 1:n_all]).max() / scale if scale > 0 else 0.0
-        if resolved(params, solver):
-            assert worst <= BOUND[solver], (f"{params}, solver {solver}, rk4_step {rk4_step}: an OK step is "
-                                            f"{worst:.3g} of max |dz| off CVODE (bound {BOUND[solver]})")
-        else:
-            free_fall = G * H * np.arange(1, n + 1) * (1 + 1e-9)
-            assert (np.abs(dz[:n]) <= free_fall).all(), f"{params}, solver {solver}: faster than free fall"
-    return (f"{len(dz)}/{steps} OK, error {worst:.2g} (after impacts too: {worst_all:.2g}; reference {len(ref)} OK), "
+    n = min(len(dz), len(ref))
+    worst = 0.0
+    if n > 0:
+        scale = np.abs(ref[:n]).max()
+        worst = np.abs(dz[:n] - ref[:n]).max() / scale if scale > 0 else 0.0
+        assert worst <= BOUND[solver], (f"{params}, solver {solver}, rk4_step {rk4_step}: an OK step is "
+                                        f"{worst:.3g} of max |dz| off CVODE (bound {BOUND[solver]})")
+    impact = f", impact at step {contact + 1}" if contact is not None else ""
+    return (f"{len(dz)}/{steps} OK, error {worst:.2g} (reference {len(ref)} OK{impact}), "
             f"slowest doStep {slowest * 1e3:.2f} ms, {'refused ' + str(status) if status else 'all OK'}")
 
 

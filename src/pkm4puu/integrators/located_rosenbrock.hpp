@@ -52,7 +52,7 @@ Status ros2_step(System& sys, double t, double h, Vec10& y) {
 
 /// located_fixed_step with ROS2.
 template <class System>
-Status located_rosenbrock_step(System& sys, double t0, double t1, const InnerSteps& inner, Vec10& x,
+Status located_rosenbrock_step(System& sys, double t0, double t1, InnerSteps& inner, Vec10& x,
                                unsigned& mode, Vec4& rho, bool& rho_valid, long& switches, double& t,
                                WorkBudget& budget) {
   auto step = [&sys](double tt, double h, Vec10& xx) { return ros2_step(sys, tt, h, xx); };

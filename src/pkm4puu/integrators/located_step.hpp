@@ -35,10 +35,24 @@ struct WorkBudget {
 };
 
 /// The longest inner steps: out of contact (`free`) and while a stop is held.
+/// After a switch of the contact mode (and where `layer` is set by the
+/// caller, at the start of a run) a new fast transient starts: with
+/// `layer_free` / `layer_contact` finite the steps start that short and grow
+/// by kLayerGrowth per step (`layer`, the current one; +inf: none), so that
+/// the transient is resolved while it lasts at a logarithmic cost.
 struct InnerSteps {
   double free = std::numeric_limits<double>::infinity();
   double contact = std::numeric_limits<double>::infinity();
+  double layer_free = std::numeric_limits<double>::infinity();
+  double layer_contact = std::numeric_limits<double>::infinity();
+  double layer = std::numeric_limits<double>::infinity();
 };
+/// The layer's growth per step: the time since the switch is then about six
+/// steps (1 + 1/1.2 + 1/1.2^2 + ...), so that a mode of rate lambda has
+/// decayed by exp(-6 h lambda) where the step is h; the cost is
+/// log(h_grid lambda / 0.1) / log(1.2) steps per switch, about 100 at the
+/// stiffest declared stops (docs/solvers.md).
+constexpr double kLayerGrowth = 1.2;
 
 /// The step from (t0, x) to t1 with `step(t, h, x)` (one step of the method,
 /// x unchanged on failure). `sys` provides
@@ -53,7 +67,7 @@ struct InnerSteps {
 /// plant's contact mode from there on). Out of budget: SolverFailure with
 /// budget.exhausted, x at t.
 template <class System, class Stepper>
-Status located_fixed_step(System& sys, Stepper&& step_fn, double t0, double t1, const InnerSteps& inner, Vec10& x,
+Status located_fixed_step(System& sys, Stepper&& step_fn, double t0, double t1, InnerSteps& inner, Vec10& x,
                           unsigned& mode, Vec4& rho, bool& rho_valid, long& switches, double& t, WorkBudget& budget) {
   t = t0;
   int located = 0;
@@ -70,7 +84,7 @@ Status located_fixed_step(System& sys, Stepper&& step_fn, double t0, double t1, 
   while (t < t1 && s == Status::Ok) {
     double step = t1 - t;
     bool to_end = true;
-    const double limit = mode != 0 ? std::min(inner.free, inner.contact) : inner.free;
+    const double limit = std::min(mode != 0 ? std::min(inner.free, inner.contact) : inner.free, inner.layer);
     if (step > limit) {
       step = limit;
       to_end = false;
@@ -109,6 +123,11 @@ Status located_fixed_step(System& sys, Stepper&& step_fn, double t0, double t1, 
       step = hi;
       ++located;
       ++switches;
+    }
+    if (trial_mode != mode) {
+      inner.layer = trial_mode != 0 ? inner.layer_contact : inner.layer_free;  // a new transient
+    } else if (step >= inner.layer) {
+      inner.layer *= kLayerGrowth;
     }
     x = trial;
     mode = trial_mode;

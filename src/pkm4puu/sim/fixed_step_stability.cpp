@@ -26,8 +26,10 @@ SubSteps fixed_sub_steps(const Model& m, Solver solver) {
   const StiffRates r = stiff_rates(m);
   constexpr double inf = std::numeric_limits<double>::infinity();
   auto step = [inf](double fraction, double rate) { return rate > 0.0 ? fraction / rate : inf; };
-  if (solver == Solver::Rosenbrock) return {inf, step(kRosenbrockRingFraction, r.ringing)};
-  return {step(kRk4StiffFraction, r.friction), step(kRk4StiffFraction, r.contact)};
+  if (solver == Solver::Rosenbrock)
+    return {inf, step(kRosenbrockRingFraction, r.ringing), step(kRk4StiffFraction, r.friction),
+            step(kRk4StiffFraction, r.contact)};
+  return {step(kRk4StiffFraction, r.friction), step(kRk4StiffFraction, r.contact), inf, inf};
 }
 
 std::string fixed_step_refusal(const Model& m, const SolverSettings& s) {

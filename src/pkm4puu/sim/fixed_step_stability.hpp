@@ -28,14 +28,19 @@ StiffRates stiff_rates(const Model& m);
 /// The sub-steps' fractions: RK4 keeps h |lambda| <= 0.1 (its error per step
 /// (h lambda)^5 / 120 <= 1e-7 of the fast motion, inside its stability
 /// interval [-2.78, 0]); ROS2 is L-stable and resolves a ringing stop with
-/// h omega <= 0.1 (its error per step ~ (h omega)^3 / 6 <= 2e-4).
+/// h omega <= 0.05 (its error per step ~ (h omega)^3 / 6 <= 2e-5).
 constexpr double kRk4StiffFraction = 0.1;
-constexpr double kRosenbrockRingFraction = 0.1;
+constexpr double kRosenbrockRingFraction = 0.05;
 
 /// The longest inner step (s) of `solver` out of contact and in contact
 /// (+inf where nothing limits it).
 struct SubSteps {
   double free = 0, contact = 0;
+  // ROS2's first step after a switch of the contact mode (or at the start),
+  // h |lambda| <= 0.1 on the bound, out of contact and in contact; from
+  // there the steps grow by kLayerGrowth (located_step.hpp). RK4: +inf (its
+  // steps resolve the stiff terms throughout).
+  double layer_free = 0, layer_contact = 0;
 };
 SubSteps fixed_sub_steps(const Model& m, Solver solver);
 

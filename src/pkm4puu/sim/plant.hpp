@@ -220,6 +220,10 @@ class Plant {
   mutable bool rho_valid_ = false;
   mutable Theta1References theta1_;
   mutable bool theta1_stale_ = false;
+  // ROS2's initial layer (located_step.hpp's InnerSteps::layer): pending
+  // after initialize() and restore(), else carried from the last advance.
+  bool layer_pending_ = true;
+  double layer_ = 0;
   long rhs_count_ = 0;
   Status rhs_status_ = Status::Ok;
   std::string error_;

@@ -116,7 +116,10 @@ Status Plant::advance_fixed(double t_end) {
   const double t0 = t_;
   const bool rosenbrock = settings_.solver == Solver::Rosenbrock;
   const SubSteps sub = fixed_sub_steps(model_, settings_.solver);
-  const InnerSteps inner{sub.free, sub.contact};
+  InnerSteps inner{sub.free, sub.contact, sub.layer_free, sub.layer_contact};
+  // The transient started at initialisation or carried over from the last advance.
+  inner.layer = layer_pending_ ? (stops_ != 0 ? sub.layer_contact : sub.layer_free) : layer_;
+  layer_pending_ = false;
   // One budget for the whole advance: work_budget inner steps per grid step.
   WorkBudget budget;
   budget.limit = static_cast<long>(std::min(settings_.work_budget * static_cast<double>(n), 1e18));
@@ -142,6 +145,7 @@ Status Plant::advance_fixed(double t_end) {
     Status s = rosenbrock
                    ? located_rosenbrock_step(ode, tk, t_next, inner, x, mode, rho, rho_valid, contact_events_, t, budget)
                    : located_rk4_step(ode, tk, t_next, inner, x, mode, rho, rho_valid, contact_events_, t, budget);
+    layer_ = inner.layer;
     if (s != Status::Ok) {
       if (budget.exhausted) {
         error_ = work_budget_message(model_, settings_, t, budget.limit, budget.in_contact);
@@ -242,6 +246,7 @@ Status Plant::advance(double t_end, const InputSignal& inputs, bool continuous) 
       stops_ = stops_start;
       t_ = t_start;
       rho_valid_ = false;
+      layer_pending_ = true;
       if (cvode_ready_) cvode_.reset(t_, packed());
     }
   }
