@@ -21,18 +21,17 @@ constexpr double kRos2Gamma = 1.0 + 0.70710678118654752440;
 
 /// One ROS2 step of size h from (t, y). `sys` provides
 ///   Status rates(double t, const Vec10& x, Vec10& xdot)
-///   Status jacobian(double t, const Vec10& x, double h, Eigen::Matrix<double, 8, 8>& A, Vec8& f_t)
-/// (A = d(pose, velocity rates)/d(pose, velocity), f_t their time derivative
-/// over [t, t + h] through the inputs). On failure y is left unchanged.
+///   Status jacobian(double t, const Vec10& x, double h, Vec10& xdot, Eigen::Matrix<double, 8, 8>& A, Vec8& f_t)
+/// (xdot the rates at (t, x), A = d(pose, velocity rates)/d(pose, velocity),
+/// f_t their time derivative over [t, t + h] through the inputs). On
+/// failure y is left unchanged.
 template <class System>
 Status ros2_step(System& sys, double t, double h, Vec10& y) {
   using Mat8 = Eigen::Matrix<double, 8, 8>;
   Vec10 f0, f1;
   Mat8 A;
   Vec8 ft;
-  Status s = sys.rates(t, y, f0);
-  if (s != Status::Ok) return s;
-  s = sys.jacobian(t, y, h, A, ft);
+  Status s = sys.jacobian(t, y, h, f0, A, ft);
   if (s != Status::Ok) return s;
   const double gh = kRos2Gamma * h;
   const Eigen::PartialPivLU<Mat8> W(Mat8(Mat8::Identity() - gh * A));

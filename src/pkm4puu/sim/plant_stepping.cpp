@@ -23,22 +23,34 @@ namespace pkm {
 struct PlantOde {
   Plant& plant;
   Status rates(double t, const Vec10& x, Vec10& xdot) { return plant.derivative(t, x, xdot); }
-  /// The analytic Jacobian of the pose and velocity rates (the leg-partitioned
-  /// terms, the machine included) and their time derivative through the
-  /// inputs, B (u(t + h) - u(t)) / h (exact for the FMUs' linear inputs).
-  Status jacobian(double t, const Vec10& x, double h, Mat8& A, Vec8& f_t) {
+  /// The rates at (t, x) with the analytic Jacobian of the pose and velocity
+  /// rates (the leg-partitioned terms, the machine included; one evaluation
+  /// gives both) and their time derivative through the inputs,
+  /// B (u(t + h) - u(t)) / h (exact for the FMUs' linear inputs). The
+  /// dissipation rate is left 0: ROS2's dissipated energy is the audit's
+  /// balance (Plant::rosenbrock_dissipation).
+  Status jacobian(double t, const Vec10& x, double h, Vec10& xdot, Mat8& A, Vec8& f_t) {
+    ++plant.rhs_count_;
+    if (!std::isfinite(t)) return Status::SolverFailure;
     Vec4 F0, tau0, F1, tau1;
     Wrench we0, we1;
     read_inputs(plant.inputs_, t, F0, we0, tau0);
     read_inputs(plant.inputs_, t + h, F1, we1, tau1);
+    if (!F0.allFinite() || !we0.allFinite() || !tau0.allFinite()) return Status::NonFinite;
     Vec8 ydot;
     Mat8x12 B;
-    const Status s = state_derivative_jacobians(plant.model_, x.head<8>(), F0, tau0, we0, plant.stops_, ydot, A, B);
-    if (s != Status::Ok) return s;
+    JointJacobians joints;
+    const Status s =
+        state_derivative_jacobians(plant.model_, x.head<8>(), F0, tau0, we0, plant.stops_, ydot, A, B, &joints);
+    if (s != Status::Ok) return s == Status::NonFinite ? Status::SolverFailure : s;
+    const Pose pd = x.segment<4>(4);
+    xdot.head<8>() = ydot;
+    xdot[8] = (F0 + plant.model_.drive_ratio * tau0).dot(joints.J_rho * pd) + we0.dot(pd);  // as energy_rates
+    xdot[9] = 0.0;
     Eigen::Matrix<double, kPlantInputs, 1> du;
     du << F1 - F0, we1 - we0, tau1 - tau0;
     f_t = B * (du / h);
-    return (A.allFinite() && f_t.allFinite()) ? Status::Ok : Status::SolverFailure;
+    return (xdot.allFinite() && A.allFinite() && f_t.allFinite()) ? Status::Ok : Status::SolverFailure;
   }
   void hold(unsigned stops) { plant.stops_ = stops; }
   unsigned mode(const Vec10& x, Vec4& rho) const { return plant.contact_mode(x, rho); }
