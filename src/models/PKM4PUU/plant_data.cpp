@@ -219,6 +219,8 @@ Status PlantData::update_outputs(Context& ctx, unsigned groups) {
       pose[i] = y[i];
       vel[i] = dy[i] = y[4 + i];
     }
+  }
+  if (groups & kGroupEnergy) {
     energy[0] = plant->energy_integrals().actuator_work;
     energy[1] = plant->energy_integrals().dissipated;
   }

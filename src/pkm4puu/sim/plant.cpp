@@ -73,6 +73,7 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
   stops_ = stops_after_event(model_.p, rho, rhod, 0u);
   t_ = t0;
   energy_ = EnergyIntegrals{};
+  balance_pending_ = false;
   for (int i = 0; i < kLegs; ++i) theta1_.ref[i] = q[leg_offset(i) + 1];
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
@@ -86,6 +87,7 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
 }
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned stops) {
+  settle_energy();  // the integrals keep their values: at the state they belong to
   const unsigned legs_held = (stops | (stops >> kLegs)) & ((1u << kLegs) - 1u);
   if (stops != ~0u && ((stops & ~kContactModeBits) != 0u || (stops & (stops >> kLegs) & ((1u << kLegs) - 1u)) != 0u ||
                        ((stops >> (2 * kLegs)) & ~legs_held) != 0u)) {
@@ -141,6 +143,7 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned 
 Status Plant::set_state(const Vec8& y) {
   if (!initialized_) return Status::NotInitialized;
   if (!y.allFinite()) return Status::NonFinite;
+  settle_energy();
   GuardReport report;
   GuardLimits none;
   none.max_jacobian_condition = std::numeric_limits<double>::infinity();
@@ -183,6 +186,7 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const Ene
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e, unsigned stops) {
   if (!std::isfinite(e.actuator_work) || !std::isfinite(e.dissipated)) return Status::NonFinite;
+  settle_energy();
   const EnergyIntegrals keep = energy_;
   energy_ = e;
   const Status s = restore(t, y, theta1_ref, stops);
@@ -209,7 +213,16 @@ Status Plant::contact_indicators(double z[kContactIndicators]) const {
   return s;
 }
 
-Vec10 Plant::packed() const {
+void Plant::settle_energy() const {
+  if (!balance_pending_) return;
+  double e = 0.0;
+  if (mechanical_energy(y_, e) != Status::Ok) return;  // y_ is always assembled: not reached
+  energy_.dissipated = balance_dissipated_ + (energy_.actuator_work - balance_work_) - (e - balance_mech_);
+  balance_pending_ = false;
+}
+
+Vec10 Plant::packed(bool settle) const {
+  if (settle) settle_energy();
   Vec10 x;
   x.head<8>() = y_;
   x[8] = energy_.actuator_work;
