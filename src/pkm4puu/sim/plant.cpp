@@ -135,7 +135,8 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned 
   theta1_.ref = theta1_ref;
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
-  layer_pending_ = true;
+  layer_pending_ = false;  // a restored run goes on as it would have (no new transient)
+  layer_ = std::numeric_limits<double>::infinity();
   initialized_ = true;
   return Status::Ok;
 }

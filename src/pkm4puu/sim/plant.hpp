@@ -235,7 +235,7 @@ class Plant {
   mutable Theta1References theta1_;
   mutable bool theta1_stale_ = false;
   // ROS2's initial layer (located_step.hpp's InnerSteps::layer): pending
-  // after initialize() and restore(), else carried from the last advance.
+  // after initialize(), else carried from the last advance (none after restore()).
   bool layer_pending_ = true;
   double layer_ = 0;
   long rhs_count_ = 0;

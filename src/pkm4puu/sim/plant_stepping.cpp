@@ -240,6 +240,8 @@ Status Plant::advance(double t_end, const InputSignal& inputs, bool continuous) 
   const Vec8 y_start = y_;
   const EnergyIntegrals e_start = energy_;
   const unsigned stops_start = stops_;
+  const bool layer_pending_start = layer_pending_;
+  const double layer_start = layer_;
   double audit_start = 0.0;
   const bool audit = settings_.energy_tolerance > 0.0;
   if (audit) {
@@ -270,7 +272,8 @@ Status Plant::advance(double t_end, const InputSignal& inputs, bool continuous) 
       stops_ = stops_start;
       t_ = t_start;
       rho_valid_ = false;
-      layer_pending_ = true;
+      layer_pending_ = layer_pending_start;
+      layer_ = layer_start;
       if (cvode_ready_) cvode_.reset(t_, packed());
     }
   }
