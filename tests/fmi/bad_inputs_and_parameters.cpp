@@ -202,7 +202,7 @@ TEST(HardeningParameters, OutOfRangeParametersFailInitialisationAndResetRecovers
       {"energy_tolerance", -1.0, "energy_tolerance"},
   };
   cases.insert(cases.end(), std::begin(others), std::end(others));
-  ASSERT_EQ(cases.size(), 47u);
+  ASSERT_EQ(cases.size(), 49u);
   int refused_when_set = 0;
   for (const BadParameter& c : cases) {
     SCOPED_TRACE(std::string(c.name) + " = " + text(c.value));
