@@ -15,6 +15,9 @@
 
 namespace pkm {
 
+/// The stop bits of a contact mode (end_stops.hpp): bits 0..7.
+constexpr unsigned kStopBits = (1u << kStopIndicators) - 1u;
+
 /// At most this many located switches per grid step (beyond, the step goes
 /// on without locating: a chattering contact).
 constexpr int kMaxSwitchesPerStep = 64;
@@ -46,6 +49,10 @@ struct InnerSteps {
   double layer_free = std::numeric_limits<double>::infinity();
   double layer_contact = std::numeric_limits<double>::infinity();
   double layer = std::numeric_limits<double>::infinity();
+  // With `contact_from_system`, `contact` is the system's own at each switch
+  // into a contact mode (sys.contact_step(t, x, mode): ROS2's ringing from
+  // the Jacobian's eigenvalues there), else fixed.
+  bool contact_from_system = false;
 };
 /// The layer's growth per step: the time since the switch is then about six
 /// steps (1 + 1/1.2 + 1/1.2^2 + ...), so that a mode of rate lambda has
@@ -126,6 +133,10 @@ Status located_fixed_step(System& sys, Stepper&& step_fn, double t0, double t1, 
     }
     if (trial_mode != mode) {
       inner.layer = trial_mode != 0 ? inner.layer_contact : inner.layer_free;  // a new transient
+      if (inner.contact_from_system && (trial_mode & kStopBits) != 0) {
+        sys.hold(trial_mode & kContactModeBits);
+        inner.contact = sys.contact_step(t + step, trial);
+      }
     } else if (step >= inner.layer) {
       inner.layer *= kLayerGrowth;
     }

@@ -238,6 +238,9 @@ class Plant {
   // after initialize(), else carried from the last advance (none after restore()).
   bool layer_pending_ = true;
   double layer_ = 0;
+  // ROS2's step in the current contact (PlantOde::contact_step); < 0: not
+  // known yet (after initialize() and restore(): computed at the next advance).
+  double contact_step_ = -1.0;
   long rhs_count_ = 0;
   Status rhs_status_ = Status::Ok;
   std::string error_;

@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+
+#include <Eigen/Eigenvalues>
 
 #include "pkm4puu/integrators/located_cvode.hpp"
 #include "pkm4puu/integrators/located_rk4.hpp"
@@ -22,6 +25,7 @@ namespace pkm {
 /// held stops, its Jacobian (ROS2), and its contact mode.
 struct PlantOde {
   Plant& plant;
+  double contact_fallback = 0;  // contact_step where the Jacobian cannot be evaluated
   Status rates(double t, const Vec10& x, Vec10& xdot) { return plant.derivative(t, x, xdot); }
   /// The rates at (t, x) with the analytic Jacobian of the pose and velocity
   /// rates (the leg-partitioned terms, the machine included; one evaluation
@@ -53,6 +57,25 @@ struct PlantOde {
     return (xdot.allFinite() && A.allFinite() && f_t.allFinite()) ? Status::Ok : Status::SolverFailure;
   }
   void hold(unsigned stops) { plant.stops_ = stops; }
+  /// ROS2's step in the contact just switched on at (t, x) under the held
+  /// stops: h omega <= kRosenbrockRingFraction with omega the largest
+  /// imaginary part of the Jacobian's eigenvalues there (the stop's ringing
+  /// against the mechanism's actual mass); +inf if nothing rings.
+  double contact_step(double t, const Vec10& x) {
+    Vec4 F, tau;
+    Wrench we;
+    read_inputs(plant.inputs_, t, F, we, tau);
+    Vec8 ydot;
+    Mat8 A;
+    Mat8x12 B;
+    if (state_derivative_jacobians(plant.model_, x.head<8>(), F, tau, we, plant.stops_, ydot, A, B) != Status::Ok ||
+        !A.allFinite())
+      return contact_fallback;
+    const Eigen::EigenSolver<Mat8> eig(A, false);
+    if (eig.info() != Eigen::Success) return contact_fallback;
+    const double omega = eig.eigenvalues().imag().cwiseAbs().maxCoeff();
+    return omega > 0.0 ? kRosenbrockRingFraction / omega : std::numeric_limits<double>::infinity();
+  }
   unsigned mode(const Vec10& x, Vec4& rho) const { return plant.contact_mode(x, rho); }
 };
 
@@ -129,13 +152,19 @@ Status Plant::advance_fixed(double t_end) {
   const bool rosenbrock = settings_.solver == Solver::Rosenbrock;
   const SubSteps sub = fixed_sub_steps(model_, settings_.solver);
   InnerSteps inner{sub.free, sub.contact, sub.layer_free, sub.layer_contact};
+  PlantOde ode{*this, sub.contact};
+  if (rosenbrock) {  // the ringing from the Jacobian at each switch into contact
+    inner.contact_from_system = true;
+    inner.contact = contact_step_ >= 0.0 ? contact_step_
+                    : (stops_ & kStopBits) != 0u ? ode.contact_step(t_, packed(false))
+                                                 : std::numeric_limits<double>::infinity();
+  }
   // The transient started at initialisation or carried over from the last advance.
   inner.layer = layer_pending_ ? (stops_ != 0 ? sub.layer_contact : sub.layer_free) : layer_;
   layer_pending_ = false;
   // One budget for the whole advance: work_budget inner steps per grid step.
   WorkBudget budget;
   budget.limit = static_cast<long>(std::min(settings_.work_budget * static_cast<double>(n), 1e18));
-  PlantOde ode{*this};
   // ROS2's stage rates do not resolve the power dissipated in a transient it
   // steps over (a stiff stop's damper), so its dissipated energy is the
   // audit's balance: brought up to date when read (settle_energy), or at
@@ -166,6 +195,7 @@ Status Plant::advance_fixed(double t_end) {
                    ? located_rosenbrock_step(ode, tk, t_next, inner, x, mode, rho, rho_valid, contact_events_, t, budget)
                    : located_rk4_step(ode, tk, t_next, inner, x, mode, rho, rho_valid, contact_events_, t, budget);
     layer_ = inner.layer;
+    if (rosenbrock) contact_step_ = inner.contact;
     if (s != Status::Ok) {
       if (budget.exhausted) {
         error_ = work_budget_message(model_, settings_, t, budget.limit, budget.in_contact);
@@ -242,6 +272,7 @@ Status Plant::advance(double t_end, const InputSignal& inputs, bool continuous) 
   const unsigned stops_start = stops_;
   const bool layer_pending_start = layer_pending_;
   const double layer_start = layer_;
+  const double contact_step_start = contact_step_;
   double audit_start = 0.0;
   const bool audit = settings_.energy_tolerance > 0.0;
   if (audit) {
@@ -274,6 +305,7 @@ Status Plant::advance(double t_end, const InputSignal& inputs, bool continuous) 
       rho_valid_ = false;
       layer_pending_ = layer_pending_start;
       layer_ = layer_start;
+      contact_step_ = contact_step_start;
       if (cvode_ready_) cvode_.reset(t_, packed());
     }
   }
