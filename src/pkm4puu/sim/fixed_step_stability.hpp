@@ -28,7 +28,10 @@ StiffRates stiff_rates(const Model& m);
 /// The sub-steps' fractions: RK4 keeps h |lambda| <= 0.1 (its error per step
 /// (h lambda)^5 / 120 <= 1e-7 of the fast motion, inside its stability
 /// interval [-2.78, 0]); ROS2 is L-stable and resolves a ringing stop with
-/// h omega <= 0.05 (its error per step ~ (h omega)^3 / 6 <= 2e-5).
+/// h omega <= 0.05 (its error per step ~ (h omega)^3 / 6 <= 2e-5), omega
+/// from the Jacobian's eigenvalues at each switch into contact
+/// (plant_stepping.cpp) or, where that cannot be evaluated, the bound
+/// StiffRates::ringing.
 constexpr double kRk4StiffFraction = 0.1;
 constexpr double kRosenbrockRingFraction = 0.05;
 
