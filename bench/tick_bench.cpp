@@ -137,6 +137,100 @@ Result measure(const pkm::Model& model, const pkm::SolverSettings& st, Inputs ki
                       reference);
 }
 
+/// Issue 28's stiff cases: F = 0 from the home pose, 1 ms steps for 0.2 s
+/// (the platform reaches the stops at 95 ms). Per solver: the median time
+/// per step, the steps answered OK and dz at the last step CVODE (BDF, rtol
+/// 1e-10) answered; ROS2's deviation from it and its cost as ratios.
+void stiff_cases(double rk4_tick_us) {
+  struct Stiff {
+    const char* name;
+    pkm::Params p;
+  };
+  std::vector<Stiff> cases;
+  pkm::Params p;
+  p.friction_viscous = 1000;
+  cases.push_back({"friction_viscous 1000", p});
+  p = {};
+  p.friction_coulomb = 5;
+  cases.push_back({"friction_coulomb 5", p});
+  p = {};
+  p.friction_coulomb = 10;
+  p.friction_velocity = 1e-6;
+  cases.push_back({"friction_coulomb 10, v_s 1e-6", p});
+  for (double m : {pkm::Params{}.m_slider, 1e-2, 1e-6}) {
+    p = {};
+    p.stop_damping = 1e6;
+    p.stop_stiffness = 1e9;
+    p.m_slider = m;
+    cases.push_back({m == pkm::Params{}.m_slider ? "stops 1e9/1e6" : (m == 1e-2 ? "stops, m_slider 1e-2"
+                                                                                 : "stops, m_slider 1e-6"),
+                     p});
+  }
+  constexpr int kStiffSteps = 200;
+  struct Outcome {
+    int ok = 0;
+    double us = 0;
+    std::vector<double> dz;
+  };
+  auto run = [](const pkm::Model& m, pkm::Solver solver) {
+    Outcome o;
+    pkm::SolverSettings st;
+    st.solver = solver;
+    st.rk4_step = kH;
+    if (solver == pkm::Solver::Cvode) {
+      st.cvode_method = pkm::CvodeMethod::BDF;
+      st.rtol = 1e-10;
+      st.atol = 1e-12;
+    }
+    std::vector<double> times;
+    for (int i = 0; i < kRuns; ++i) {
+      pkm::Plant plant(m);
+      if (plant.set_solver(st) != Status::Ok || plant.initialize(0.0, Pose(0, 0, 0.05, 0), Pose::Zero()) != Status::Ok)
+        return o;  // refused at initialisation
+      o.dz.clear();
+      int k = 0;
+      const auto t0 = Clock::now();
+      for (; k < kStiffSteps; ++k) {
+        if (plant.advance((k + 1) * kH, pkm::InputSignal{}) != Status::Ok) break;
+        o.dz.push_back(plant.state()[6]);
+      }
+      times.push_back(std::chrono::duration<double>(Clock::now() - t0).count() / std::max(k + 1, 1));
+      o.ok = k;
+    }
+    std::sort(times.begin(), times.end());
+    o.us = 1e6 * times[times.size() / 2];
+    return o;
+  };
+  std::printf("\nissue 28's stiff cases: F = 0 from the home pose, 1 ms steps, %d steps; CVODE BDF rtol 1e-10 is the "
+              "reference\n(targets: ROS2 within 1 %% of CVODE, at most 3x an RK4 tick)\n",
+              kStiffSteps);
+  std::printf("%-30s %14s %14s %14s %10s %10s %10s %12s\n", "case", "CVODE us/ok", "RK4 us/ok", "ROS2 us/ok",
+              "ROS2/RK4", "/RK4 tick", "ROS2/CVODE", "ROS2 |ddz|");
+  for (const Stiff& c : cases) {
+    pkm::Model m;
+    if (pkm::make_model(c.p, m) != Status::Ok) continue;
+    const Outcome cv = run(m, pkm::Solver::Cvode), r4 = run(m, pkm::Solver::Rk4),
+                  rb = run(m, pkm::Solver::Rosenbrock);
+    const int n = std::min(cv.ok, rb.ok);
+    double dev = 0, scale = 0;
+    for (int k = 0; k < n; ++k) {
+      dev = std::max(dev, std::fabs(rb.dz[k] - cv.dz[k]));
+      scale = std::max(scale, std::fabs(cv.dz[k]));
+    }
+    char a[32], b[32], d[32];
+    std::snprintf(a, sizeof a, "%.2f/%d", cv.us, cv.ok);
+    std::snprintf(b, sizeof b, "%.2f/%d", r4.us, r4.ok);
+    std::snprintf(d, sizeof d, "%.2f/%d", rb.us, rb.ok);
+    std::printf("%-30s %14s %14s %14s %10.2f %10.2f %10.2f %11.2g%%\n", c.name, a, b, d, r4.ok ? rb.us / r4.us : 0.0,
+                rb.us / rk4_tick_us, rb.us / cv.us, scale > 0 ? 100 * dev / scale : 0.0);
+  }
+  std::printf("us/ok: median microseconds per step (the failing step included) / steps answered OK; /RK4 tick: ROS2\n"
+              "against the held-input RK4 tick above (%.3f us, the default machine). RK4 refuses\n"
+              "the stuck-friction case at initialisation (0 steps) and runs out of its work budget at the stiff\n"
+              "stops' impact; CVODE fails there too (error test at hmin); ROS2's deviation covers the steps CVODE\n"
+              "answered.\n", rk4_tick_us);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -160,6 +254,8 @@ int main(int argc, char** argv) {
   pkm::SolverSettings rk4;
   rk4.solver = pkm::Solver::Rk4;
   rk4.rk4_step = kH;
+  pkm::SolverSettings ros2 = rk4;
+  ros2.solver = pkm::Solver::Rosenbrock;
 
   if (!ticks) {
   std::printf("pkm_tick_bench: 1-ms communication steps of the core's Plant, 1 s from the home pose\n");
@@ -170,6 +266,7 @@ int main(int argc, char** argv) {
               "max|dxyz| m");
   }
   int failures = 0;
+  double rk4_us = 0;  // the last (held inputs) RK4 tick: the stiff cases' yardstick
   const Inputs kinds[] = {Inputs::Ramp, Inputs::Sampled, Inputs::Held};
   const char* knames[] = {"ramp", "sampled", "held"};
   for (int ki = 0; ki < 3; ++ki) {
@@ -183,7 +280,8 @@ int main(int argc, char** argv) {
       bool cont;
     } cases[] = {{"CVODE 1e-8, restart every step", &cvode, false},
                  {"CVODE 1e-8, continued across steps", &cvode, true},
-                 {"RK4, rk4_step 1 ms", &rk4, false}};
+                 {"RK4, rk4_step 1 ms", &rk4, false},
+                 {"Rosenbrock (ROS2), 1 ms", &ros2, false}};
     double restart_us = 0;
     for (const Case& c : cases) {
       const Result r = measure(model, *c.st, kind, c.cont, F_static, reference);
@@ -200,14 +298,17 @@ int main(int argc, char** argv) {
         continue;
       }
       if (c.st == &cvode && !c.cont) restart_us = r.median_us;
+      if (c.st == &rk4) rk4_us = r.median_us;
       std::printf("%-44s %9.3f %9.2f %9ld %9.2f %12.2e", name, r.median_us, r.rhs_mean, r.rhs_max,
                   r.cvode_steps_mean, r.max_dev);
       if (c.st == &cvode && c.cont) std::printf("   %.1fx faster than restarting", restart_us / r.median_us);
+      if (c.st == &ros2) std::printf("   %.2fx RK4 (target <= 3x)", r.median_us / rk4_us);
       std::printf("\n");
     }
   }
   if (ticks) return failures ? 1 : 0;
   std::printf("\nreference: CVODE rtol 1e-12, restarted every step, the same inputs. Continuing across the jumps of\n"
               "sampled or held inputs costs accuracy: the FMU continues only where the inputs continue (pkm4puu.cpp).\n");
+  stiff_cases(rk4_us);
   return failures ? 1 : 0;
 }

@@ -20,7 +20,8 @@ H = 1e-3
 T_SAVE, T_END = 1.0, 1.5
 OUT = (POSE + VEL + RHO + DRHO + THETA1 + THETA2
        + indexed_names("lambda", 12) + ["constraint_residual", "jacobian_condition"])
-SOLVERS = {"CVODE": {"solver": 0, "rtol": 1e-9}, "RK4": {"solver": 1, "rk4_step": 5e-4}}
+SOLVERS = {"CVODE": {"solver": 0, "rtol": 1e-9}, "RK4": {"solver": 1, "rk4_step": 5e-4},
+           "Rosenbrock": {"solver": 2, "rk4_step": 5e-4}}
 
 
 def forces(t):

@@ -19,7 +19,7 @@ import numpy as np
 from . import locate
 
 PKM_OK = 0
-PKM_SOLVER_CVODE, PKM_SOLVER_RK4 = 0, 1
+PKM_SOLVER_CVODE, PKM_SOLVER_RK4, PKM_SOLVER_ROSENBROCK = 0, 1, 2
 PKM_CVODE_ADAMS, PKM_CVODE_BDF = 0, 1
 PKM_FORM_AUGMENTED, PKM_FORM_NULLSPACE_QR, PKM_FORM_LEG_PARTITIONED = 0, 1, 2
 # pkm_forward_derivatives: the state (x, y, z, phi, dx, dy, dz, dphi) and the
@@ -106,6 +106,10 @@ def load(path=None):
     lib.pkm_last_error.restype = ct.c_char_p
     lib.pkm_set_solver.argtypes = [vp, P(SolverSettings)]
     lib.pkm_set_solver.restype = i
+    lib.pkm_set_step_checks.argtypes = [vp, ct.c_double, ct.c_double]
+    lib.pkm_set_step_checks.restype = i
+    lib.pkm_get_step_checks.argtypes = [vp, dp, dp]
+    lib.pkm_get_step_checks.restype = i
     lib.pkm_init_pose.argtypes = [vp, ct.c_double, dp, dp]
     lib.pkm_init_pose.restype = i
     lib.pkm_inverse_dynamics.argtypes = [vp, dp, dp, dp, dp, P(InverseResult)]
@@ -227,6 +231,17 @@ class Plant:
         for k, v in settings.items():
             setattr(s, k, v)
         self._check(self.lib.pkm_set_solver(self.handle, ct.byref(s)), "pkm_set_solver")
+
+    def set_step_checks(self, work_budget=1000.0, energy_tolerance=0.0):
+        """The fixed-step solvers' work budget (inner steps per grid step) and
+        the energy audit's run-time check (J, 0 = off): docs/solvers.md."""
+        self._check(self.lib.pkm_set_step_checks(self.handle, work_budget, energy_tolerance), "pkm_set_step_checks")
+
+    def step_checks(self):
+        """(work_budget, energy_tolerance)."""
+        b, e = ct.c_double(), ct.c_double()
+        self._check(self.lib.pkm_get_step_checks(self.handle, ct.byref(b), ct.byref(e)), "pkm_get_step_checks")
+        return b.value, e.value
 
     def init_pose(self, t0, pose, velocity=None):
         self._check(self.lib.pkm_init_pose(self.handle, t0, _d4(pose), _d4(velocity)), "pkm_init_pose")

@@ -306,7 +306,7 @@ const char* pkm_status_string(pkm_status s) { return pkm::status_name(static_cas
 
 pkm_status pkm_set_solver(pkm_model* m, const pkm_solver_settings* c) {
   if (!m || !c) return PKM_ERR_INVALID_ARGUMENT;
-  pkm::SolverSettings s;
+  pkm::SolverSettings s = m->plant.solver();  // the step checks kept
   s.solver = static_cast<pkm::Solver>(c->solver);
   s.rk4_step = c->rk4_step;
   s.rtol = c->rtol;
@@ -320,6 +320,26 @@ pkm_status pkm_set_solver(pkm_model* m, const pkm_solver_settings* c) {
     m->error = why;
     return PKM_ERR_INVALID_ARGUMENT;
   }
+  return PKM_OK;
+}
+
+pkm_status pkm_set_step_checks(pkm_model* m, double work_budget, double energy_tolerance) {
+  if (!m) return PKM_ERR_INVALID_ARGUMENT;
+  pkm::SolverSettings s = m->plant.solver();
+  s.work_budget = work_budget;
+  s.energy_tolerance = energy_tolerance;
+  std::string why;
+  if (m->plant.set_solver(s, &why) != Status::Ok) {
+    m->error = why;
+    return PKM_ERR_INVALID_ARGUMENT;
+  }
+  return PKM_OK;
+}
+
+pkm_status pkm_get_step_checks(const pkm_model* m, double* work_budget, double* energy_tolerance) {
+  if (!m || !work_budget || !energy_tolerance) return PKM_ERR_INVALID_ARGUMENT;
+  *work_budget = m->plant.solver().work_budget;
+  *energy_tolerance = m->plant.solver().energy_tolerance;
   return PKM_OK;
 }
 

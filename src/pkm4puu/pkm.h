@@ -58,7 +58,10 @@ typedef struct {
   double g;                       /**< m/s^2, along -z */
 } pkm_params;
 
-typedef enum { PKM_SOLVER_CVODE = 0, PKM_SOLVER_RK4 = 1 } pkm_solver_kind;
+/* RK4: fixed step, sub-stepped where friction or a held end stop is stiff;
+ * ROSENBROCK: fixed-step ROS2, linearly implicit with the analytic Jacobian,
+ * for stiff machines in real time (docs/solvers.md). */
+typedef enum { PKM_SOLVER_CVODE = 0, PKM_SOLVER_RK4 = 1, PKM_SOLVER_ROSENBROCK = 2 } pkm_solver_kind;
 typedef enum { PKM_CVODE_ADAMS = 0, PKM_CVODE_BDF = 1 } pkm_cvode_method;
 typedef enum {
   PKM_FORM_AUGMENTED = 0,      /**< Eq. 12 */
@@ -124,6 +127,16 @@ PKM_API const char* pkm_last_error(const pkm_model* m);
 PKM_API const char* pkm_status_string(pkm_status s);
 
 PKM_API pkm_status pkm_set_solver(pkm_model* m, const pkm_solver_settings* s);
+
+/** The fixed-step solvers' checks (docs/solvers.md), kept by pkm_set_solver:
+ * work_budget, the inner steps (grid steps, stiff sub-steps, bisection
+ * trials) allowed per grid step, summed over one pkm_advance* ([1, 1e6],
+ * default 1000; beyond, PKM_ERR_SOLVER and pkm_last_error says
+ * why); energy_tolerance (J, [0, 1e9], 0 = off, the default): an advance
+ * whose energy audit residual exceeds it is undone (PKM_ERR_SOLVER).
+ * PKM_ERR_INVALID_ARGUMENT (nothing changes) out of range. */
+PKM_API pkm_status pkm_set_step_checks(pkm_model* m, double work_budget, double energy_tolerance);
+PKM_API pkm_status pkm_get_step_checks(const pkm_model* m, double* work_budget, double* energy_tolerance);
 
 /** Consistent initial state at time t0 from pose[4] and velocity[4]
  * (velocity may be NULL: at rest). PKM_ERR_UNREACHABLE if a leg cannot

@@ -79,7 +79,7 @@ TEST(CApi, StaticForcesHoldTheHomePose) {
   pkm_inverse_result inv;
   ASSERT_EQ(pkm_inverse_dynamics(h.m, kHome, zero, zero, nullptr, &inv), PKM_OK);
   for (int i = 0; i < 4; ++i) EXPECT_NEAR(inv.F[i], 2.655616050, 1e-9);
-  for (int solver : {PKM_SOLVER_CVODE, PKM_SOLVER_RK4}) {
+  for (int solver : {PKM_SOLVER_CVODE, PKM_SOLVER_RK4, PKM_SOLVER_ROSENBROCK}) {
     pkm_solver_settings s;
     pkm_default_solver_settings(&s);
     s.solver = solver;
@@ -98,25 +98,55 @@ TEST(CApi, StaticForcesHoldTheHomePose) {
 }
 
 TEST(CApi, SavedStateRestoresABitIdenticalContinuation) {
+  for (int solver : {PKM_SOLVER_RK4, PKM_SOLVER_ROSENBROCK}) {
+    Handle h;
+    pkm_solver_settings s;
+    pkm_default_solver_settings(&s);
+    s.solver = solver;
+    ASSERT_EQ(pkm_set_solver(h.m, &s), PKM_OK);
+    const double v0[4] = {0.01, 0.0, 0.0, 0.05};
+    ASSERT_EQ(pkm_init_pose(h.m, 0.0, kHome, v0), PKM_OK);
+    const double F[4] = {2.7, 2.6, 2.65, 2.66};
+    ASSERT_EQ(pkm_advance(h.m, 0.2, F, nullptr), PKM_OK);
+    double t, y[8], th[4];
+    ASSERT_EQ(pkm_get_state(h.m, &t, y, th), PKM_OK);
+    ASSERT_EQ(pkm_advance(h.m, 0.4, F, nullptr), PKM_OK);
+    pkm_outputs a, b;
+    ASSERT_EQ(pkm_get_outputs(h.m, F, nullptr, &a), PKM_OK);
+    ASSERT_EQ(pkm_set_state(h.m, t, y, th), PKM_OK);
+    ASSERT_EQ(pkm_advance(h.m, 0.4, F, nullptr), PKM_OK);
+    ASSERT_EQ(pkm_get_outputs(h.m, F, nullptr, &b), PKM_OK);
+    EXPECT_EQ(std::memcmp(&a, &b, sizeof a), 0) << "solver " << solver;
+    EXPECT_NE(a.pose[0], kHome[0]);  // it did move
+  }
+}
+
+TEST(CApi, StepChecksAreSetCheckedAndKeptBySetSolver) {
   Handle h;
+  double budget = 0, tolerance = -1;
+  ASSERT_EQ(pkm_get_step_checks(h.m, &budget, &tolerance), PKM_OK);
+  EXPECT_EQ(budget, 1000.0);
+  EXPECT_EQ(tolerance, 0.0);
+  EXPECT_EQ(pkm_set_step_checks(h.m, 0.5, 0.0), PKM_ERR_INVALID_ARGUMENT);  // below 1 inner step
+  EXPECT_NE(std::string(pkm_last_error(h.m)).find("work_budget"), std::string::npos);
+  EXPECT_EQ(pkm_set_step_checks(h.m, 10.0, -1.0), PKM_ERR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(pkm_last_error(h.m)).find("energy_tolerance"), std::string::npos);
+  ASSERT_EQ(pkm_set_step_checks(h.m, 10.0, 1e-3), PKM_OK);
   pkm_solver_settings s;
   pkm_default_solver_settings(&s);
   s.solver = PKM_SOLVER_RK4;
   ASSERT_EQ(pkm_set_solver(h.m, &s), PKM_OK);
-  const double v0[4] = {0.01, 0.0, 0.0, 0.05};
-  ASSERT_EQ(pkm_init_pose(h.m, 0.0, kHome, v0), PKM_OK);
-  const double F[4] = {2.7, 2.6, 2.65, 2.66};
-  ASSERT_EQ(pkm_advance(h.m, 0.2, F, nullptr), PKM_OK);
-  double t, y[8], th[4];
-  ASSERT_EQ(pkm_get_state(h.m, &t, y, th), PKM_OK);
-  ASSERT_EQ(pkm_advance(h.m, 0.4, F, nullptr), PKM_OK);
-  pkm_outputs a, b;
-  ASSERT_EQ(pkm_get_outputs(h.m, F, nullptr, &a), PKM_OK);
-  ASSERT_EQ(pkm_set_state(h.m, t, y, th), PKM_OK);
-  ASSERT_EQ(pkm_advance(h.m, 0.4, F, nullptr), PKM_OK);
-  ASSERT_EQ(pkm_get_outputs(h.m, F, nullptr, &b), PKM_OK);
-  EXPECT_EQ(std::memcmp(&a, &b, sizeof a), 0);
-  EXPECT_NE(a.pose[0], kHome[0]);  // it did move
+  ASSERT_EQ(pkm_get_step_checks(h.m, &budget, &tolerance), PKM_OK);
+  EXPECT_EQ(budget, 10.0);
+  EXPECT_EQ(tolerance, 1e-3);
+  // F = 0 from the home pose: the fall reaches the stops at 95 ms, whose
+  // located contact (about 30 bisection trials) does not fit 10 inner steps.
+  ASSERT_EQ(pkm_init_pose(h.m, 0.0, kHome, nullptr), PKM_OK);
+  const double zero[4] = {0, 0, 0, 0};
+  pkm_status st = PKM_OK;
+  for (int k = 1; k <= 200 && st == PKM_OK; ++k) st = pkm_advance(h.m, k * 1e-3, zero, nullptr);
+  EXPECT_EQ(st, PKM_ERR_SOLVER);
+  EXPECT_NE(std::string(pkm_last_error(h.m)).find("work budget"), std::string::npos) << pkm_last_error(h.m);
 }
 
 TEST(CApi, CallbackInputsMatchConstantInputs) {

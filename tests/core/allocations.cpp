@@ -98,9 +98,12 @@ TEST_F(AllocationsTest, AnalyticDerivatives) {
   EXPECT_EQ(alloc_count() - before, 0);
 }
 
-TEST_F(AllocationsTest, Rk4AdvanceAfterInitialisation) {
+class FixedStepAllocations : public AllocationsTest, public ::testing::WithParamInterface<pkm::Solver> {};
+
+// RK4 and ROS2 (its Jacobian and the 8x8 LU are fixed-size).
+TEST_P(FixedStepAllocations, AdvanceAfterInitialisation) {
   pkm::SolverSettings rk4;
-  rk4.solver = pkm::Solver::Rk4;
+  rk4.solver = GetParam();
   rk4.rk4_step = 1e-3;
   pkm::PathForces forces;
   forces.model = &model;
@@ -117,5 +120,24 @@ TEST_F(AllocationsTest, Rk4AdvanceAfterInitialisation) {
   EXPECT_EQ(alloc_count() - before, 0);
   EXPECT_EQ(s, Status::Ok);
 }
+
+// The drop onto the stops (F = 0 from the home pose, contact at 95 ms):
+// located switches, RK4's contact sub-steps, ROS2's graded steps and its
+// ringing from the Jacobian's eigenvalues (fixed-size EigenSolver).
+TEST_P(FixedStepAllocations, DropOntoTheStops) {
+  pkm::SolverSettings st;
+  st.solver = GetParam();
+  pkm::Plant plant(model);
+  ASSERT_EQ(plant.set_solver(st), Status::Ok);
+  ASSERT_EQ(plant.initialize(0.0, Pose(0, 0, 0.05, 0), Pose::Zero()), Status::Ok);
+  Status s = Status::Ok;
+  const long before = alloc_count();
+  for (long k = 1; k <= 150 && s == Status::Ok; ++k) s = plant.advance(static_cast<double>(k) * 1e-3, pkm::InputSignal{});
+  EXPECT_EQ(alloc_count() - before, 0);
+  EXPECT_EQ(s, Status::Ok);
+  EXPECT_GT(plant.contact_events(), 0) << "the stops were reached";
+}
+
+INSTANTIATE_TEST_SUITE_P(Solvers, FixedStepAllocations, ::testing::Values(pkm::Solver::Rk4, pkm::Solver::Rosenbrock));
 
 }  // namespace

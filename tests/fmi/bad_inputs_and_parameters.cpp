@@ -141,8 +141,9 @@ TEST(HardeningParameters, NonFiniteParametersAreRejectedBeforeInitialisation) {
     ++n;
   }
   // 21 of the mechanism, 8 of the initial state, rk4_step, rtol, atol, the
-  // two guards, 11 of the machine (MODEL_SPEC) and the stops' stiffness and damping.
-  EXPECT_EQ(n, 47);
+  // two guards, 11 of the machine (MODEL_SPEC), the stops' stiffness and
+  // damping, work_budget and energy_tolerance.
+  EXPECT_EQ(n, 49);
   table_row("fmi2SetReal of any Real parameter (all " + std::to_string(n) + " of the plant) to NaN, +Inf, -Inf",
             "fmi2Error, \"<name> = nan is not finite; value rejected\"",
             "yes: start value kept, initialisation succeeds");
@@ -181,8 +182,8 @@ TEST(HardeningParameters, OutOfRangeParametersFailInitialisationAndResetRecovers
       {"max_jacobian_condition", -5.0, "max_jacobian_condition = -5 must be greater than 1"},
       {"min_leg_measure", -0.25, "min_leg_measure = -0.25 must lie in [0, 0.5)"},
       {"min_leg_measure", 0.5, "min_leg_measure = 0.5 must lie in [0, 0.5)"},
-      {"solver", 2, "solver = 2 must be 0 (CVODE) or 1 (RK4)", true},
-      {"solver", -1, "solver = -1 must be 0 (CVODE) or 1 (RK4)", true},
+      {"solver", 3, "solver = 3 must be 0 (CVODE), 1 (RK4) or 2 (Rosenbrock)", true},
+      {"solver", -1, "solver = -1 must be 0 (CVODE), 1 (RK4) or 2 (Rosenbrock)", true},
       {"cvode_method", 7, "cvode_method = 7 must be 0 (Adams) or 1 (BDF)", true},
       {"formulation", 3, "formulation = 3 must be 0", true},
       {"formulation", -2, "formulation = -2 must be 0", true},
@@ -197,9 +198,11 @@ TEST(HardeningParameters, OutOfRangeParametersFailInitialisationAndResetRecovers
       {"dx0", 1e200, "dx0"},
       {"dphi0", -1e5, "dphi0"},
       {"stop_stiffness", 1e12, "stop_stiffness"},
+      {"work_budget", 0.5, "work_budget"},
+      {"energy_tolerance", -1.0, "energy_tolerance"},
   };
   cases.insert(cases.end(), std::begin(others), std::end(others));
-  ASSERT_EQ(cases.size(), 47u);
+  ASSERT_EQ(cases.size(), 49u);
   int refused_when_set = 0;
   for (const BadParameter& c : cases) {
     SCOPED_TRACE(std::string(c.name) + " = " + text(c.value));

@@ -352,7 +352,7 @@ TEST_F(Stepping, TooManyRk4StepsAreRefusedBeforeAnyWork) {
   ASSERT_EQ(twin.step(0.0, 1e-3), fmi2OK);
   EXPECT_TRUE(bit_identical(p.outputs(), twin.outputs()));
   table_row("RK4 with rk4_step = 1e-6 s (the smallest its range allows), then fmi2DoStep(h = 20 s): 2e7 RK4 steps",
-            "fmi2Error at once, \"a communication step of 20 s needs 2e+07 RK4 steps of rk4_step = 1e-06 s, more "
+            "fmi2Error at once, \"a communication step of 20 s needs 2e+07 fixed steps of rk4_step = 1e-06 s, more "
             "than the work budget of 1e+07 per step ...; the call has no effect\"",
             "yes: every variable bit-identical; the next step bit-identical to an untouched twin's");
 }

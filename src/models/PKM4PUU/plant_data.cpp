@@ -51,6 +51,8 @@ Status PlantData::configuration(Context& ctx, const char* function, pkm::Model& 
   s.formulation = static_cast<pkm::Formulation>(formulation);
   s.max_jacobian_condition = limits.max_jacobian_condition;
   s.min_leg_measure = limits.min_leg_measure;
+  s.work_budget = work_budget;
+  s.energy_tolerance = energy_tolerance;
   const std::string invalid = pkm::validate(s);
   if (!invalid.empty()) {
     ctx.log.error("%s: parameter %s", function, invalid.c_str());
@@ -190,11 +192,11 @@ Status PlantData::check_step(Context& ctx, double h) const {
                   h, pkm::kMinCvodeSpan);
     return Status::Error;
   }
-  if (!plant || plant->solver().solver != pkm::Solver::Rk4) return Status::OK;
+  if (!plant || !pkm::fixed_step(plant->solver().solver)) return Status::OK;
   const double step = plant->solver().rk4_step;
   const double steps = pkm::rk4_steps_for(h, step);
   if (steps <= pkm::kMaxRk4StepsPerAdvance) return Status::OK;
-  ctx.log.error("DoStep: a communication step of %.6g s needs %.3g RK4 steps of rk4_step = %.6g s, more than the "
+  ctx.log.error("DoStep: a communication step of %.6g s needs %.3g fixed steps of rk4_step = %.6g s, more than the "
                 "work budget of %.0e per step: use shorter communication steps or a larger rk4_step; the call has "
                 "no effect",
                 h, steps, step, pkm::kMaxRk4StepsPerAdvance);
@@ -219,6 +221,8 @@ Status PlantData::update_outputs(Context& ctx, unsigned groups) {
       pose[i] = y[i];
       vel[i] = dy[i] = y[4 + i];
     }
+  }
+  if (groups & kGroupEnergy) {
     energy[0] = plant->energy_integrals().actuator_work;
     energy[1] = plant->energy_integrals().dissipated;
   }

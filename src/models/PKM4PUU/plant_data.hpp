@@ -76,12 +76,13 @@ constexpr double kInputJump = 1e-12;
 // The output groups (Variable::group): a get computes only the groups it
 // reads, each once until the state, time or inputs change.
 enum : std::uint8_t {
-  kGroupState = 1u << 0,     // pose, velocity, energy integrals, der(pose): copies of the state
+  kGroupState = 1u << 0,     // pose, velocity, der(pose): copies of the state
   kGroupJoints = 1u << 1,    // drho, theta1, theta2: the legs in closed form
   kGroupDynamics = 1u << 2,  // accelerations and multipliers: the full forward dynamics
   kGroupMachine = 1u << 3,   // end stops, holding forces, energies and their rates
   kGroupHealth = 1u << 4,    // loop-closure residual, Jacobian condition, guard indicators
   kGroupSliders = 1u << 5,   // rho: the closed form without angles (what a joint-space controller reads)
+  kGroupEnergy = 1u << 6,    // the energy integrals (Rosenbrock: the dissipated energy's balance, computed on read)
 };
 
 struct PlantData final : MechanismData {
@@ -94,6 +95,8 @@ struct PlantData final : MechanismData {
   double atol = kDefaultSolver.atol;
   std::int32_t cvode_method = static_cast<std::int32_t>(kDefaultSolver.cvode_method);
   std::int32_t formulation = static_cast<std::int32_t>(kDefaultSolver.formulation);
+  double work_budget = kDefaultSolver.work_budget;
+  double energy_tolerance = kDefaultSolver.energy_tolerance;
   // Inputs u = [F1..F4, Fe1..Fe3, Me_z, tau1..tau4] at the current time, and du/dt.
   double u[kInputs] = {kHoldingForce, kHoldingForce, kHoldingForce, kHoldingForce};
   double du[kInputs] = {};

@@ -60,8 +60,8 @@ constexpr Variable kVariables[] = {
   state_output(15, "dy", "m/s", "Velocity of P, y component", PLANT(vel), 1, 5, kOnRates, kNominalSpeed, kGroupState),
   state_output(16, "dz", "m/s", "Velocity of P, z component", PLANT(vel), 2, 6, kOnHeightRate, kNominalSpeed, kGroupState),
   state_output(17, "dphi", "rad/s", "Platform angular velocity about z", PLANT(vel), 3, 7, kOnRates, kNominalAngularSpeed, kGroupState),
-  state_output(18, "actuator_work", "J", "Work done on the machine since the start: integral of (F_i + (2 pi/screw_lead) tau_i) drho_i plus the external wrench's power", PLANT(energy), 0, 8, kOnEnergy, kNominalEnergy, kGroupState),
-  state_output(19, "dissipated_energy", "J", "Energy dissipated since the start by joint friction and the end stops' damping", PLANT(energy), 1, 9, kOnEnergy, kNominalEnergy, kGroupState),
+  state_output(18, "actuator_work", "J", "Work done on the machine since the start: integral of (F_i + (2 pi/screw_lead) tau_i) drho_i plus the external wrench's power", PLANT(energy), 0, 8, kOnEnergy, kNominalEnergy, kGroupEnergy),
+  state_output(19, "dissipated_energy", "J", "Energy dissipated since the start by joint friction and the end stops' damping", PLANT(energy), 1, 9, kOnEnergy, kNominalEnergy, kGroupEnergy),
   real_output(20, "rho[1]", "m", "Actuated prismatic joint of leg 1 (slider position)", PLANT(rho), 0, kSliders, kGroupSliders),
   real_output(21, "rho[2]", "m", "Actuated prismatic joint of leg 2 (slider position)", PLANT(rho), 1, kSliders, kGroupSliders),
   real_output(22, "rho[3]", "m", "Actuated prismatic joint of leg 3 (slider position)", PLANT(rho), 2, kSliders, kGroupSliders),
@@ -155,10 +155,12 @@ constexpr Variable kVariables[] = {
   initial_state_parameter(136, "dz0", 0.0, "m/s", "Initial velocity of P, z component", PLANT(vel0), 2, -pkm::kMaxSpeed, pkm::kMaxSpeed, 6),
   initial_state_parameter(137, "dphi0", 0.0, "rad/s", "Initial platform angular velocity about z", PLANT(vel0), 3, -pkm::kMaxSpeed / pkm::kConditionLength, pkm::kMaxSpeed / pkm::kConditionLength, 7),
   integer_parameter(140, "solver", static_cast<int>(kDefaultSolver.solver),
-                    "Co-Simulation integrator: 0 = CVODE (variable step, rtol and atol), 1 = fixed-step RK4 (rk4_step), as in the paper",
-                    PLANT_SCALAR(solver), 0, 1),
+                    "Co-Simulation integrator: 0 = CVODE (variable step, rtol and atol), 1 = fixed-step RK4 (rk4_step), as in "
+                    "the paper, sub-stepped where friction or a held end stop is stiff, 2 = fixed-step Rosenbrock (ROS2, "
+                    "linearly implicit with the analytic Jacobian: stiff friction and end stops in real time)",
+                    PLANT_SCALAR(solver), 0, 2),
   real_parameter(141, "rk4_step", kDefaultSolver.rk4_step, "s",
-                 "RK4 step: a communication step is split into whole steps no longer than this", PLANT_SCALAR(rk4_step), 0,
+                 "Fixed step of RK4 and Rosenbrock: a communication step is split into whole steps no longer than this", PLANT_SCALAR(rk4_step), 0,
                  pkm::kMinRk4Step, pkm::kMaxRk4Step),
   real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance", PLANT_SCALAR(rtol), 0, pkm::kMinRtol, pkm::kMaxRtol),
   real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)", PLANT_SCALAR(atol), 0, pkm::kMinAtol, pkm::kMaxAtol),
@@ -175,6 +177,14 @@ constexpr Variable kVariables[] = {
   mechanism_parameter(149, "stop_damping", "N.s/m", "Damping d of the end stops",
                  PKM_FMI_PARAM(stop_damping), 0),
   PKM_FMI_MACHINE_PARAMETERS,
+  real_parameter(161, "work_budget", kDefaultSolver.work_budget, "",
+                 "Fixed-step solvers: inner steps (grid steps, stiff sub-steps, bisection trials locating end-stop "
+                 "events) allowed per grid step, summed over a communication step; a step that needs more returns "
+                 "Discard with the reason", PLANT_SCALAR(work_budget), 0, pkm::kMinWorkBudget, pkm::kMaxWorkBudget),
+  real_parameter(162, "energy_tolerance", kDefaultSolver.energy_tolerance, "J",
+                 "Energy audit as a run-time check: a communication step whose audit residual (change of "
+                 "kinetic + potential - actuator_work + dissipated_energy) exceeds this returns Discard with the "
+                 "figures; 0 = off", PLANT_SCALAR(energy_tolerance), 0, 0.0, pkm::kMaxEnergyTolerance),
 };
 // clang-format on
 

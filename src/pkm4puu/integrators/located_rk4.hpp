@@ -1,93 +1,22 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// One fixed RK4 grid step across the end stops' switches: split where the
-// contact mode changes (located by bisection) and, while a contact is on,
-// substepped so that RK4 resolves the stop's spring.
+// One fixed RK4 grid step across the end stops' switches (located_step.hpp):
+// split where the contact mode changes and sub-stepped where the friction or
+// a held stop is stiff, so that RK4 resolves them.
 #pragma once
 
-#include <cmath>
-#include <limits>
-
+#include "pkm4puu/integrators/located_step.hpp"
 #include "pkm4puu/integrators/rk4.hpp"
-#include "pkm4puu/machine/end_stops.hpp"
 
 namespace pkm {
 
-/// At most this many located switches per grid step (beyond, the step goes
-/// on without locating: a chattering contact).
-constexpr int kMaxSwitchesPerStep = 64;
-
-/// The bisection's resolution in time near t (s).
-inline double switch_time_tolerance(double t) {
-  return 1e-12 + 8.0 * std::numeric_limits<double>::epsilon() * std::fabs(t);
-}
-
-/// The step from (t0, x) to t1. `sys` provides
-///   Status rates(double t, const Vec10& x, Vec10& xdot)  under the held stops,
-///   void hold(unsigned stops)                           the stops held from now on,
-///   unsigned mode(const Vec10& x, Vec4& rho)            the contact mode at x (end_stops.hpp's
-///                                                       bits, the clamps' included; ~0u off the
-///                                                       workspace) and the actuator positions.
-/// `mode` and `rho` hold the contact mode and actuator positions at x on
-/// entry and at the end on return (`rho_valid` false where unknown);
-/// `switches` counts the located switches. `t` returns where the step got to
-/// (t1 on success). On return the stops of the final mode are held (the
-/// plant's contact mode from there on).
+/// located_fixed_step with RK4; `sys` also provides
+///   Status rates(double t, const Vec10& x, Vec10& xdot)  under the held stops.
 template <class System>
-Status located_rk4_step(System& sys, double t0, double t1, double h_contact, Vec10& x, unsigned& mode, Vec4& rho,
-                        bool& rho_valid, long& switches, double& t) {
+Status located_rk4_step(System& sys, double t0, double t1, InnerSteps& inner, Vec10& x, unsigned& mode,
+                        Vec4& rho, bool& rho_valid, long& switches, double& t, WorkBudget& budget) {
   auto f = [&sys](double tt, const Vec10& xx, Vec10& xdot) { return sys.rates(tt, xx, xdot); };
-  t = t0;
-  int located = 0;
-  Status s = Status::Ok;
-  while (t < t1 && s == Status::Ok) {
-    double step = t1 - t;
-    bool to_end = true;
-    if (mode != 0 && step > h_contact) {
-      step = h_contact;
-      to_end = false;
-    }
-    sys.hold(mode & kContactModeBits);  // over the step and its re-steps
-    Vec10 trial = x;
-    s = rk4_step(f, t, step, trial);
-    if (s != Status::Ok) break;
-    Vec4 rho_trial;
-    unsigned trial_mode = sys.mode(trial, rho_trial);
-    bool rho_trial_valid = trial_mode != ~0u;
-    if (trial_mode == ~0u) trial_mode = mode;  // off the workspace: the caller's guard reports it
-    if (trial_mode != mode && located < kMaxSwitchesPerStep) {
-      // The shortest step, re-stepped from t, after which the mode has changed.
-      double lo = 0.0, hi = step;
-      const double tol = switch_time_tolerance(t);
-      while (hi - lo > tol && s == Status::Ok) {
-        const double mid = 0.5 * (lo + hi);
-        Vec10 xm = x;
-        s = rk4_step(f, t, mid, xm);
-        Vec4 rho_m;
-        const unsigned mm = sys.mode(xm, rho_m);
-        if (mm == mode || mm == ~0u) {
-          lo = mid;
-        } else {
-          hi = mid;
-          trial = xm;
-          trial_mode = mm;
-          rho_trial = rho_m;
-          rho_trial_valid = true;
-        }
-      }
-      if (s != Status::Ok) break;
-      if (hi < step) to_end = false;
-      step = hi;
-      ++located;
-      ++switches;
-    }
-    x = trial;
-    mode = trial_mode;
-    rho = rho_trial;
-    rho_valid = rho_trial_valid;
-    t = to_end ? t1 : t + step;
-  }
-  sys.hold(mode & kContactModeBits);
-  return s;
+  auto step = [&f](double tt, double h, Vec10& xx) { return rk4_step(f, tt, h, xx); };
+  return located_fixed_step(sys, step, t0, t1, inner, x, mode, rho, rho_valid, switches, t, budget);
 }
 
 }  // namespace pkm

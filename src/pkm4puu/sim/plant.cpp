@@ -11,6 +11,7 @@
 #include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/kinematics/servo_kinematics.hpp"
 #include "pkm4puu/machine/passive_force.hpp"
+#include "pkm4puu/sim/fixed_step_stability.hpp"
 
 namespace pkm {
 
@@ -20,6 +21,11 @@ Status Plant::set_solver(const SolverSettings& s, std::string* error) {
   const std::string why = validate(s);
   if (!why.empty()) {
     if (error) *error = why;
+    return Status::InvalidArgument;
+  }
+  const std::string unstable = fixed_step_refusal(model_, s);
+  if (!unstable.empty()) {
+    if (error) *error = unstable;
     return Status::InvalidArgument;
   }
   settings_ = s;
@@ -67,9 +73,12 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
   stops_ = stops_after_event(model_.p, rho, rhod, 0u);
   t_ = t0;
   energy_ = EnergyIntegrals{};
+  balance_pending_ = false;
   for (int i = 0; i < kLegs; ++i) theta1_.ref[i] = q[leg_offset(i) + 1];
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
+  layer_pending_ = true;
+  contact_step_ = -1.0;
   initialized_ = true;
   return Status::Ok;
 }
@@ -79,6 +88,7 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
 }
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned stops) {
+  settle_energy();  // the integrals keep their values: at the state they belong to
   const unsigned legs_held = (stops | (stops >> kLegs)) & ((1u << kLegs) - 1u);
   if (stops != ~0u && ((stops & ~kContactModeBits) != 0u || (stops & (stops >> kLegs) & ((1u << kLegs) - 1u)) != 0u ||
                        ((stops >> (2 * kLegs)) & ~legs_held) != 0u)) {
@@ -126,6 +136,9 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned 
   theta1_.ref = theta1_ref;
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
+  layer_pending_ = false;  // a restored run goes on as it would have (no new transient)
+  layer_ = std::numeric_limits<double>::infinity();
+  contact_step_ = -1.0;
   initialized_ = true;
   return Status::Ok;
 }
@@ -133,6 +146,7 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned 
 Status Plant::set_state(const Vec8& y) {
   if (!initialized_) return Status::NotInitialized;
   if (!y.allFinite()) return Status::NonFinite;
+  settle_energy();
   GuardReport report;
   GuardLimits none;
   none.max_jacobian_condition = std::numeric_limits<double>::infinity();
@@ -175,6 +189,7 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const Ene
 
 Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e, unsigned stops) {
   if (!std::isfinite(e.actuator_work) || !std::isfinite(e.dissipated)) return Status::NonFinite;
+  settle_energy();
   const EnergyIntegrals keep = energy_;
   energy_ = e;
   const Status s = restore(t, y, theta1_ref, stops);
@@ -201,7 +216,16 @@ Status Plant::contact_indicators(double z[kContactIndicators]) const {
   return s;
 }
 
-Vec10 Plant::packed() const {
+void Plant::settle_energy() const {
+  if (!balance_pending_) return;
+  double e = 0.0;
+  if (mechanical_energy(y_, e) != Status::Ok) return;  // y_ is always assembled: not reached
+  energy_.dissipated = balance_dissipated_ + (energy_.actuator_work - balance_work_) - (e - balance_mech_);
+  balance_pending_ = false;
+}
+
+Vec10 Plant::packed(bool settle) const {
+  if (settle) settle_energy();
   Vec10 x;
   x.head<8>() = y_;
   x[8] = energy_.actuator_work;

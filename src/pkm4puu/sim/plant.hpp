@@ -110,7 +110,10 @@ class Plant {
   Status contact_indicators(double z[kContactIndicators]) const;
 
   /// The running energy integrals (zero at initialize()).
-  const EnergyIntegrals& energy_integrals() const { return energy_; }
+  const EnergyIntegrals& energy_integrals() const {
+    settle_energy();
+    return energy_;
+  }
 
   /// stop_force, F_hold, energies and the stop indicators at the current
   /// time, for the inputs at that time.
@@ -130,7 +133,10 @@ class Plant {
   /// (guard_indicators) locate their crossing.
   Status set_state(const Vec8& y);
   /// Sets the running energy integrals (the importer integrates them too).
-  void set_energy_integrals(const EnergyIntegrals& e) { energy_ = e; }
+  void set_energy_integrals(const EnergyIntegrals& e) {
+    energy_ = e;
+    balance_pending_ = false;
+  }
   /// d/dt of [y; actuator_work; dissipated] at the current time and state
   /// for the given inputs, under the contact mode stops().
   Status derivative_now(const InputSignal& inputs, Vec10& xdot) const;
@@ -175,7 +181,10 @@ class Plant {
                        bool* inputs_fault = nullptr) const;
   /// rho and rhod at the state y (closed form).
   Status joint_motion(const Vec8& y, Vec4& rho, Vec4& rhod) const;
-  Vec10 packed() const;
+  /// [y; energy integrals] (`settle`: the dissipated energy brought up to date first).
+  Vec10 packed(bool settle = true) const;
+  /// Brings energy_.dissipated to the balance if ROS2 left it pending.
+  void settle_energy() const;
   void unpack(const Vec10& x);
   /// The contact mode at x (located_rk4.hpp): the event rule
   /// (stops_after_event) from the held mode (stops_) at x, the clamps
@@ -187,7 +196,16 @@ class Plant {
   /// Creates CVODE's objects (once, when it is the solver), so that no step
   /// allocates: at initialize() and restore().
   Status prepare_cvode();
-  Status advance_rk4(double t_end);
+  /// RK4 or ROS2 (settings_.solver) on whole grid steps of at most rk4_step.
+  Status advance_fixed(double t_end);
+  /// Kinetic plus potential energy at y (J).
+  Status mechanical_energy(const Vec8& y, double& e) const;
+  /// ROS2's dissipated energy over the grid step to x: the balance of the
+  /// work and of the mechanical energy (e_mech at its start, updated);
+  /// with energy_tolerance, a step that gains more energy than that fails.
+  Status rosenbrock_dissipation(Vec10& x, double& e_mech, double t0, double t1);
+  /// kinetic + potential - actuator_work + dissipated at the current state (J).
+  Status energy_audit(double& value) const;
   Status advance_cvode(double t_end, bool continuous);
   /// check_configuration of y's pose against the settings' limits; on
   /// failure error_ describes it.
@@ -203,7 +221,12 @@ class Plant {
   bool initialized_ = false;
   double t_ = 0;
   Vec8 y_ = Vec8::Zero();
-  EnergyIntegrals energy_;
+  mutable EnergyIntegrals energy_;
+  // ROS2's dissipated energy, the audit's balance, brought up to date when
+  // read (settle_energy): the mechanical energy costs a third of a ROS2 step.
+  // balance_* hold the energies where it was last exact.
+  mutable bool balance_pending_ = false;
+  double balance_mech_ = 0, balance_work_ = 0, balance_dissipated_ = 0;
   long contact_events_ = 0;
   unsigned stops_ = 0;  // the contact mode (stops()): never kStopsFromState
   // actuator_positions at y_, when rho_valid_ (every change of y_ clears it).
@@ -211,6 +234,13 @@ class Plant {
   mutable bool rho_valid_ = false;
   mutable Theta1References theta1_;
   mutable bool theta1_stale_ = false;
+  // ROS2's initial layer (located_step.hpp's InnerSteps::layer): pending
+  // after initialize(), else carried from the last advance (none after restore()).
+  bool layer_pending_ = true;
+  double layer_ = 0;
+  // ROS2's step in the current contact (PlantOde::contact_step); < 0: not
+  // known yet (after initialize() and restore(): computed at the next advance).
+  double contact_step_ = -1.0;
   long rhs_count_ = 0;
   Status rhs_status_ = Status::Ok;
   std::string error_;

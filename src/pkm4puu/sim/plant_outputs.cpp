@@ -56,6 +56,7 @@ Status Plant::machine_outputs(const InputSignal& inputs, MachineOutputs& out) co
   if (s != Status::Ok) return s;
   out.kinetic_energy = kinetic_energy(model_, q, qd);
   out.potential_energy = potential_energy(model_, q);
+  settle_energy();
   out.actuator_work = energy_.actuator_work;
   out.dissipated_energy = energy_.dissipated;
   energy_rates(p, stops_, F + model_.drive_ratio * tau, we, y_.tail<4>(), out.rho, out.rhod,

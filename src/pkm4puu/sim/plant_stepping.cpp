@@ -1,22 +1,81 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// The Plant's stepping: advance() with RK4 or CVODE across the end stops'
-// switches (integrators/located_*.hpp), each step checked by the guard.
+// The Plant's stepping: advance() with RK4, ROS2 or CVODE across the end
+// stops' switches (integrators/located_*.hpp), each step checked by the
+// guard, the fixed-step solvers within their work budget, and the energy
+// audit checked where energy_tolerance asks.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <limits>
+
+#include <Eigen/Eigenvalues>
 
 #include "pkm4puu/integrators/located_cvode.hpp"
 #include "pkm4puu/integrators/located_rk4.hpp"
+#include "pkm4puu/integrators/located_rosenbrock.hpp"
+#include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
 #include "pkm4puu/kinematics/actuator_positions.hpp"
+#include "pkm4puu/sim/fixed_step_stability.hpp"
 #include "pkm4puu/sim/plant.hpp"
 
 namespace pkm {
 
-/// What located_rk4_step integrates: the plant's derivative under the held
-/// stops, and its contact mode.
+/// What the fixed-step solvers integrate: the plant's derivative under the
+/// held stops, its Jacobian (ROS2), and its contact mode.
 struct PlantOde {
   Plant& plant;
+  double contact_fallback = 0;  // contact_step where the Jacobian cannot be evaluated
   Status rates(double t, const Vec10& x, Vec10& xdot) { return plant.derivative(t, x, xdot); }
+  /// The rates at (t, x) with the analytic Jacobian of the pose and velocity
+  /// rates (the leg-partitioned terms, the machine included; one evaluation
+  /// gives both) and their time derivative through the inputs,
+  /// B (u(t + h) - u(t)) / h (exact for the FMUs' linear inputs). The
+  /// dissipation rate is left 0: ROS2's dissipated energy is the audit's
+  /// balance (Plant::rosenbrock_dissipation).
+  Status jacobian(double t, const Vec10& x, double h, Vec10& xdot, Mat8& A, Vec8& f_t) {
+    ++plant.rhs_count_;
+    if (!std::isfinite(t)) return Status::SolverFailure;
+    Vec4 F0, tau0, F1, tau1;
+    Wrench we0, we1;
+    read_inputs(plant.inputs_, t, F0, we0, tau0);
+    read_inputs(plant.inputs_, t + h, F1, we1, tau1);
+    if (!F0.allFinite() || !we0.allFinite() || !tau0.allFinite()) return Status::NonFinite;
+    Vec8 ydot;
+    Mat8x12 B;
+    JointJacobians joints;
+    const Status s =
+        state_derivative_jacobians(plant.model_, x.head<8>(), F0, tau0, we0, plant.stops_, ydot, A, B, &joints);
+    if (s != Status::Ok) return s == Status::NonFinite ? Status::SolverFailure : s;
+    const Pose pd = x.segment<4>(4);
+    xdot.head<8>() = ydot;
+    xdot[8] = (F0 + plant.model_.drive_ratio * tau0).dot(joints.J_rho * pd) + we0.dot(pd);  // as energy_rates
+    xdot[9] = 0.0;
+    Eigen::Matrix<double, kPlantInputs, 1> du;
+    du << F1 - F0, we1 - we0, tau1 - tau0;
+    f_t = B * (du / h);
+    return (xdot.allFinite() && A.allFinite() && f_t.allFinite()) ? Status::Ok : Status::SolverFailure;
+  }
   void hold(unsigned stops) { plant.stops_ = stops; }
+  /// ROS2's step in the contact just switched on at (t, x) under the held
+  /// stops: h omega <= kRosenbrockRingFraction with omega the largest
+  /// imaginary part of the Jacobian's eigenvalues there (the stop's ringing
+  /// against the mechanism's actual mass); +inf if nothing rings.
+  double contact_step(double t, const Vec10& x) {
+    Vec4 F, tau;
+    Wrench we;
+    read_inputs(plant.inputs_, t, F, we, tau);
+    Vec8 ydot;
+    Mat8 A;
+    Mat8x12 B;
+    if (state_derivative_jacobians(plant.model_, x.head<8>(), F, tau, we, plant.stops_, ydot, A, B) != Status::Ok ||
+        !A.allFinite())
+      return contact_fallback;
+    const Eigen::EigenSolver<Mat8> eig(A, false);
+    if (eig.info() != Eigen::Success) return contact_fallback;
+    const double omega = eig.eigenvalues().imag().cwiseAbs().maxCoeff();
+    return omega > 0.0 ? kRosenbrockRingFraction / omega : std::numeric_limits<double>::infinity();
+  }
   unsigned mode(const Vec10& x, Vec4& rho) const { return plant.contact_mode(x, rho); }
 };
 
@@ -75,13 +134,13 @@ int Plant::cvode_rhs(double t, const Vec10& y, Vec10& ydot, void* self) {
   return (s == Status::Unreachable || s == Status::Singular || s == Status::SolverFailure) ? 1 : -1;
 }
 
-Status Plant::advance_rk4(double t_end) {
+Status Plant::advance_fixed(double t_end) {
   const double span = t_end - t_;
   const double steps = rk4_steps_for(span, settings_.rk4_step);
   if (!(steps <= kMaxRk4StepsPerAdvance)) {  // also NaN
     char buf[200];
     std::snprintf(buf, sizeof buf,
-                  "an interval of %.6g s needs %.3g RK4 steps of rk4_step = %.6g s, more than %.0e: "
+                  "an interval of %.6g s needs %.3g fixed steps of rk4_step = %.6g s, more than %.0e: "
                   "use shorter intervals or a larger rk4_step",
                   span, steps, settings_.rk4_step, kMaxRk4StepsPerAdvance);
     error_ = buf;
@@ -90,31 +149,74 @@ Status Plant::advance_rk4(double t_end) {
   const long n = std::max(1L, static_cast<long>(steps));
   const double h = span / static_cast<double>(n);
   const double t0 = t_;
-  const double h_contact = stop_contact_step(model_);
-  PlantOde ode{*this};
+  const bool rosenbrock = settings_.solver == Solver::Rosenbrock;
+  const SubSteps sub = fixed_sub_steps(model_, settings_.solver);
+  InnerSteps inner{sub.free, sub.contact, sub.layer_free, sub.layer_contact};
+  PlantOde ode{*this, sub.contact};
+  if (rosenbrock) {  // the ringing from the Jacobian at each switch into contact
+    inner.contact_from_system = true;
+    inner.contact = contact_step_ >= 0.0 ? contact_step_
+                    : (stops_ & kStopBits) != 0u ? ode.contact_step(t_, packed(false))
+                                                 : std::numeric_limits<double>::infinity();
+  }
+  // The transient started at initialisation or carried over from the last advance.
+  inner.layer = layer_pending_ ? (stops_ != 0 ? sub.layer_contact : sub.layer_free) : layer_;
+  layer_pending_ = false;
+  // One budget for the whole advance: work_budget inner steps per grid step.
+  WorkBudget budget;
+  budget.limit = static_cast<long>(std::min(settings_.work_budget * static_cast<double>(n), 1e18));
+  // ROS2's stage rates do not resolve the power dissipated in a transient it
+  // steps over (a stiff stop's damper), so its dissipated energy is the
+  // audit's balance: brought up to date when read (settle_energy), or at
+  // every grid step where energy_tolerance checks it.
+  const bool balance_each_step = rosenbrock && settings_.energy_tolerance > 0.0;
+  double e_mech = 0.0;
+  if (balance_each_step) {
+    settle_energy();
+    const Status s = mechanical_energy(y_, e_mech);
+    if (s != Status::Ok) return s;
+  } else if (rosenbrock && !balance_pending_) {
+    const Status s = mechanical_energy(y_, balance_mech_);
+    if (s != Status::Ok) return s;
+    balance_work_ = energy_.actuator_work;
+    balance_dissipated_ = energy_.dissipated;
+  }
   for (long k = 0; k < n; ++k) {
     const double tk = (k == 0) ? t0 : t0 + static_cast<double>(k) * h;
     const double t_next = (k + 1 == n) ? t_end : t0 + static_cast<double>(k + 1) * h;
     const unsigned stops_start = stops_;  // kept with the state if the step is undone
-    Vec10 x = packed();
+    Vec10 x = packed(!rosenbrock);
     // rho at x: the previous grid step's end computed it (actuator_positions).
     Vec4 rho;
     unsigned mode = actuator_positions(rho) == Status::Ok ? contact_mode_at(x, rho) : ~0u;
     bool rho_valid = mode != ~0u;
     double t = tk;
-    Status s = located_rk4_step(ode, tk, t_next, h_contact, x, mode, rho, rho_valid, contact_events_, t);
+    Status s = rosenbrock
+                   ? located_rosenbrock_step(ode, tk, t_next, inner, x, mode, rho, rho_valid, contact_events_, t, budget)
+                   : located_rk4_step(ode, tk, t_next, inner, x, mode, rho, rho_valid, contact_events_, t, budget);
+    layer_ = inner.layer;
+    if (rosenbrock) contact_step_ = inner.contact;
     if (s != Status::Ok) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "the RK4 step from t = %.17g s could not be evaluated: %s", t,
-                    status_name(s));
-      error_ = buf;
+      if (budget.exhausted) {
+        error_ = work_budget_message(model_, settings_, t, budget.limit, budget.in_contact);
+      } else {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "the %s step from t = %.17g s could not be evaluated: %s",
+                      rosenbrock ? "Rosenbrock" : "RK4", t, status_name(s));
+        error_ = buf;
+      }
       stops_ = stops_start;
       return s;
     }
     s = guard(x.head<8>(), t_next);  // every step ends within the limits, or is undone
+    if (s == Status::Ok && balance_each_step) s = rosenbrock_dissipation(x, e_mech, tk, t_next);
     if (s != Status::Ok) {
       stops_ = stops_start;
       return s;
+    }
+    if (rosenbrock && !balance_each_step) {
+      x[9] = energy_.dissipated;  // the balance's reference, not this step's
+      balance_pending_ = true;
     }
     unpack(x);
     t_ = t_next;
@@ -165,9 +267,85 @@ Status Plant::advance(double t_end, const InputSignal& inputs, bool continuous) 
   error_.clear();
   inputs_ = inputs;
   const double t_start = t_;
-  const Status s = settings_.solver == Solver::Rk4 ? advance_rk4(t_end) : advance_cvode(t_end, continuous);
+  const Vec8 y_start = y_;
+  const EnergyIntegrals e_start = energy_;
+  const unsigned stops_start = stops_;
+  const bool layer_pending_start = layer_pending_;
+  const double layer_start = layer_;
+  const double contact_step_start = contact_step_;
+  double audit_start = 0.0;
+  const bool audit = settings_.energy_tolerance > 0.0;
+  if (audit) {
+    const Status a = energy_audit(audit_start);
+    if (a != Status::Ok) {
+      inputs_ = InputSignal{};
+      return a;
+    }
+  }
+  Status s = fixed_step(settings_.solver) ? advance_fixed(t_end) : advance_cvode(t_end, continuous);
+  if (s == Status::Ok && audit) {
+    double audit_end = 0.0;
+    s = energy_audit(audit_end);
+    const double residual = audit_end - audit_start;
+    if (s == Status::Ok && !(std::fabs(residual) <= settings_.energy_tolerance)) {
+      char buf[480];
+      std::snprintf(buf, sizeof buf,
+                    "the energy audit from t = %.17g s to %.17g s is off by %.6g J (kinetic + potential - "
+                    "actuator_work + dissipated_energy went from %.9g J to %.9g J), more than energy_tolerance = "
+                    "%g J: the step is undone; a smaller rk4_step, solver = 2 (Rosenbrock) or solver = 0 (CVODE)",
+                    t_start, t_end, residual, audit_start, audit_end, settings_.energy_tolerance);
+      error_ = buf;
+      s = Status::SolverFailure;
+    }
+    if (s != Status::Ok) {  // back to the call's start
+      y_ = y_start;
+      energy_ = e_start;
+      stops_ = stops_start;
+      t_ = t_start;
+      rho_valid_ = false;
+      layer_pending_ = layer_pending_start;
+      layer_ = layer_start;
+      contact_step_ = contact_step_start;
+      if (cvode_ready_) cvode_.reset(t_, packed());
+    }
+  }
   inputs_ = InputSignal{};
   if (t_ != t_start) theta1_stale_ = true;
+  return s;
+}
+
+Status Plant::mechanical_energy(const Vec8& y, double& e) const {
+  Vec16 q, qd;
+  const Status s = expand_state(model_, y, q, qd);
+  if (s == Status::Ok) e = kinetic_energy(model_, q, qd) + potential_energy(model_, q);
+  return s;
+}
+
+Status Plant::rosenbrock_dissipation(Vec10& x, double& e_mech, double t0, double t1) {
+  double e1 = 0.0;
+  const Status s = mechanical_energy(x.head<8>(), e1);
+  if (s != Status::Ok) return s;
+  // dissipated = work - change of kinetic + potential (the audit's balance).
+  const double dissipated = (x[8] - energy_.actuator_work) - (e1 - e_mech);
+  if (settings_.energy_tolerance > 0.0 && dissipated < -settings_.energy_tolerance) {
+    char buf[400];
+    std::snprintf(buf, sizeof buf,
+                  "the Rosenbrock step from t = %.17g s to %.17g s gains %.6g J that the inputs did not supply "
+                  "(kinetic + potential %.9g J -> %.9g J, actuator work %.6g J), more than energy_tolerance = %g J: "
+                  "a smaller rk4_step or solver = 0 (CVODE)",
+                  t0, t1, -dissipated, e_mech, e1, x[8] - energy_.actuator_work, settings_.energy_tolerance);
+    error_ = buf;
+    return Status::SolverFailure;
+  }
+  x[9] = energy_.dissipated + dissipated;
+  e_mech = e1;
+  return Status::Ok;
+}
+
+Status Plant::energy_audit(double& value) const {
+  MachineOutputs mo;
+  const Status s = machine_outputs(inputs_, mo);
+  value = mo.kinetic_energy + mo.potential_energy - mo.actuator_work + mo.dissipated_energy;
   return s;
 }
 

@@ -12,8 +12,9 @@ std::string validate(const SolverSettings& s) {
   char buf[160];
   // The choices first: the FMUs and the C API pass their integers through
   // unchecked, and this is the one place that words them.
-  if (s.solver != Solver::Cvode && s.solver != Solver::Rk4) {
-    std::snprintf(buf, sizeof buf, "solver = %d must be 0 (CVODE) or 1 (RK4)", static_cast<int>(s.solver));
+  if (s.solver != Solver::Cvode && s.solver != Solver::Rk4 && s.solver != Solver::Rosenbrock) {
+    std::snprintf(buf, sizeof buf, "solver = %d must be 0 (CVODE), 1 (RK4) or 2 (Rosenbrock)",
+                  static_cast<int>(s.solver));
     return buf;
   }
   if (s.cvode_method != CvodeMethod::Adams && s.cvode_method != CvodeMethod::BDF) {
@@ -43,6 +44,16 @@ std::string validate(const SolverSettings& s) {
   }
   if (!(s.atol >= kMinAtol) || !(s.atol <= kMaxAtol)) {
     std::snprintf(buf, sizeof buf, "atol = %.17g must be positive and at most 1 (at least %g)", s.atol, kMinAtol);
+    return buf;
+  }
+  if (!(s.work_budget >= kMinWorkBudget && s.work_budget <= kMaxWorkBudget)) {
+    std::snprintf(buf, sizeof buf, "work_budget = %.17g must lie in [%g, %g] inner steps per grid step",
+                  s.work_budget, kMinWorkBudget, kMaxWorkBudget);
+    return buf;
+  }
+  if (!(s.energy_tolerance >= 0.0 && s.energy_tolerance <= kMaxEnergyTolerance)) {
+    std::snprintf(buf, sizeof buf, "energy_tolerance = %.17g J must lie in [0, %g] J (0: off)", s.energy_tolerance,
+                  kMaxEnergyTolerance);
     return buf;
   }
   return validate(s.limits());

@@ -11,7 +11,12 @@
 
 namespace pkm {
 
-enum class Solver { Cvode = 0, Rk4 = 1 };
+/// Cvode: variable step (rtol, atol). Rk4: classical fixed step (rk4_step),
+/// sub-stepped where the stiff terms need it. Rosenbrock: linearly implicit
+/// fixed step (ROS2, L-stable, the analytic Jacobian; rk4_step too).
+enum class Solver { Cvode = 0, Rk4 = 1, Rosenbrock = 2 };
+/// The fixed-step solvers (rk4_step, the work budget).
+inline bool fixed_step(Solver s) { return s == Solver::Rk4 || s == Solver::Rosenbrock; }
 
 struct SolverSettings {
   Solver solver = Solver::Cvode;
@@ -24,6 +29,14 @@ struct SolverSettings {
   // step: a step ending beyond either is undone and reported (Status::Singular).
   double max_jacobian_condition = GuardLimits{}.max_jacobian_condition;
   double min_leg_measure = GuardLimits{}.min_leg_measure;
+  // The fixed-step solvers' work budget: inner steps (grid steps, stiff
+  // sub-steps, bisection trials) per grid step, summed over one advance; an
+  // advance that would exceed it stops there (Status::SolverFailure, a message).
+  double work_budget = 1000.0;
+  // The energy audit as a run-time check (J): an advance whose audit
+  // residual (change of kinetic + potential - actuator_work +
+  // dissipated_energy) exceeds it is undone (SolverFailure). 0: off.
+  double energy_tolerance = 0.0;
 
   GuardLimits limits() const { return {max_jacobian_condition, min_leg_measure}; }
 };
@@ -31,7 +44,8 @@ struct SolverSettings {
 inline bool operator==(const SolverSettings& a, const SolverSettings& b) {
   return a.solver == b.solver && a.rk4_step == b.rk4_step && a.rtol == b.rtol && a.atol == b.atol &&
          a.cvode_method == b.cvode_method && a.formulation == b.formulation &&
-         a.max_jacobian_condition == b.max_jacobian_condition && a.min_leg_measure == b.min_leg_measure;
+         a.max_jacobian_condition == b.max_jacobian_condition && a.min_leg_measure == b.min_leg_measure &&
+         a.work_budget == b.work_budget && a.energy_tolerance == b.energy_tolerance;
 }
 
 /// The range of rk4_step (s): a thousandth of the paper's 1 ms resolves the
@@ -59,6 +73,12 @@ constexpr double kMaxRk4StepsPerAdvance = 1e7;
 /// How many RK4 steps an advance over `span` takes (whole steps no longer
 /// than rk4_step); compare with kMaxRk4StepsPerAdvance before any work.
 double rk4_steps_for(double span, double rk4_step);
+
+/// The range of work_budget (inner steps per grid step): at least the grid
+/// step itself; at most 1e6 (a million-fold the nominal cost is no budget).
+constexpr double kMinWorkBudget = 1.0, kMaxWorkBudget = 1e6;
+/// The range of energy_tolerance (J): 0 (off) up to 1e9 J.
+constexpr double kMaxEnergyTolerance = 1e9;
 
 /// Returns "" if the settings are usable, otherwise a message naming the
 /// offending setting.
