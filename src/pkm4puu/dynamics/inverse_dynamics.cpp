@@ -1,14 +1,18 @@
 // SPDX-License-Identifier: BSD-2-Clause
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "pkm4puu/kinematics/constraints.hpp"
+#include "pkm4puu/dynamics/inverse_lanes.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
 #include "pkm4puu/machine/passive_force.hpp"
 
 namespace pkm {
 namespace {
 
-constexpr int kActuated[kLegs] = {0, 3, 6, 9};
+constexpr int kActuatedCoord[kLegs] = {0, 3, 6, 9};
 constexpr int kUnactuated[kM] = {1, 2, 4, 5, 7, 8, 10, 11, 12, 13, 14, 15};
 
 /// Eqs. 10-11; with `passive`, on top of the joints' passive forces.
@@ -34,7 +38,7 @@ Status forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& qdd,
   if (!(std::abs(lu.determinant()) > 0.0)) return Status::Singular;
   lambda = lu.solve(rhs);  // Eq. 10
   for (int i = 0; i < kLegs; ++i) {
-    const int k = kActuated[i];
+    const int k = kActuatedCoord[i];
     F[i] = inertial[k] + Cq.col(k).dot(lambda);  // Eq. 11
     if (passive) F[i] -= passive_joint_force(m.p, q[k], qd[k]);
   }
@@ -56,9 +60,9 @@ Status holding_forces(const Model& m, const Vec16& q, const Wrench& we, Vec4& F)
   return forces(m, q, Vec16::Zero(), Vec16::Zero(), we, /*passive=*/false, F, lambda);
 }
 
-Status inverse_dynamics(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,
-                        const Wrench& we, InverseDynamicsResult& out, bool warm_start,
-                        const NewtonOptions& opt) {
+Status inverse_dynamics_general(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,
+                                const Wrench& we, InverseDynamicsResult& out, bool warm_start,
+                                const NewtonOptions& opt) {
   if (!pose.allFinite() || !pose_d.allFinite() || !pose_dd.allFinite() || !we.allFinite())
     return Status::NonFinite;
   Status s = Status::Ok;
@@ -79,6 +83,50 @@ Status inverse_dynamics(const Model& m, const Pose& pose, const Pose& pose_d, co
   s = actuator_forces(m, out.q, out.qd, out.qdd, we, out.F, out.lambda);
   out.tau = out.F / m.drive_ratio;
   return s;
+}
+
+Status inverse_dynamics(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,
+                        const Wrench& we, InverseDynamicsResult& out, bool, const NewtonOptions&) {
+  InverseLegs legs;
+  Vec4 F;
+  const Status s = reduced_inverse(m, pose, pose_d, pose_dd, we, legs, F);
+  if (s != Status::Ok) return s;
+  Vec4 rho;
+  for (int i = 0; i < kLegs; ++i) {
+    const int o = leg_offset(i);
+    rho[i] = legs.rho[i];
+    out.q[o] = legs.rho[i];
+    reduced_inverse_angles(legs, m.p, i, out.q[o + 1], out.q[o + 2]);
+    out.qd.segment<3>(o) << legs.rhod[i], legs.th1d[i], legs.th2d[i];
+    out.qdd.segment<3>(o) << legs.rhodd[i], legs.th1dd[i], legs.th2dd[i];
+  }
+  out.q.segment<4>(kPlatform) = pose;
+  out.qd.segment<4>(kPlatform) = pose_d;
+  out.qdd.segment<4>(kPlatform) = pose_dd;
+  out.F = F;
+  out.tau = F / m.drive_ratio;
+  out.beyond_stops = stops_passed(m.p, rho);
+  reduced_inverse_lambda(legs, F, out.lambda);
+  return Status::Ok;
+}
+
+Status inverse_actuators(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,
+                         const Wrench& we, InverseActuators& out) {
+  InverseLegs legs;
+  Vec4 F;
+  const Status s = reduced_inverse(m, pose, pose_d, pose_dd, we, legs, F);
+  if (s != Status::Ok) return s;
+  double measure = 0.5;  // the largest |c2 s2| = |sin(2 theta2)| / 2
+  for (int i = 0; i < kLegs; ++i) {
+    out.rho[i] = legs.rho[i];
+    out.rhod[i] = legs.rhod[i];
+    measure = std::min(measure, std::fabs(legs.c2[i] * legs.s2[i]));
+  }
+  out.F = F;
+  out.tau = F / m.drive_ratio;
+  out.leg_measure_min = measure;
+  out.beyond_stops = stops_passed(m.p, out.rho);
+  return Status::Ok;
 }
 
 }  // namespace pkm
