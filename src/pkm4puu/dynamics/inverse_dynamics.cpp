@@ -120,7 +120,9 @@ Status inverse_actuators(const Model& m, const Pose& pose, const Pose& pose_d, c
   for (int i = 0; i < kLegs; ++i) {
     out.rho[i] = legs.rho[i];
     out.rhod[i] = legs.rhod[i];
-    measure = std::min(measure, std::fabs(legs.c2[i] * legs.s2[i]));
+    out.leg_measure[i] = std::fabs(legs.c2[i] * legs.s2[i]);
+    measure = std::min(measure, out.leg_measure[i]);
+    out.J_rho.row(i) << legs.linv[0][i], legs.linv[1][i], 1.0, legs.a03[i];
   }
   out.F = F;
   out.tau = F / m.drive_ratio;

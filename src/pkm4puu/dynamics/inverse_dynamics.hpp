@@ -61,8 +61,11 @@ Status inverse_dynamics_general(const Model& m, const Pose& pose, const Pose& po
 struct InverseActuators {
   Vec4 F = Vec4::Zero(), tau = Vec4::Zero();  // as InverseDynamicsResult
   Vec4 rho = Vec4::Zero(), rhod = Vec4::Zero();
-  /// min_i |cos theta2_i sin theta2_i| (leg_singularity_measure).
+  /// |cos theta2_i sin theta2_i| (leg_singularity_measure) and its minimum.
+  Vec4 leg_measure = Vec4::Zero();
   double leg_measure_min = 0;
+  /// The actuator Jacobian d rho/d(x, y, z, phi).
+  Mat4 J_rho = Mat4::Zero();
   unsigned beyond_stops = 0;  // as InverseDynamicsResult
 };
 Status inverse_actuators(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,

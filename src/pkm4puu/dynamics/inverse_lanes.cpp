@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 #include "pkm4puu/base/lanes.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
@@ -95,6 +96,7 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
   put(Jt[0], l00);
   put(Jt[1], l01);
   put(Jt[3], a03);
+  put(out.a03, a03);
   put(out.rho, lp.rho);
   put(out.rhod, rd);
   put(out.rhodd, rdd);
@@ -113,6 +115,32 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
   put(out.tau[1], tau1);
   put(out.tau[2], tau2);
   return Status::Ok;
+}
+
+// a x = b for a 4x4 (overwritten) by Gaussian elimination with partial
+// pivoting, written out (b in x); false for a zero pivot.
+bool solve4(double a[4][kLegs], double x[4]) {
+  for (int k = 0; k < 4; ++k) {
+    int piv = k;
+    for (int i = k + 1; i < 4; ++i)
+      if (std::fabs(a[i][k]) > std::fabs(a[piv][k])) piv = i;
+    if (!(std::fabs(a[piv][k]) > 0.0)) return false;  // also NaN
+    if (piv != k) {
+      for (int j = k; j < 4; ++j) std::swap(a[k][j], a[piv][j]);
+      std::swap(x[k], x[piv]);
+    }
+    const double inv = 1.0 / a[k][k];
+    for (int i = k + 1; i < 4; ++i) {
+      const double f = a[i][k] * inv;
+      for (int j = k + 1; j < 4; ++j) a[i][j] -= f * a[k][j];
+      x[i] -= f * x[k];
+    }
+  }
+  for (int i = 3; i >= 0; --i) {
+    for (int j = i + 1; j < 4; ++j) x[i] -= a[i][j] * x[j];
+    x[i] /= a[i][i];
+  }
+  return true;
 }
 
 Status legs_generic(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd, InverseLegs& out,
@@ -148,11 +176,10 @@ Status reduced_inverse(const Model& m, const Pose& pose, const Pose& pd, const P
   rhs[1] = r[1] + (pi.mass * pdd[1] + pi.mwx * pdd[3] - pi.mwy * w2 - we[1]);
   rhs[2] = r[2] + (pi.mass * pdd[2] + pi.mass * m.p.g - we[2]);
   rhs[3] = r[3] + (-pi.mwy * pdd[0] + pi.mwx * pdd[1] + pi.Izz * pdd[3] - we[3]);
-  Mat4 JrT;
-  for (int i = 0; i < kLegs; ++i) JrT.col(i) << Jt[0][i], Jt[1][i], 1.0, Jt[3][i];
-  const Eigen::PartialPivLU<Mat4> lu(JrT);
-  if (!(std::abs(lu.determinant()) > 0.0)) return Status::Singular;  // a parallel singularity
-  F = lu.solve(rhs);
+  Jt[2][0] = Jt[2][1] = Jt[2][2] = Jt[2][3] = 1.0;
+  double x[4] = {rhs[0], rhs[1], rhs[2], rhs[3]};
+  if (!solve4(Jt, x)) return Status::Singular;  // a parallel singularity
+  F = Vec4(x[0], x[1], x[2], x[3]);
   return F.allFinite() ? Status::Ok : Status::Singular;
 }
 

@@ -23,6 +23,7 @@ struct InverseLegs {
   double c2[kLegs], s2[kLegs];
   double linv[6][kLegs];  // L_i^{-1}'s first two columns by rows: l00 l01 l10 l11 l20 l21 (the third is e_0)
   double tau[3][kLegs];   // tau_i (header comment)
+  double a03[kLegs];      // d rho_i/d phi (J_rho's row i: l00, l01, 1, a03)
 };
 
 /// The actuator forces F of the machine (rotor, payload, friction and, beyond
