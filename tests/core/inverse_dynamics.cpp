@@ -42,6 +42,13 @@ double expect_paths_agree(const Model& m, const Pose& p, const Pose& v, const Po
   EXPECT_LT(rel_diff(r.qd, g.qd), 1e-12);
   EXPECT_LT(rel_diff(r.qdd, g.qdd), 1e-12);
   EXPECT_EQ(r.beyond_stops, g.beyond_stops);
+  // The angles (a rational atan in lanes against libm's atan2 and acos
+  // through Newton): to a few units in the last place of pi.
+  for (int i = 0; i < kLegs; ++i) {
+    const int o = leg_offset(i);
+    EXPECT_LT(std::fabs(r.q[o + 1] - g.q[o + 1]), 1e-15) << "theta1 of leg " << i + 1;
+    EXPECT_LT(std::fabs(r.q[o + 2] - g.q[o + 2]), 1e-15) << "theta2 of leg " << i + 1;
+  }
   // The actuators-only entry point: the same kernel, the same bits.
   InverseActuators act;
   EXPECT_EQ(inverse_actuators(m, p, v, a, we, act), Status::Ok);
@@ -134,5 +141,30 @@ TEST(InverseDynamics, ReducedGivesTheGeneralPathsStatuses) {
     EXPECT_EQ(inverse_dynamics_general(m, b.p, b.v, z, Wrench::Zero(), g), b.expected);
     EXPECT_EQ(inverse_dynamics(m, b.p, b.v, z, Wrench::Zero(), r), b.expected);
     EXPECT_EQ(inverse_actuators(m, b.p, b.v, z, Wrench::Zero(), act), b.expected);
+  }
+}
+
+TEST(InverseDynamics, BaselineLanesGiveTheSameBitsAsAvx) {
+  // Model::avx picks the lanes' AVX variant where the processor has it; the
+  // baseline variant (SSE2 pairs) runs the same expressions in the same order.
+  Model avx = model_of(machine_params());
+  Model base = avx;
+  base.avx = false;
+  if (!avx.avx) GTEST_SKIP() << "no AVX here: only the baseline variant runs";
+  for (unsigned seed = 1; seed <= 50; ++seed) {
+    const RandomState s = random_state(avx, seed);
+    const Pose acc = random_vec<4>(3000 + seed, 3.0);
+    const Wrench we = random_vec<4>(4000 + seed, 0.5);
+    InverseDynamicsResult a, b;
+    ASSERT_EQ(inverse_dynamics(avx, s.pose, s.vel, acc, we, a), Status::Ok);
+    ASSERT_EQ(inverse_dynamics(base, s.pose, s.vel, acc, we, b), Status::Ok);
+    EXPECT_EQ(a.F, b.F);
+    EXPECT_EQ(a.q, b.q);
+    EXPECT_EQ(a.lambda, b.lambda);
+    InverseActuators x, y;
+    ASSERT_EQ(inverse_actuators(avx, s.pose, s.vel, acc, we, x), Status::Ok);
+    ASSERT_EQ(inverse_actuators(base, s.pose, s.vel, acc, we, y), Status::Ok);
+    EXPECT_EQ(x.F, y.F);
+    EXPECT_EQ(x.J_rho, y.J_rho);
   }
 }

@@ -1,9 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 
-#include <algorithm>
-#include <cmath>
-
 #include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/dynamics/inverse_lanes.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
@@ -87,48 +84,12 @@ Status inverse_dynamics_general(const Model& m, const Pose& pose, const Pose& po
 
 Status inverse_dynamics(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,
                         const Wrench& we, InverseDynamicsResult& out, bool, const NewtonOptions&) {
-  InverseLegs legs;
-  Vec4 F;
-  const Status s = reduced_inverse(m, pose, pose_d, pose_dd, we, legs, F);
-  if (s != Status::Ok) return s;
-  Vec4 rho;
-  for (int i = 0; i < kLegs; ++i) {
-    const int o = leg_offset(i);
-    rho[i] = legs.rho[i];
-    out.q[o] = legs.rho[i];
-    reduced_inverse_angles(legs, m.p, i, out.q[o + 1], out.q[o + 2]);
-    out.qd.segment<3>(o) << legs.rhod[i], legs.th1d[i], legs.th2d[i];
-    out.qdd.segment<3>(o) << legs.rhodd[i], legs.th1dd[i], legs.th2dd[i];
-  }
-  out.q.segment<4>(kPlatform) = pose;
-  out.qd.segment<4>(kPlatform) = pose_d;
-  out.qdd.segment<4>(kPlatform) = pose_dd;
-  out.F = F;
-  out.tau = F / m.drive_ratio;
-  out.beyond_stops = stops_passed(m.p, rho);
-  reduced_inverse_lambda(legs, F, out.lambda);
-  return Status::Ok;
+  return reduced_inverse(m, pose, pose_d, pose_dd, we, &out, nullptr);
 }
 
 Status inverse_actuators(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,
                          const Wrench& we, InverseActuators& out) {
-  InverseLegs legs;
-  Vec4 F;
-  const Status s = reduced_inverse(m, pose, pose_d, pose_dd, we, legs, F);
-  if (s != Status::Ok) return s;
-  double measure = 0.5;  // the largest |c2 s2| = |sin(2 theta2)| / 2
-  for (int i = 0; i < kLegs; ++i) {
-    out.rho[i] = legs.rho[i];
-    out.rhod[i] = legs.rhod[i];
-    out.leg_measure[i] = std::fabs(legs.c2[i] * legs.s2[i]);
-    measure = std::min(measure, out.leg_measure[i]);
-    out.J_rho.row(i) << legs.linv[0][i], legs.linv[1][i], 1.0, legs.a03[i];
-  }
-  out.F = F;
-  out.tau = F / m.drive_ratio;
-  out.leg_measure_min = measure;
-  out.beyond_stops = stops_passed(m.p, out.rho);
-  return Status::Ok;
+  return reduced_inverse(m, pose, pose_d, pose_dd, we, nullptr, &out);
 }
 
 }  // namespace pkm

@@ -2,10 +2,10 @@
 #include "pkm4puu/dynamics/inverse_lanes.hpp"
 
 #include <cmath>
-#include <cstring>
-#include <utility>
+#include <algorithm>
 
 #include "pkm4puu/base/lanes.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
 #include "pkm4puu/dynamics/leg_position_lanes.hpp"
 #include "pkm4puu/machine/passive_force.hpp"
@@ -23,7 +23,42 @@ namespace {
 
 using lanes::Pack;
 
-PKM_LANES_INLINE void put(double* dst, const Pack& v) { std::memcpy(dst, &v, sizeof(double) * kLegs); }
+// m ? a : b lane by lane.
+PKM_LANES_INLINE Pack choose(const lanes::Mask& m, const Pack& a, const Pack& b) {
+#if PKM_LANES_VECTOR_EXTENSIONS
+  return (Pack)((m & (lanes::Mask)a) | (~m & (lanes::Mask)b));
+#else
+  Pack r;
+  for (int i = 0; i < kLegs; ++i) r.v[i] = m.v[i] ? a.v[i] : b.v[i];
+  return r;
+#endif
+}
+
+// atan2(y, x) lane by lane for finite (x, y) != (0, 0), to about an ulp of
+// pi: the ratio of the smaller to the larger magnitude in [0, 1], Cephes'
+// atan there (a rational approximation of degree 4/5 in z = t^2 after the
+// reduction t -> (t - 1)/(t + 1) above 0.66, with pi/4's lower bits), then
+// the octant. No libm call: the legs' angles for four legs at once.
+PKM_LANES_INLINE Pack atan2_lanes(const Pack& y, const Pack& x) {
+  const Pack ay = lanes::abs(y), ax = lanes::abs(x);
+  const auto steep = lanes::gt(ay - ax, 0.0);
+  // t = num/den in [0, 1]; above 0.66 (t - 1)/(t + 1) = (num - den)/(num + den): one division either way.
+  const Pack num = choose(steep, ax, ay), den = choose(steep, ay, ax);
+  const auto upper = lanes::gt(num - 0.66 * den, 0.0);
+  const Pack u = choose(upper, num - den, num) / choose(upper, num + den, den);
+  const Pack z = u * u;
+  const Pack P = (((-8.750608600031904122785e-1 * z - 1.615753718733365076637e1) * z - 7.500855792314704667340e1) * z -
+                  1.228866684490136173410e2) * z - 6.485021904942025371773e1;
+  const Pack Q = ((((z + 2.485846490142306297962e1) * z + 1.650270098316988542046e2) * z + 4.328810604912902668951e2) *
+                      z + 4.853903996359136964868e2) * z + 1.945506571482613964425e2;
+  const Pack w = u * (z * P / Q) + u;
+  const lanes::Pack zero = lanes::broadcast(0.0);
+  const double kPio4 = 0.78539816339744830962, kMoreBits = 6.123233995736765886130e-17;
+  Pack r = choose(upper, w + 0.5 * kMoreBits + kPio4, w);                     // atan(t), t in [0, 1]
+  r = choose(steep, (1.5707963267948966 - r) + kMoreBits, r);                // |y| > |x|
+  r = choose(lanes::lt(x, 0.0), (3.141592653589793 - r) + 2.0 * kMoreBits, r);  // x < 0
+  return choose(lanes::lt(y, 0.0), zero - r, r);
+}
 
 // The joints' passive forces (friction, a stop beyond it), as
 // actuator_forces takes them: lane-wise in the plain case (no Coulomb
@@ -37,10 +72,11 @@ PKM_LANES_INLINE Pack passive_lanes(const Params& p, const Pack& rho, const Pack
 }
 
 // The four legs as lanes: inverse kinematics, A_i's rows, qd_i, qdd_i,
-// tau_i; their A_i^T tau_i summed into r and J_rho's rows into J (J_rho^T
-// by columns). Unreachable before Singular, as the servo-constraint path.
+// tau_i; their A_i^T tau_i summed, the platform's terms added and J_rho^T F
+// = that solved. Unreachable before Singular, as the servo-constraint path.
+template <bool kFull>
 PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd,
-                                     InverseLegs& out, double r[4], double Jt[4][kLegs]) {
+                                     const Wrench& we, InverseDynamicsResult* full, InverseActuators* act) {
   const Params& p = m.p;
   const lane_legs::LegPosition<Pack> lp = lane_legs::leg_position(p, pc, lane_legs::lane_inputs(m));
   if (lanes::any(lp.out_of_reach)) return Status::Unreachable;
@@ -91,110 +127,96 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
   // A_i^T tau_i summed over the legs; J_rho^T's columns (l00, l01, 1, a03).
   const Pack c[4] = {l00 * tau0 + l10 * tau1 + l20 * tau2, l01 * tau0 + l11 * tau1 + l21 * tau2, tau0,
                      a03 * tau0 + a13 * tau1 + a23 * tau2};
+  double r[4];
   for (int n = 0; n < 4; ++n)
     r[n] = (lanes::lane(c[n], 0) + lanes::lane(c[n], 1)) + (lanes::lane(c[n], 2) + lanes::lane(c[n], 3));
-  put(Jt[0], l00);
-  put(Jt[1], l01);
-  put(Jt[3], a03);
-  put(out.a03, a03);
-  put(out.rho, lp.rho);
-  put(out.rhod, rd);
-  put(out.rhodd, rdd);
-  put(out.th1d, t1d);
-  put(out.th1dd, t1dd);
-  put(out.th2d, t2d);
-  put(out.th2dd, t2dd);
-  put(out.qx, lp.qx);
-  put(out.qy, lp.qy);
-  put(out.A, lp.A);
-  put(out.c2, c2);
-  put(out.s2, s2);
-  const Pack L[6] = {l00, l01, l10, l11, l20, l21};
-  for (int n = 0; n < 6; ++n) put(out.linv[n], L[n]);
-  put(out.tau[0], tau0);
-  put(out.tau[1], tau1);
-  put(out.tau[2], tau2);
+  // The platform with its payload: M_p pdd + V_p + G_p - we (reduced_system's terms).
+  const PlatformInertia pi = platform_inertia(m, pc.cphi, pc.sphi);
+  Vec4 rhs;
+  rhs[0] = r[0] + (pi.mass * pdd[0] - pi.mwy * pdd[3] - pi.mwx * w2 - we[0]);
+  rhs[1] = r[1] + (pi.mass * pdd[1] + pi.mwx * pdd[3] - pi.mwy * w2 - we[1]);
+  rhs[2] = r[2] + (pi.mass * pdd[2] + pi.mass * p.g - we[2]);
+  rhs[3] = r[3] + (-pi.mwy * pdd[0] + pi.mwx * pdd[1] + pi.Izz * pdd[3] - we[3]);
+  Mat4 JrT;  // J_rho^T: column i is J_rho's row i, (l00, l01, 1, a03)
+  for (int i = 0; i < kLegs; ++i)
+    JrT.col(i) << lanes::lane(l00, i), lanes::lane(l01, i), 1.0, lanes::lane(a03, i);
+  // Eigen's closed-form 4x4 inverse (cofactors, vectorised): a third of an
+  // elimination's time; at a parallel singularity it is not finite. All of
+  // it here, in the lanes' instruction set: no values through memory
+  // between the lanes and the scalar code (store-forwarding stalls).
+  const Vec4 F = JrT.inverse() * rhs;
+  if (!F.allFinite()) return Status::Singular;
+  const Pack rho = lp.rho;
+  if (kFull) {
+    InverseDynamicsResult& o = *full;
+    // leg_inverse_kinematics' theta1 = atan2(qy, qx) + atan2(h', A) lies in
+    // (-pi, 3 pi/2]: atan2(s1, c1) + 2 pi where that is below 0 and qy is not.
+    const Pack th1 = atan2_lanes(s1, c1), th2 = atan2_lanes(s2, c2);  // theta2 in (-pi/2, 0): elbow-down
+    // Leg i's rows of Eq. 1: lambda_i = L_i^{-T} (F_i e_0 - tau_i) (Eq. 10).
+    const Pack v0 = lanes::pack(F[0], F[1], F[2], F[3]) - tau0;
+    const Pack lam0 = l00 * v0 - l10 * tau1 - l20 * tau2, lam1 = l01 * v0 - l11 * tau1 - l21 * tau2;
+    for (int i = 0; i < kLegs; ++i) {
+      const int k = leg_offset(i);
+      double t1 = lanes::lane(th1, i);
+      if (!std::signbit(lanes::lane(lp.qy, i)) && t1 < 0.0) t1 += 6.283185307179586;
+      o.q.segment<3>(k) << lanes::lane(rho, i), t1, lanes::lane(th2, i);
+      o.qd.segment<3>(k) << lanes::lane(rd, i), lanes::lane(t1d, i), lanes::lane(t2d, i);
+      o.qdd.segment<3>(k) << lanes::lane(rdd, i), lanes::lane(t1dd, i), lanes::lane(t2dd, i);
+      o.lambda.segment<3>(3 * i) << lanes::lane(lam0, i), lanes::lane(lam1, i), lanes::lane(v0, i);
+    }
+    o.q.segment<4>(kPlatform) = pc.pose;
+    o.qd.segment<4>(kPlatform) = pd;
+    o.qdd.segment<4>(kPlatform) = pdd;
+    o.F = F;
+    o.tau = F / m.drive_ratio;
+    o.beyond_stops = stops_passed(p, Vec4(lanes::lane(rho, 0), lanes::lane(rho, 1), lanes::lane(rho, 2),
+                                          lanes::lane(rho, 3)));
+  } else {
+    InverseActuators& o = *act;
+    const Pack measure = lanes::abs(c2 * s2);
+    o.leg_measure_min = 0.5;  // the largest |c2 s2| = |sin(2 theta2)| / 2
+    for (int i = 0; i < kLegs; ++i) {
+      o.rho[i] = lanes::lane(rho, i);
+      o.rhod[i] = lanes::lane(rd, i);
+      o.leg_measure[i] = lanes::lane(measure, i);
+      o.leg_measure_min = std::min(o.leg_measure_min, o.leg_measure[i]);
+    }
+    o.J_rho = JrT.transpose();
+    o.F = F;
+    o.tau = F / m.drive_ratio;
+    o.beyond_stops = stops_passed(p, o.rho);
+  }
   return Status::Ok;
 }
 
-// a x = b for a 4x4 (overwritten) by Gaussian elimination with partial
-// pivoting, written out (b in x); false for a zero pivot.
-bool solve4(double a[4][kLegs], double x[4]) {
-  for (int k = 0; k < 4; ++k) {
-    int piv = k;
-    for (int i = k + 1; i < 4; ++i)
-      if (std::fabs(a[i][k]) > std::fabs(a[piv][k])) piv = i;
-    if (!(std::fabs(a[piv][k]) > 0.0)) return false;  // also NaN
-    if (piv != k) {
-      for (int j = k; j < 4; ++j) std::swap(a[k][j], a[piv][j]);
-      std::swap(x[k], x[piv]);
-    }
-    const double inv = 1.0 / a[k][k];
-    for (int i = k + 1; i < 4; ++i) {
-      const double f = a[i][k] * inv;
-      for (int j = k + 1; j < 4; ++j) a[i][j] -= f * a[k][j];
-      x[i] -= f * x[k];
-    }
-  }
-  for (int i = 3; i >= 0; --i) {
-    for (int j = i + 1; j < 4; ++j) x[i] -= a[i][j] * x[j];
-    x[i] /= a[i][i];
-  }
-  return true;
-}
-
-Status legs_generic(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd, InverseLegs& out,
-                    double r[4], double Jt[4][kLegs]) {
-  return legs_inverse(m, pc, pd, pdd, out, r, Jt);
+template <bool kFull>
+Status inverse_legs_generic(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd,
+                            const Wrench& we, InverseDynamicsResult* full, InverseActuators* act) {
+  return legs_inverse<kFull>(m, pc, pd, pdd, we, full, act);
 }
 
 #if PKM_INVERSE_AVX_DISPATCH
-__attribute__((target("avx"))) Status legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
-                                               const Pose& pdd, InverseLegs& out, double r[4], double Jt[4][kLegs]) {
-  return legs_inverse(m, pc, pd, pdd, out, r, Jt);
+template <bool kFull>
+__attribute__((target("avx"))) Status inverse_legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
+                                                       const Pose& pdd, const Wrench& we, InverseDynamicsResult* full,
+                                                       InverseActuators* act) {
+  return legs_inverse<kFull>(m, pc, pd, pdd, we, full, act);
 }
 #endif
 
 }  // namespace
 
 Status reduced_inverse(const Model& m, const Pose& pose, const Pose& pd, const Pose& pdd, const Wrench& we,
-                       InverseLegs& legs, Vec4& F) {
+                       InverseDynamicsResult* full, InverseActuators* act) {
   if (!pose.allFinite() || !pd.allFinite() || !pdd.allFinite() || !we.allFinite()) return Status::NonFinite;
   const PlatformConfig pc = platform_config(pose);
-  double r[4], Jt[4][kLegs];
 #if PKM_INVERSE_AVX_DISPATCH
-  const Status s = m.avx ? legs_avx(m, pc, pd, pdd, legs, r, Jt) : legs_generic(m, pc, pd, pdd, legs, r, Jt);
-#else
-  const Status s = legs_generic(m, pc, pd, pdd, legs, r, Jt);
+  if (m.avx)
+    return full ? inverse_legs_avx<true>(m, pc, pd, pdd, we, full, nullptr)
+                : inverse_legs_avx<false>(m, pc, pd, pdd, we, nullptr, act);
 #endif
-  if (s != Status::Ok) return s;
-  // The platform with its payload: M_p pdd + V_p + G_p - we (reduced_system's terms).
-  const PlatformInertia pi = platform_inertia(m, pc.cphi, pc.sphi);
-  const double w2 = pd[3] * pd[3];
-  Vec4 rhs;
-  rhs[0] = r[0] + (pi.mass * pdd[0] - pi.mwy * pdd[3] - pi.mwx * w2 - we[0]);
-  rhs[1] = r[1] + (pi.mass * pdd[1] + pi.mwx * pdd[3] - pi.mwy * w2 - we[1]);
-  rhs[2] = r[2] + (pi.mass * pdd[2] + pi.mass * m.p.g - we[2]);
-  rhs[3] = r[3] + (-pi.mwy * pdd[0] + pi.mwx * pdd[1] + pi.Izz * pdd[3] - we[3]);
-  Jt[2][0] = Jt[2][1] = Jt[2][2] = Jt[2][3] = 1.0;
-  double x[4] = {rhs[0], rhs[1], rhs[2], rhs[3]};
-  if (!solve4(Jt, x)) return Status::Singular;  // a parallel singularity
-  F = Vec4(x[0], x[1], x[2], x[3]);
-  return F.allFinite() ? Status::Ok : Status::Singular;
-}
-
-void reduced_inverse_lambda(const InverseLegs& g, const Vec4& F, Vec12& lambda) {
-  for (int i = 0; i < kLegs; ++i) {
-    const double v0 = F[i] - g.tau[0][i], v1 = -g.tau[1][i], v2 = -g.tau[2][i];
-    lambda[3 * i] = g.linv[0][i] * v0 + g.linv[2][i] * v1 + g.linv[4][i] * v2;
-    lambda[3 * i + 1] = g.linv[1][i] * v0 + g.linv[3][i] * v1 + g.linv[5][i] * v2;
-    lambda[3 * i + 2] = v0;
-  }
-}
-
-void reduced_inverse_angles(const InverseLegs& g, const Params& p, int i, double& theta1, double& theta2) {
-  theta1 = std::atan2(g.qy[i], g.qx[i]) + std::atan2(p.h_prime, g.A[i]);
-  theta2 = -std::acos(g.c2[i]);
+  return full ? inverse_legs_generic<true>(m, pc, pd, pdd, we, full, nullptr)
+              : inverse_legs_generic<false>(m, pc, pd, pdd, we, nullptr, act);
 }
 
 }  // namespace pkm

@@ -26,7 +26,7 @@ struct LegPosition {
   T ax, ay;          // Rz(phi) r_Qi (its z is 0)
   T c1, s1, c2, s2;  // the leg's angles' cosines and sines
   T rho;
-  T qx, qy, A;       // q~'s xy in the leg's frame and A = sqrt(|q~_xy|^2 - h'^2) (for the angles)
+  T qy;              // q~'s y in the leg's frame (the quadrant of theta1)
   decltype(lanes::not_ge(T(), 0.0)) out_of_reach;
 };
 
@@ -54,9 +54,7 @@ PKM_LANES_INLINE LegPosition<T> leg_position(const Params& p, const PlatformConf
   const T s2sq = 1.0 - o.c2 * o.c2;
   o.s2 = -lanes::sqrt(lanes::select(lanes::gt(s2sq, 0.0), s2sq, 0.0));  // elbow-down
   o.rho = qz - p.h - p.l * o.s2;
-  o.qx = qx;
   o.qy = qy;
-  o.A = A;
   return o;
 }
 
