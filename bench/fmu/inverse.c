@@ -36,7 +36,7 @@
 #endif
 
 #define TICKS 1000    /* tabulated motion */
-#define REPEAT 20     /* passes over the table per batch: 20000 ticks */
+#define REPEAT 4      /* passes over the table per batch: 4000 ticks */
 #define H 1e-3        /* s */
 #define TARGET 0.1    /* tick / mj_inverse */
 #define PI 3.14159265358979323846
@@ -229,7 +229,7 @@ int main(int argc, char** argv) {
   const char* xml = PKM_FMU_INVERSE_XML;
   const char* mjcf = PKM_MUJOCO_MJCF;
   const char* state = PKM_MUJOCO_STATE;
-  int batches = 31, i, k, ok = 1;
+  int batches = 101, i, k, ok = 1;
   static const char* const inputs[12] = {"x", "y", "z", "phi", "dx", "dy", "dz", "dphi", "ddx", "ddy", "ddz", "ddphi"};
   static const char* const outputs[4] = {"F[1]", "F[2]", "F[3]", "F[4]"};
   char guid[128];
