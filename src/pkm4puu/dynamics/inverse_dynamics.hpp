@@ -3,7 +3,9 @@
 // kinematics, Eq. 1 has 16 rows and 16 unknowns: lambda (12) and the
 // actuator forces F (4). The 12 rows of the unactuated coordinates
 // (theta1_i, theta2_i, x, y, z, phi) carry no actuator force and give lambda
-// (Eq. 10); the 4 rows of rho_i then give F (Eq. 11).
+// (Eq. 10); the 4 rows of rho_i then give F (Eq. 11): the general path
+// (inverse_dynamics_general, actuator_forces). inverse_dynamics solves the
+// same equations in reduced, leg-partitioned form (inverse_lanes.hpp).
 #pragma once
 
 #include "pkm4puu/kinematics/servo_kinematics.hpp"
