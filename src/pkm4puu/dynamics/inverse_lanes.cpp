@@ -137,14 +137,28 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
   rhs[1] = r[1] + (pi.mass * pdd[1] + pi.mwx * pdd[3] - pi.mwy * w2 - we[1]);
   rhs[2] = r[2] + (pi.mass * pdd[2] + pi.mass * p.g - we[2]);
   rhs[3] = r[3] + (-pi.mwy * pdd[0] + pi.mwx * pdd[1] + pi.Izz * pdd[3] - we[3]);
-  Mat4 JrT;  // J_rho^T: column i is J_rho's row i, (l00, l01, 1, a03)
-  for (int i = 0; i < kLegs; ++i)
-    JrT.col(i) << lanes::lane(l00, i), lanes::lane(l01, i), 1.0, lanes::lane(a03, i);
-  // Eigen's closed-form 4x4 inverse (cofactors, vectorised): a third of an
-  // elimination's time; at a parallel singularity it is not finite. All of
-  // it here, in the lanes' instruction set: no values through memory
-  // between the lanes and the scalar code (store-forwarding stalls).
-  const Vec4 F = JrT.inverse() * rhs;
+  // J_rho^T F = rhs, J_rho^T's rows (l00_i), (l01_i), (1), (a03_i) over the
+  // legs i. Its row of ones gives F_3 = rhs_2 - F_0 - F_1 - F_2; the other
+  // rows then a 3x3 system G (F_0, F_1, F_2) = g, G_kj = row_k[j] - row_k[3],
+  // solved by Cramer's rule (det J_rho = -det G): a few dozen operations.
+  double row[3][kLegs];
+  for (int j = 0; j < kLegs; ++j) {
+    row[0][j] = lanes::lane(l00, j);
+    row[1][j] = lanes::lane(l01, j);
+    row[2][j] = lanes::lane(a03, j);
+  }
+  const double rk[3] = {rhs[0], rhs[1], rhs[3]};
+  Vec3 G[3];
+  double gk[3];
+  for (int k = 0; k < 3; ++k) {
+    G[k] = Vec3(row[k][0] - row[k][3], row[k][1] - row[k][3], row[k][2] - row[k][3]);
+    gk[k] = rk[k] - row[k][3] * rhs[2];
+  }
+  const Vec3 c12 = G[1].cross(G[2]), c20 = G[2].cross(G[0]), c01 = G[0].cross(G[1]);
+  const double det = G[0].dot(c12);
+  if (!(std::fabs(det) > 0.0)) return Status::Singular;  // a parallel singularity (also NaN)
+  const Vec3 F012 = (gk[0] * c12 + gk[1] * c20 + gk[2] * c01) / det;
+  const Vec4 F(F012[0], F012[1], F012[2], rhs[2] - F012[0] - F012[1] - F012[2]);
   if (!F.allFinite()) return Status::Singular;
   const Pack rho = lp.rho;
   if (kFull) {
@@ -181,7 +195,7 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
       o.leg_measure[i] = lanes::lane(measure, i);
       o.leg_measure_min = std::min(o.leg_measure_min, o.leg_measure[i]);
     }
-    o.J_rho = JrT.transpose();
+    for (int i = 0; i < kLegs; ++i) o.J_rho.row(i) << row[0][i], row[1][i], 1.0, row[2][i];
     o.F = F;
     o.tau = F / m.drive_ratio;
     o.beyond_stops = stops_passed(p, o.rho);
