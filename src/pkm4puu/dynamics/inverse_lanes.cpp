@@ -121,7 +121,11 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
   const Pack dM22 = 2.0 * k * s2 * c2;
   const double G0 = (p.m_slider + p.m_rod) * p.g;
   const Pack G2 = 0.5 * p.m_rod * p.g * l * c2;
-  const Pack tau0 = m00 * rdd + m02 * t2dd + dM13 * t2d * t2d + G0 - passive_lanes(p, lp.rho, rd);
+  // tau_i without the passive force: J_rho^T F = rhs - J_rho^T F_passive, so
+  // the total force on rho_i, F_i + F_passive,i, comes from the system and
+  // F_passive,i is subtracted from it alone. The multipliers then do not
+  // see the passive forces at all (to the bit: they do not depend on z, dz).
+  const Pack tau0 = m00 * rdd + m02 * t2dd + dM13 * t2d * t2d + G0;
   const Pack tau1 = m11 * t1dd + dM22 * t1d * t2d;
   const Pack tau2 = m02 * rdd + m22 * t2dd - 0.5 * dM22 * t1d * t1d + G2;
   // A_i^T tau_i summed over the legs; J_rho^T's columns (l00, l01, 1, a03).
@@ -150,15 +154,18 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
   const double rk[3] = {rhs[0], rhs[1], rhs[3]};
   Vec3 G[3];
   double gk[3];
-  for (int k = 0; k < 3; ++k) {
-    G[k] = Vec3(row[k][0] - row[k][3], row[k][1] - row[k][3], row[k][2] - row[k][3]);
-    gk[k] = rk[k] - row[k][3] * rhs[2];
+  for (int n = 0; n < 3; ++n) {
+    G[n] = Vec3(row[n][0] - row[n][3], row[n][1] - row[n][3], row[n][2] - row[n][3]);
+    gk[n] = rk[n] - row[n][3] * rhs[2];
   }
   const Vec3 c12 = G[1].cross(G[2]), c20 = G[2].cross(G[0]), c01 = G[0].cross(G[1]);
   const double det = G[0].dot(c12);
   if (!(std::fabs(det) > 0.0)) return Status::Singular;  // a parallel singularity (also NaN)
   const Vec3 F012 = (gk[0] * c12 + gk[1] * c20 + gk[2] * c01) / det;
-  const Vec4 F(F012[0], F012[1], F012[2], rhs[2] - F012[0] - F012[1] - F012[2]);
+  const Vec4 Ft(F012[0], F012[1], F012[2], rhs[2] - F012[0] - F012[1] - F012[2]);  // F + F_passive
+  const Pack passive = passive_lanes(p, lp.rho, rd);
+  const Vec4 F(Ft[0] - lanes::lane(passive, 0), Ft[1] - lanes::lane(passive, 1), Ft[2] - lanes::lane(passive, 2),
+               Ft[3] - lanes::lane(passive, 3));
   if (!F.allFinite()) return Status::Singular;
   const Pack rho = lp.rho;
   if (kFull) {
@@ -166,16 +173,16 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
     // leg_inverse_kinematics' theta1 = atan2(qy, qx) + atan2(h', A) lies in
     // (-pi, 3 pi/2]: atan2(s1, c1) + 2 pi where that is below 0 and qy is not.
     const Pack th1 = atan2_lanes(s1, c1), th2 = atan2_lanes(s2, c2);  // theta2 in (-pi/2, 0): elbow-down
-    // Leg i's rows of Eq. 1: lambda_i = L_i^{-T} (F_i e_0 - tau_i) (Eq. 10).
-    const Pack v0 = lanes::pack(F[0], F[1], F[2], F[3]) - tau0;
+    // Leg i's rows of Eq. 1: lambda_i = L_i^{-T} ((F_i + F_passive,i) e_0 - tau_i) (Eq. 10).
+    const Pack v0 = lanes::pack(Ft[0], Ft[1], Ft[2], Ft[3]) - tau0;
     const Pack lam0 = l00 * v0 - l10 * tau1 - l20 * tau2, lam1 = l01 * v0 - l11 * tau1 - l21 * tau2;
     for (int i = 0; i < kLegs; ++i) {
-      const int k = leg_offset(i);
+      const int at = leg_offset(i);
       double t1 = lanes::lane(th1, i);
       if (!std::signbit(lanes::lane(lp.qy, i)) && t1 < 0.0) t1 += 6.283185307179586;
-      o.q.segment<3>(k) << lanes::lane(rho, i), t1, lanes::lane(th2, i);
-      o.qd.segment<3>(k) << lanes::lane(rd, i), lanes::lane(t1d, i), lanes::lane(t2d, i);
-      o.qdd.segment<3>(k) << lanes::lane(rdd, i), lanes::lane(t1dd, i), lanes::lane(t2dd, i);
+      o.q.segment<3>(at) << lanes::lane(rho, i), t1, lanes::lane(th2, i);
+      o.qd.segment<3>(at) << lanes::lane(rd, i), lanes::lane(t1d, i), lanes::lane(t2d, i);
+      o.qdd.segment<3>(at) << lanes::lane(rdd, i), lanes::lane(t1dd, i), lanes::lane(t2dd, i);
       o.lambda.segment<3>(3 * i) << lanes::lane(lam0, i), lanes::lane(lam1, i), lanes::lane(v0, i);
     }
     o.q.segment<4>(kPlatform) = pc.pose;

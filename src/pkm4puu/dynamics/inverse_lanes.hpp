@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// Inverse dynamics in reduced, leg-partitioned form (docs/model.md,
-// "Inverse dynamics"). With qd_i = A_i pd and qdd_i = A_i pdd + b_i
+// Inverse dynamics (Eqs. 10-11) in reduced, leg-partitioned form. With
+// qd_i = A_i pd and qdd_i = A_i pdd + b_i
 // (reduced_dynamics.hpp), projecting Eq. 1 on B = [A_1; ...; A_4; I4]
 // removes lambda and leaves four equations for the four forces:
 //   J_rho^T F = sum_i A_i^T tau_i + M_p pdd + V_p + G_p - we,
