@@ -223,7 +223,15 @@ __attribute__((target("avx"))) Status inverse_legs_avx(const Model& m, const Pla
 Status reduced_inverse(const Model& m, const Pose& pose, const Pose& pd, const Pose& pdd, const Wrench& we,
                        InverseDynamicsResult* full, InverseActuators* act) {
   if (!pose.allFinite() || !pd.allFinite() || !pdd.allFinite() || !we.allFinite()) return Status::NonFinite;
-  const PlatformConfig pc = platform_config(pose);
+  PlatformConfig pc;
+#if defined(__GLIBC__)
+  // platform_config's cos and sin in one call (glibc's sincos: the same
+  // values), which the FMU's link-time optimisation does not always fuse.
+  pc.pose = pose;
+  ::sincos(pose[3], &pc.sphi, &pc.cphi);
+#else
+  pc = platform_config(pose);
+#endif
 #if PKM_INVERSE_AVX_DISPATCH
   if (m.avx)
     return full ? inverse_legs_avx<true>(m, pc, pd, pdd, we, full, nullptr)
