@@ -151,6 +151,11 @@ struct Bench {
     const size_t u = static_cast<size_t>(j);
     return pkm::inverse_dynamics(model, gp[u], gpd[u], gpdd[u], Wrench::Zero(), r, warm);
   }
+  /// The general path (servo constraints, Newton) at grid point j.
+  Status general_at(long j, pkm::InverseDynamicsResult& r, bool warm) const {
+    const size_t u = static_cast<size_t>(j);
+    return pkm::inverse_dynamics_general(model, gp[u], gpd[u], gpdd[u], Wrench::Zero(), r, warm);
+  }
 };
 
 /// Everything the sections share; false (with the reason on stderr) if the
@@ -408,8 +413,14 @@ double regressor_section(Bench& b) {
 }
 
 // ------------------------------------------------------- 2. inverse dynamics
+// The reduced path (inverse_dynamics: closed-form leg inverse kinematics,
+// the leg-partitioned reduced system, no iteration) against one forward
+// state derivative, and the general path (inverse_dynamics_general: Newton
+// on the servo constraints, Eqs. 10-11 in full) it replaced.
+constexpr double kInverseTarget = 1.0, kInverseStretch = 0.5;  // x one state derivative
+
 struct InverseDynamicsFigures {
-  Figure cold, warm, same, stages;
+  Figure reduced, actuators, stages, general_cold, general_warm;
 };
 
 /// Newton iterations of solve_position at grid point `mid`: from the closed
@@ -433,8 +444,43 @@ InverseDynamicsFigures inverse_dynamics_section(Bench& b, const Figure& sd) {
   pkm::InverseDynamicsResult r;
   {
     long j = 0;
-    f.cold = time_checked(b, "inverse_dynamics (cold)", [&](double& acc) {
+    f.reduced = time_checked(b, "inverse_dynamics", [&](double& acc) {
       const Status s = b.inverse_at(j, r, false);
+      j = (j + 1) % b.n_grid;
+      acc += r.F[0];
+      return s;
+    });
+  }
+  {
+    long j = 0;
+    pkm::InverseActuators a;
+    f.actuators = time_checked(b, "inverse_actuators", [&](double& acc) {
+      const size_t u = static_cast<size_t>(j);
+      const Status s = pkm::inverse_actuators(b.model, b.gp[u], b.gpd[u], b.gpdd[u], Wrench::Zero(), a);
+      j = (j + 1) % b.n_grid;
+      acc += a.F[0];
+      return s;
+    });
+  }
+  {
+    // The RK4 round trip's sequence of stage times (what PathForces sees):
+    // t_k, t_k + h/2, t_k + h/2, t_k + h, then t_k + h again as the next step's
+    // first stage: grid indices 2k, 2k+1, 2k+1, 2k+2, 2k+2, 2k+3, ...
+    long c = 0;
+    f.stages = time_checked(b, "inverse_dynamics (stage sequence)", [&](double& acc) {
+      const long m = c % (4 * b.n_out);  // one pass over the 2 s = 4 * 2000 calls
+      ++c;
+      const long step = m / 4, stage = m % 4;
+      const long j = 2 * step + (stage == 0 ? 0 : stage == 3 ? 2 : 1);
+      const Status s = b.inverse_at(j, r, m != 0);
+      acc += r.F[0];
+      return s;
+    });
+  }
+  {
+    long j = 0;
+    f.general_cold = time_checked(b, "inverse_dynamics_general (cold)", [&](double& acc) {
+      const Status s = b.general_at(j, r, false);
       j = (j + 1) % b.n_grid;
       acc += r.F[0];
       return s;
@@ -443,67 +489,39 @@ InverseDynamicsFigures inverse_dynamics_section(Bench& b, const Figure& sd) {
   {
     // Ping-pong along the grid so that every warm start is the neighbour 0.5 ms away.
     long j = 0, dir = 1;
-    const Status seed = b.inverse_at(0, r, false);
-    f.warm = time_checked(
-        b, "inverse_dynamics (warm)",
+    const Status seed = b.general_at(0, r, false);
+    f.general_warm = time_checked(
+        b, "inverse_dynamics_general (warm)",
         [&](double& acc) {
           if (j + dir < 0 || j + dir >= b.n_grid) dir = -dir;
           j += dir;
-          const Status s = b.inverse_at(j, r, true);
-          acc += r.F[0];
-          return s;
-        },
-        seed);
-  }
-  {
-    // Warm start from the same point again (RK4 asks twice at t + h/2 and at
-    // t + h): the point t = 1 s over and over, seeded once.
-    const Status seed = b.inverse_at(b.n_out, r, false);
-    f.same = time_checked(
-        b, "inverse_dynamics (warm, same point)",
-        [&](double& acc) {
-          const Status s = b.inverse_at(b.n_out, r, true);
-          acc += r.F[0];
-          return s;
-        },
-        seed);
-  }
-  {
-    // The RK4 round trip's sequence of stage times (what PathForces sees):
-    // t_k, t_k + h/2, t_k + h/2, t_k + h, then t_k + h again as the next step's
-    // first stage: grid indices 2k, 2k+1, 2k+1, 2k+2, 2k+2, 2k+3, ...
-    long c = 0;
-    const Status seed = b.inverse_at(0, r, false);
-    f.stages = time_checked(
-        b, "inverse_dynamics (stage sequence)",
-        [&](double& acc) {
-          const long m = c % (4 * b.n_out);  // one pass over the 2 s = 4 * 2000 calls
-          ++c;
-          const long step = m / 4, stage = m % 4;
-          const long j = 2 * step + (stage == 0 ? 0 : stage == 3 ? 2 : 1);
-          // at the wrap (back to t = 0) the start is far: take the closed form there
-          const Status s = b.inverse_at(j, r, m != 0);
+          const Status s = b.general_at(j, r, true);
           acc += r.F[0];
           return s;
         },
         seed);
   }
   const std::array<int, 2> it = newton_iterations(b, static_cast<size_t>(b.n_out));  // t = 1 s
+  const double ratio = f.reduced.median / sd.median;
 
-  std::printf("2. Inverse dynamics: one pkm::inverse_dynamics on the stage-time grid (t = j*0.5 ms, 4001 points)\n");
-  std::printf("   %-34s %12s %12s %10s %12s %8s\n", "start", "median/call", "min/call", "N/batch", "vs sd(LegP)",
+  std::printf("2. Inverse dynamics: one call per point of the stage-time grid (t = j*0.5 ms, 4001 points)\n");
+  std::printf("   %-44s %12s %12s %10s %12s %8s\n", "evaluation", "median/call", "min/call", "N/batch", "vs sd(LegP)",
               "Newton it");
   auto row = [&](const char* name, const Figure& x, const std::string& iterations) {
-    std::printf("   %-34s %12s %12s %10ld %11.2fx %8s\n", name, fmt_time(x.median).c_str(), fmt_time(x.min).c_str(),
+    std::printf("   %-44s %12s %12s %10ld %11.2fx %8s\n", name, fmt_time(x.median).c_str(), fmt_time(x.min).c_str(),
                 x.per_batch, x.median / sd.median, iterations.c_str());
   };
-  row("cold (closed-form start)", f.cold, std::to_string(it[0]));
-  row("warm (previous point, 0.5 ms away)", f.warm, std::to_string(it[1]));
-  row("warm (the same point again)", f.same, "0");
-  row("warm, RK4 stage sequence [**]", f.stages, "2/0");
+  row("inverse_dynamics (reduced: q, qd, qdd, F, lambda)", f.reduced, "-");
+  row("inverse_actuators (reduced: F, tau, rho, rhod)", f.actuators, "-");
+  row("inverse_dynamics, RK4 stage sequence [**]", f.stages, "-");
+  row("inverse_dynamics_general, cold (closed form)", f.general_cold, std::to_string(it[0]));
+  row("inverse_dynamics_general, warm (0.5 ms away)", f.general_warm, std::to_string(it[1]));
+  std::printf("   target: inverse_dynamics / sd(LegP) = %.2fx <= %gx: %s (stretch <= %gx: %s); "
+              "general cold / reduced = %.1fx\n",
+              ratio, kInverseTarget, ok_mark(ratio, kInverseTarget), kInverseStretch, ok_mark(ratio, kInverseStretch),
+              f.general_cold.median / f.reduced.median);
   std::printf("   (Newton it = iterations of solve_position at t = 1 s, residual tolerance 1e-14)\n");
-  std::printf("   [**] t_k, t_k+h/2, t_k+h/2, t_k+h, t_k+h, ... as PathForces sees them in the RK4 round trip:\n");
-  std::printf("        every other call is a repeat of the previous point.\n");
+  std::printf("   [**] t_k, t_k+h/2, t_k+h/2, t_k+h, t_k+h, ... as PathForces sees them in the RK4 round trip.\n");
   rule();
   return f;
 }
@@ -812,9 +830,11 @@ void ratios_section(const StateDerivativeFigures& sd, double jac_ratio, double r
   std::printf("Machine-independent ratios (medians)\n");
   std::printf("   sd(NullSpaceQR) / sd(LegPartitioned)                 %8.2f\n", sd[1].median / sd0);
   std::printf("   sd(Augmented)   / sd(LegPartitioned)                 %8.2f\n", sd[2].median / sd0);
-  std::printf("   ID / sd(LegP): cold, warm 0.5 ms, same point, [**]   %8.2f %8.2f %8.2f %8.2f\n",
-              id.cold.median / sd0, id.warm.median / sd0, id.same.median / sd0, id.stages.median / sd0);
-  std::printf("   ID warm (0.5 ms away) / ID cold                      %8.2f\n", id.warm.median / id.cold.median);
+  std::printf("   ID / sd(LegP): reduced, actuators only, [**]         %8.2f %8.2f %8.2f   (target <= %g, stretch %g)\n",
+              id.reduced.median / sd0, id.actuators.median / sd0, id.stages.median / sd0, kInverseTarget,
+              kInverseStretch);
+  std::printf("   ID general / sd(LegP): cold, warm 0.5 ms             %8.2f %8.2f\n", id.general_cold.median / sd0,
+              id.general_warm.median / sd0);
   std::printf("   Jacobians A, B / sd(LegP) (same run, item 1b)        %8.2f   (target <= 3)\n", jac_ratio);
   std::printf("   regressor / ID cold (same run, item 1c)              %8.2f   (target <= 2)\n", reg_ratio);
   std::printf("   RK4 forward run / (8000 x sd(LegP))                  %8.2f   (integrator + input overhead)\n",

@@ -12,9 +12,8 @@ void path_forces(void* user, double t, Vec4& F, Wrench& we) {
   Pose p, pd, pdd;
   pf->path.eval(t, p, pd, pdd);
   we.setZero();
-  // Started from the closed form, Newton meets its stopping rule at once;
-  // a warm start from the previous stage would cost two iterations.
-  const Status s = inverse_dynamics(*pf->model, p, pd, pdd, we, pf->id, /*warm_start=*/false);
+  // The reduced inverse dynamics: closed-form legs, no iteration.
+  const Status s = inverse_dynamics(*pf->model, p, pd, pdd, we, pf->id);
   if (s != Status::Ok) {
     pf->status = s;
     F.setConstant(std::numeric_limits<double>::quiet_NaN());  // makes the step fail visibly

@@ -55,6 +55,10 @@ class ModelData {
   /// From t to t + h (t is the current time). On return t_reached is the last
   /// time the state is valid for: t + h for OK, the last good point for Discard.
   virtual Status do_step(Context& ctx, double t, double h, double& t_reached) = 0;
+  /// Whether do_step may change anything but the time or answer Discard: if
+  /// not (an algebraic model), FMI 3.0's DoStep need not save the state at
+  /// the call to go back to.
+  virtual bool step_has_effects() const { return true; }
   /// GetFMUState: the state was saved here. A model whose integrator carries
   /// history across steps that the saved state does not hold restarts it at
   /// the next step, as a run restored from the state will: both continue

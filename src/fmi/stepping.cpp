@@ -109,7 +109,8 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
   // FMI 3.0.2 4.2.3: a Discard leaves the FMU in the state before the call.
   // The model keeps only its last good point (RK4: the last whole step), so
   // the state at the call is kept here (a buffer sized at initialisation).
-  if (version_ == 3) save(step_start_);
+  const bool rollback = version_ == 3 && data_->step_has_effects();
+  if (rollback) save(step_start_);
   // The model integrates from elapsed_ by h; the reported time follows the
   // master's t + h.
   double reached = elapsed_;
@@ -125,7 +126,7 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
       if (version_ == 3) {
         // Back to the state at the call, still in Step Mode: the importer may
         // retry with other inputs or a shorter step.
-        if (!load(step_start_.data(), step_start_.size(), fn, false)) {
+        if (rollback && !load(step_start_.data(), step_start_.size(), fn, false)) {
           mode_ = kError;
           return Status::Error;
         }

@@ -9,6 +9,10 @@
 
 namespace pkm_fmi {
 
+// A get or set looks each value reference up once: the first this many
+// (every control tick's) are kept on the stack, beyond them found again.
+constexpr std::size_t kFoundCache = 32;
+
 const Variable* Instance::lookup(const char* function, VarType type, std::uint32_t vr) {
   const Variable* v = def_.find(vr);
   if (!v || v->type != type || (!v->value && v->causality != Causality::Independent)) {
@@ -42,9 +46,11 @@ Status Instance::get_values(const char* function, VarType type, const std::uint3
     return Status::Error;
   }
   unsigned needed = 0;  // the output groups this call reads
+  const Variable* found[kFoundCache];  // the first loop's look-ups, reused by the second
   for (std::size_t k = 0; k < n; ++k) {
     const Variable* v = lookup(function, type, vr[k]);
     if (!v) return Status::Error;
+    if (k < kFoundCache) found[k] = v;
     // Before initialisation only start values exist (FMI 3.0.2 2.3.2).
     if (mode_ == kInstantiated && !v->has_start()) {
       log_.error("%s: %s has no start value: it is computed from %s on; the call has no effect", function, v->name,
@@ -61,7 +67,7 @@ Status Instance::get_values(const char* function, VarType type, const std::uint3
     if (s == Status::Error || s == Status::Fatal) return s;
   }
   for (std::size_t k = 0; k < n; ++k) {
-    const Variable* v = def_.find(vr[k]);
+    const Variable* v = k < kFoundCache ? found[k] : def_.find(vr[k]);
     value[k] = v->causality == Causality::Independent ? static_cast<T>(time_) : *static_cast<T*>(v->value(*data_, v->index));
   }
   return s;
@@ -83,9 +89,11 @@ Status Instance::set_values(const char* function, VarType type, const std::uint3
   const bool states_settable = interface_ == Interface::ModelExchange && (mode_ & kSetStatesByReference);
   bool sets_states = false;
   // Check everything first: a rejected call changes nothing.
+  const Variable* found[kFoundCache];  // the checks' look-ups, reused to write
   for (std::size_t k = 0; k < n; ++k) {
     const Variable* v = lookup(function, type, vr[k]);
     if (!v) return Status::Error;
+    if (k < kFoundCache) found[k] = v;
     const bool as_state = states_settable && v->state >= 0 && v->value;
     sets_states = sets_states || as_state;
     if (!as_state && (!v->stored_in_state() || v->variability == Variability::Constant || !v->value)) {
@@ -125,7 +133,7 @@ Status Instance::set_values(const char* function, VarType type, const std::uint3
     if (s != Status::OK) return s;
   }
   for (std::size_t k = 0; k < n; ++k) {
-    const Variable* v = def_.find(vr[k]);
+    const Variable* v = k < kFoundCache ? found[k] : def_.find(vr[k]);
     if (sets_states && v->state >= 0) {
       if (log_.enabled(LogCategory::Calls)) log_.call("%s: %s = %.17g (state)", function, v->name, static_cast<double>(value[k]));
       continue;

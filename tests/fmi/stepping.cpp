@@ -2,7 +2,8 @@
 // Communication steps of the FMU binaries through the raw FMI 2.0
 // functions: the static forces hold the home pose (CVODE and RK4), a failed
 // step is discarded with the last good state kept, input derivatives are
-// interpolated within a step, the inverse FMU's static forces and its
+// interpolated within a step, the inverse FMU's static forces, its output
+// groups (the same values whichever is read first) and its
 // refusal of unreachable poses; bad, overflowing, vanishing, too long and
 // past-stopTime steps, huge finite inputs, and the motion's independence of
 // the start time.
@@ -16,6 +17,7 @@
 #include "fmi2FunctionTypes.h"
 #include "fmu_fixture.hpp"
 #include "models/models.hpp"
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
 
 namespace {
 
@@ -185,6 +187,62 @@ TEST_F(Stepping, InverseAtRestAtHomeGivesTheStaticForces) {
   ASSERT_EQ(zero_g.set("g", 0.0), fmi2OK);
   zero_g.initialize();
   for (int i = 1; i <= 4; ++i) EXPECT_NEAR(zero_g.get("F[" + std::to_string(i) + "]"), 0.0, 1e-15);
+}
+
+TEST_F(Stepping, InverseOutputGroupsAgreeWhicheverIsReadFirst) {
+  // The outputs are computed by group, each on the first get that reads it
+  // (forces; multipliers; condition number): read alone, in either order or
+  // all at once after an input changed, each is the same, bit for bit, and
+  // the forces and multipliers are the general path's (Newton on the servo
+  // constraints, Eqs. 10-11 in full) to 1e-12.
+  const char* in[16] = {"x", "y", "z", "phi", "dx", "dy", "dz", "dphi",
+                        "ddx", "ddy", "ddz", "ddphi", "Fe[1]", "Fe[2]", "Fe[3]", "Me_z"};
+  const double u[16] = {0.004, -0.003, 0.062, 0.05, 0.02, -0.01, 0.03, 0.2,
+                        0.5, -0.3, 0.8, 4.0, 0.1, -0.2, 0.3, 0.01};
+  std::vector<std::string> names;
+  for (int i = 1; i <= 4; ++i) names.push_back(force_name(i));
+  for (int i = 1; i <= 12; ++i) names.push_back("lambda[" + std::to_string(i) + "]");
+  names.push_back("jacobian_condition");
+  FmuLibrary& ilib = inverse_library();
+  auto read = [&](InverseFmu& f, const std::vector<int>& which) {
+    std::vector<fmi2ValueReference> vr;
+    for (int k : which) vr.push_back(f.vr(names[static_cast<size_t>(k)]));
+    std::vector<double> v(vr.size(), -1.0);
+    EXPECT_EQ(ilib.fmi2GetReal(f.c, vr.data(), vr.size(), v.data()), fmi2OK) << f.log.dump();
+    return v;
+  };
+  std::vector<int> all(names.size()), forces = {0, 1, 2, 3}, lambda, condition = {16};
+  for (size_t k = 0; k < names.size(); ++k) all[k] = static_cast<int>(k);
+  for (int k = 4; k < 16; ++k) lambda.push_back(k);
+  InverseFmu a("a"), b("b"), c("c");
+  for (InverseFmu* f : {&a, &b, &c}) {
+    f->initialize();
+    (void)read(*f, all);  // at the start values: every group valid
+    for (int k = 0; k < 16; ++k) ASSERT_EQ(f->set(in[k], u[k]), fmi2OK);
+  }
+  const std::vector<double> together = read(a, all);
+  const std::vector<double> lam_b = read(b, lambda), cond_b = read(b, condition), F_b = read(b, forces);
+  const std::vector<double> F_c = read(c, forces), cond_c = read(c, condition), lam_c = read(c, lambda);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(F_b[static_cast<size_t>(k)], together[static_cast<size_t>(k)]);
+    EXPECT_EQ(F_c[static_cast<size_t>(k)], together[static_cast<size_t>(k)]);
+  }
+  for (int k = 0; k < 12; ++k) {
+    EXPECT_EQ(lam_b[static_cast<size_t>(k)], together[static_cast<size_t>(4 + k)]);
+    EXPECT_EQ(lam_c[static_cast<size_t>(k)], together[static_cast<size_t>(4 + k)]);
+  }
+  EXPECT_EQ(cond_b[0], together[16]);
+  EXPECT_EQ(cond_c[0], together[16]);
+  pkm::Model m;
+  ASSERT_EQ(pkm::make_model(pkm::Params{}, m), pkm::Status::Ok);
+  pkm::InverseDynamicsResult g;
+  ASSERT_EQ(pkm::inverse_dynamics_general(m, pkm::Pose(u[0], u[1], u[2], u[3]), pkm::Pose(u[4], u[5], u[6], u[7]),
+                                          pkm::Pose(u[8], u[9], u[10], u[11]), pkm::Wrench(u[12], u[13], u[14], u[15]),
+                                          g),
+            pkm::Status::Ok);
+  const double F_scale = g.F.cwiseAbs().maxCoeff(), lam_scale = g.lambda.cwiseAbs().maxCoeff();
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(together[static_cast<size_t>(k)], g.F[k], 1e-12 * F_scale);
+  for (int k = 0; k < 12; ++k) EXPECT_NEAR(together[static_cast<size_t>(4 + k)], g.lambda[k], 1e-12 * lam_scale);
 }
 
 TEST_F(Stepping, InverseRejectsAnUnreachablePoseWithoutNaN) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 #include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
 #include "pkm4puu/kinematics/constraints.hpp"
@@ -34,50 +35,71 @@ Status InverseData::exit_initialization(Context& ctx) {
   return Status::OK;
 }
 
-const pkm::Model* InverseData::current_model(Context& ctx, const char* function, pkm::Model& temporary) const {
-  if (ctx.initialization_mode) return make(ctx, function, temporary) == Status::OK ? &temporary : nullptr;
+const pkm::Model* InverseData::current_model(Context& ctx, const char* function,
+                                             std::optional<pkm::Model>& temporary) const {
+  if (ctx.initialization_mode) return make(ctx, function, temporary.emplace()) == Status::OK ? &*temporary : nullptr;
   if (!model) ctx.log.error("%s: outputs not available (initialisation did not succeed)", function);
   return model.get();
 }
 
-Status InverseData::update_outputs(Context& ctx, unsigned) {  // one group: everything
-  pkm::Model temporary;
+Status InverseData::update_outputs(Context& ctx, unsigned groups) {
+  std::optional<pkm::Model> temporary;
   const pkm::Model* m = current_model(ctx, "get", temporary);
   if (!m) return Status::Error;
   const pkm::Pose p(pose[0], pose[1], pose[2], pose[3]);
   const pkm::Pose pd(vel[0], vel[1], vel[2], vel[3]);
   const pkm::Pose pdd(acc[0], acc[1], acc[2], acc[3]);
   const pkm::Wrench we(wrench[0], wrench[1], wrench[2], wrench[3]);
-  pkm::GuardReport guard;
-  if (pkm::check_configuration(*m, p, limits, &guard) == pkm::Status::Singular) {
+  auto beyond_guard = [&](const pkm::GuardReport& guard) {
     ctx.log.discard("get: the requested pose x = %.17g m, y = %.17g m, z = %.17g m, phi = %.17g rad is beyond a "
                     "singularity guard: %s; the outputs keep their values of the last pose within the guards",
                     pose[0], pose[1], pose[2], pose[3],
                     pkm::describe_configuration_failure(*m, p, limits, guard).c_str());
     return Status::Discard;
-  }
-  pkm::InverseDynamicsResult r;
-  const pkm::Status s = pkm::inverse_dynamics(*m, p, pd, pdd, we, r, /*warm_start=*/false);
-  if (s != pkm::Status::Ok) {
+  };
+  auto failed = [&](pkm::Status s) {
+    // A singular pose is one beyond the guards (whose floor is the core's):
+    // Discard with the guard's reason, as for a pose the guards refuse.
+    pkm::GuardReport guard;
+    if (s == pkm::Status::Singular && pkm::check_configuration(*m, p, limits, &guard) == pkm::Status::Singular)
+      return beyond_guard(guard);
     ctx.log.error("get: inverse dynamics at x = %g m, y = %g m, z = %g m, phi = %g rad failed: %s "
                   "(outputs not written)",
                   pose[0], pose[1], pose[2], pose[3], pkm::status_name(s));
     return Status::Error;
+  };
+  // The forces first: their legs' Jacobian and measures serve the guards
+  // (check_jacobian), which every group passes before anything is written.
+  pkm::InverseActuators r;
+  const pkm::Status s = pkm::inverse_actuators(*m, p, pd, pdd, we, r);
+  if (s != pkm::Status::Ok) return failed(s);
+  {
+    pkm::Mat4 J = r.J_rho;
+    J.col(3) /= pkm::kConditionLength;
+    const pkm::Vec4 measure2 = r.leg_measure.cwiseProduct(r.leg_measure);
+    pkm::GuardReport guard;
+    if (pkm::check_jacobian(J, measure2, limits, &guard) == pkm::Status::Singular) return beyond_guard(guard);
   }
+  if (groups & kGroupMultipliers) {  // the whole reduced path, angles and lambda
+    pkm::InverseDynamicsResult full;
+    const pkm::Status sf = pkm::inverse_dynamics(*m, p, pd, pdd, we, full);
+    if (sf != pkm::Status::Ok) return failed(sf);
+    for (int k = 0; k < 12; ++k) lambda[k] = full.lambda[k];
+  }
+  if (groups & kGroupCondition) {  // the actuator Jacobian's SVD
+    pkm::Vec16 q;
+    const pkm::Status sq = pkm::closed_form_position(*m, p, q);
+    if (sq != pkm::Status::Ok) return failed(sq);
+    condition = pkm::actuator_jacobian_condition(*m, q);
+  }
+  if (!(groups & kGroupActuators)) return Status::OK;
   for (int i = 0; i < 4; ++i) {
-    const int o = pkm::leg_offset(i);
     F[i] = r.F[i];
     tau[i] = r.tau[i];
-    rho[i] = r.q[o];
-    drho[i] = r.qd[o];
+    rho[i] = r.rho[i];
+    drho[i] = r.rhod[i];
   }
-  for (int k = 0; k < 12; ++k) lambda[k] = r.lambda[k];
-  condition = pkm::actuator_jacobian_condition(*m, r.q);
-  leg_measure_min = 0.5;
-  for (int i = 0; i < 4; ++i) {
-    const double t2 = r.q[pkm::leg_offset(i) + 2];
-    leg_measure_min = std::min(leg_measure_min, std::fabs(std::cos(t2) * std::sin(t2)));
-  }
+  leg_measure_min = r.leg_measure_min;
   const unsigned entered = r.beyond_stops & ~beyond_stops;
   beyond_stops = r.beyond_stops;
   if (entered == 0) return Status::OK;
@@ -100,7 +122,7 @@ Status InverseData::update_outputs(Context& ctx, unsigned) {  // one group: ever
 Status InverseData::partial_derivatives(Context& ctx, const Variable* const unknowns[], std::size_t nu,
                                         const Variable* const knowns[], std::size_t nk, double J[]) {
   const char* fn = "GetDirectionalDerivative";
-  pkm::Model temporary;
+  std::optional<pkm::Model> temporary;
   const pkm::Model* m = current_model(ctx, fn, temporary);
   if (!m) return Status::Error;
   pkm::InverseDynamicsPartials d;

@@ -9,13 +9,13 @@
 // once per instance at the end of initialisation. Per instance
 // (InverseData): parameter and input values and the output cache.
 //
-// The position problem starts from the closed-form elbow-down inverse
-// kinematics every time (inverse_dynamics with warm_start = false), not
-// from the previous solution: the closed form is already exact (Newton
-// stops after 0 iterations), so this is faster than a warm start, cannot leave the elbow-down branch
-// after a jump of the inputs, and makes the outputs a pure function of the
-// current inputs and parameters (bit for bit, whatever was computed
-// before; nothing to carry in FMU states).
+// The legs' positions are the closed-form elbow-down inverse kinematics
+// (the reduced inverse dynamics, inverse_lanes.hpp: no iteration), so the
+// outputs are a pure function of the current inputs and parameters (bit
+// for bit, whatever was computed before; nothing to carry in FMU states).
+// Outputs are computed lazily by group (kGroup* below), each on the first
+// get that reads it after an input changed: reading the forces does not pay
+// for the multipliers or the Jacobian's condition number.
 //
 // The plant's singularity guards (workspace_guard.hpp, the same parameters
 // max_jacobian_condition and min_leg_measure): near a leg or parallel
@@ -25,6 +25,7 @@
 // within the guards; the outputs jacobian_condition and leg_measure_min tell
 // the master how close it is.
 #include <cstdint>
+#include <optional>
 
 #include "models/common/dependencies.hpp"
 #include "models/common/mechanism_parameters.hpp"
@@ -33,6 +34,13 @@
 namespace pkm_fmi {
 namespace pkm4puu_inverse_model {
 
+
+// The output groups (Variable::group).
+enum : std::uint8_t {
+  kGroupActuators = 1u << 0,    // F, tau, rho, drho, leg_measure_min: the reduced inverse dynamics
+  kGroupMultipliers = 1u << 1,  // lambda: the legs' angles and rows as well
+  kGroupCondition = 1u << 2,    // jacobian_condition: an SVD of the actuator Jacobian
+};
 
 struct InverseData final : MechanismData {
   // Inputs.
@@ -54,6 +62,7 @@ struct InverseData final : MechanismData {
     t_reached = t + h;  // no dynamics: the outputs follow the inputs
     return Status::OK;
   }
+  bool step_has_effects() const override { return false; }
   Status update_outputs(Context& ctx, unsigned groups) override;
   void save(StateWriter& w) const override;
   bool load(StateReader& r, Context& ctx) override;
@@ -63,9 +72,9 @@ struct InverseData final : MechanismData {
 
   Status make(Context& ctx, const char* function, pkm::Model& out) const;
   /// The model to evaluate with: the instance's, or in initialisation mode
-  /// one made into `temporary` from the current parameters; nullptr (logged)
-  /// if there is none.
-  const pkm::Model* current_model(Context& ctx, const char* function, pkm::Model& temporary) const;
+  /// one made into `temporary` (constructed only then) from the current
+  /// parameters; nullptr (logged) if there is none.
+  const pkm::Model* current_model(Context& ctx, const char* function, std::optional<pkm::Model>& temporary) const;
 };
 
 }  // namespace pkm4puu_inverse_model

@@ -38,6 +38,19 @@
 #endif
 #endif
 
+// x86-64 with GCC or Clang: the lane kernels compile an AVX variant beside
+// the SSE2 baseline, taken where Model::avx (make_model asks CPUID). On
+// Windows only with PKM_UNALIGNED_VECTOR_MOVES: MinGW-w64's GCC does not keep
+// the 32-byte stack alignment its aligned AVX spills assume (GCC PR 54412),
+// so the build has the assembler make every vector move unaligned
+// (CMakeLists.txt).
+#if PKM_LANES_VECTOR_EXTENSIONS && defined(__x86_64__) && !defined(__AVX__) && \
+    (!defined(_WIN32) || defined(PKM_UNALIGNED_VECTOR_MOVES))
+#define PKM_LANES_AVX_DISPATCH 1
+#else
+#define PKM_LANES_AVX_DISPATCH 0
+#endif
+
 // Every function here is inlined: GCC's note that a 32-byte vector is
 // passed differently with and without AVX (-Wpsabi) concerns no call. GCC
 // emits it at the end of the translation unit, so it is silenced for the

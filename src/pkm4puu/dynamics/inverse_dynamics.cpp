@@ -2,13 +2,14 @@
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 
 #include "pkm4puu/kinematics/constraints.hpp"
+#include "pkm4puu/dynamics/inverse_lanes.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
 #include "pkm4puu/machine/passive_force.hpp"
 
 namespace pkm {
 namespace {
 
-constexpr int kActuated[kLegs] = {0, 3, 6, 9};
+constexpr int kActuatedCoord[kLegs] = {0, 3, 6, 9};
 constexpr int kUnactuated[kM] = {1, 2, 4, 5, 7, 8, 10, 11, 12, 13, 14, 15};
 
 /// Eqs. 10-11; with `passive`, on top of the joints' passive forces.
@@ -34,7 +35,7 @@ Status forces(const Model& m, const Vec16& q, const Vec16& qd, const Vec16& qdd,
   if (!(std::abs(lu.determinant()) > 0.0)) return Status::Singular;
   lambda = lu.solve(rhs);  // Eq. 10
   for (int i = 0; i < kLegs; ++i) {
-    const int k = kActuated[i];
+    const int k = kActuatedCoord[i];
     F[i] = inertial[k] + Cq.col(k).dot(lambda);  // Eq. 11
     if (passive) F[i] -= passive_joint_force(m.p, q[k], qd[k]);
   }
@@ -56,9 +57,9 @@ Status holding_forces(const Model& m, const Vec16& q, const Wrench& we, Vec4& F)
   return forces(m, q, Vec16::Zero(), Vec16::Zero(), we, /*passive=*/false, F, lambda);
 }
 
-Status inverse_dynamics(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,
-                        const Wrench& we, InverseDynamicsResult& out, bool warm_start,
-                        const NewtonOptions& opt) {
+Status inverse_dynamics_general(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,
+                                const Wrench& we, InverseDynamicsResult& out, bool warm_start,
+                                const NewtonOptions& opt) {
   if (!pose.allFinite() || !pose_d.allFinite() || !pose_dd.allFinite() || !we.allFinite())
     return Status::NonFinite;
   Status s = Status::Ok;
@@ -79,6 +80,16 @@ Status inverse_dynamics(const Model& m, const Pose& pose, const Pose& pose_d, co
   s = actuator_forces(m, out.q, out.qd, out.qdd, we, out.F, out.lambda);
   out.tau = out.F / m.drive_ratio;
   return s;
+}
+
+Status inverse_dynamics(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,
+                        const Wrench& we, InverseDynamicsResult& out, bool, const NewtonOptions&) {
+  return reduced_inverse(m, pose, pose_d, pose_dd, we, &out, nullptr);
+}
+
+Status inverse_actuators(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,
+                         const Wrench& we, InverseActuators& out) {
+  return reduced_inverse(m, pose, pose_d, pose_dd, we, nullptr, &out);
 }
 
 }  // namespace pkm

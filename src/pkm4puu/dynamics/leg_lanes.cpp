@@ -8,18 +8,6 @@
 #include "pkm4puu/kinematics/actuator_positions.hpp"
 #include "pkm4puu/machine/passive_force.hpp"
 
-// x86-64 with GCC or Clang: an AVX variant of the legs' lanes beside the
-// SSE2 baseline, taken where Model::avx (make_model asks CPUID). On Windows
-// only with PKM_UNALIGNED_VECTOR_MOVES: MinGW-w64's GCC does not keep the
-// 32-byte stack alignment its aligned AVX spills assume (GCC PR 54412), so
-// the build has the assembler make every vector move unaligned
-// (CMakeLists.txt).
-#if PKM_LANES_VECTOR_EXTENSIONS && defined(__x86_64__) && !defined(__AVX__) && \
-    (!defined(_WIN32) || defined(PKM_UNALIGNED_VECTOR_MOVES))
-#define PKM_LANES_AVX_DISPATCH 1
-#else
-#define PKM_LANES_AVX_DISPATCH 0
-#endif
 
 namespace pkm {
 namespace {

@@ -4,13 +4,6 @@
 #include "pkm4puu/dynamics/leg_lanes_kernel.hpp"
 #include "pkm4puu/dynamics/reduced_dynamics.hpp"
 
-// The AVX variant beside the baseline, as leg_lanes.cpp.
-#if PKM_LANES_VECTOR_EXTENSIONS && defined(__x86_64__) && !defined(__AVX__) && \
-    (!defined(_WIN32) || defined(PKM_UNALIGNED_VECTOR_MOVES))
-#define PKM_LANES_AVX_DISPATCH 1
-#else
-#define PKM_LANES_AVX_DISPATCH 0
-#endif
 
 namespace pkm {
 namespace {

@@ -74,7 +74,6 @@ Status check_configuration(const Model& m, const Pose& pose, const GuardLimits& 
   GuardReport& r = report ? *report : local;
   r = GuardReport{};
   if (!pose.allFinite()) return r.status = Status::NonFinite;
-  const double min_measure = std::fmax(lim.min_leg_measure, kLegSingularFloor);
   Mat4 J;
   Vec4 measure2;
   const int unreachable = actuator_rows(m, pose, J, measure2);
@@ -82,6 +81,14 @@ Status check_configuration(const Model& m, const Pose& pose, const GuardLimits& 
     r.leg = unreachable;
     return r.status = Status::Unreachable;
   }
+  return check_jacobian(J, measure2, lim, &r);
+}
+
+Status check_jacobian(const Mat4& J, const Vec4& measure2, const GuardLimits& lim, GuardReport* report) {
+  GuardReport local;
+  GuardReport& r = report ? *report : local;
+  r = GuardReport{};
+  const double min_measure = std::fmax(lim.min_leg_measure, kLegSingularFloor);
   for (int i = 0; i < kLegs; ++i) {
     if (!(measure2[i] >= min_measure * min_measure)) {
       r.leg = i;

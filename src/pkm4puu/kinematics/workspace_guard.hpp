@@ -51,6 +51,12 @@ struct GuardReport {
 Status check_configuration(const Model& m, const Pose& pose, const GuardLimits& lim,
                            GuardReport* report = nullptr);
 
+/// check_configuration's checks on what a caller already has from the legs'
+/// inverse kinematics: J = d rho/d(x, y, z, phi) with its phi column divided
+/// by kConditionLength (constraints.hpp), measure2[i] = (cos theta2_i sin
+/// theta2_i)^2. Status::Ok or ::Singular, the report as check_configuration's.
+Status check_jacobian(const Mat4& J, const Vec4& measure2, const GuardLimits& lim, GuardReport* report = nullptr);
+
 /// A sentence for a failed check: which leg or the whole machine, which
 /// quantity, its value, the limit or the geometric reason, and the
 /// parameters involved.
