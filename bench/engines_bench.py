@@ -23,7 +23,7 @@ step, through
 For each: the median wall time per simulated second, the ratio of MuJoCo's
 time to it (how many times faster than MuJoCo), the largest ||C(q)|| over the
 whole 1.5 s test (the project's own constraint_residual, and ||C(q)|| from
-MODEL_SPEC's formula on the engines' coordinates), and the largest difference
+docs/model.md's formula on the engines' coordinates), and the largest difference
 from Pinocchio's tightly integrated reference (engine_comparison.py: DOP853,
 rtol 1e-13, exact forces).
 

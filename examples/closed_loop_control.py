@@ -3,7 +3,7 @@
 PKM4PUU.fmu along the spec's auto-test motion (2 s, P0 -> P1) while the plant
 is the machine, not the ideal mechanism: each prismatic joint has viscous and
 Coulomb friction, and the platform carries an off-centre payload
-(MODEL_SPEC "The machine around the mechanism").
+(docs/model.md "The machine around the mechanism").
 
 Every 1 ms, at t_k, the controller
   1. reads the plant's actuator positions and rates rho(t_k), drho(t_k)

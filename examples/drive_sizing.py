@@ -5,7 +5,7 @@ speed omega_i = 2 pi drho_i / p, drawn as operating points in the
 torque-speed plane beside a motor's limits, with the RMS torque against the
 rated torque.
 
-PKM4PUU_Inverse.fmu, given the machine's parameters (MODEL_SPEC "The machine
+PKM4PUU_Inverse.fmu, given the machine's parameters (docs/model.md "The machine
 around the mechanism"), reports besides F[1..4] the motor torques
 tau[1..4] = F_i p / (2 pi) that include gravity, the mechanism's dynamics,
 the rotors' inertia J (reflected mass J (2 pi / p)^2 per slider), the

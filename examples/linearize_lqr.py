@@ -11,7 +11,7 @@ closed_loop_control.py.
 2. The open-loop modes. At rest the rate terms vanish (the velocity forces
    are quadratic in the rates; the ideal machine has no friction), so
    A = [[0, I], [-M^-1 K, 0]] and its eigenvalues are +-i omega with omega^2
-   the eigenvalues of M^-1 K: the hanging machine oscillates (MODEL_SPEC
+   the eigenvalues of M^-1 K: the hanging machine oscillates (docs/model.md
    "Working mode": elbow-down, Hessian eigenvalues +307, +95, +1.3 and 0
    along z). Computed here independently of the FMU: K the Hessian of the
    potential U(p) = gravity - sum F_i rho_i over the pose, the legs from the
@@ -72,7 +72,7 @@ import closed_loop_control as clc  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-LEVER = 0.1  # m: phi as arc length at this lever (MODEL_SPEC's jacobian_condition convention)
+LEVER = 0.1  # m: phi as arc length at this lever (docs/model.md's jacobian_condition convention)
 F_HOLD = np.full(4, spec.STATIC_FORCE_P0)  # N: the spec's holding forces at P0
 U0 = np.concatenate([F_HOLD, np.zeros(8)])  # the plant's 12 inputs at the equilibrium
 Y0 = np.concatenate([spec.P0, np.zeros(4)])
@@ -108,7 +108,7 @@ def modes(A):
 
 # --- 2. the independent Hessian and mass matrix -------------------------------------------------
 def potential(pose, forces=F_HOLD):
-    """U(p) (J) of MODEL_SPEC "Working mode": gravity minus sum F_i rho_i, the
+    """U(p) (J) of docs/model.md "Working mode": gravity minus sum F_i rho_i, the
     legs by the spec's closed-form inverse kinematics (up to a constant)."""
     legs = spec.leg_inverse_kinematics(pose)
     rho, th2 = legs[:, 0], legs[:, 2]

@@ -5,7 +5,7 @@ run, as an animated GIF and as a still of several frames (like the paper's
 Fig. 7).
 
 Every point is computed from the CSV's joint values and pose with
-MODEL_SPEC's formulas (pkm4puu.validation.drawing.mechanism_points): the legs from the DH
+docs/model.md's formulas (pkm4puu.validation.drawing.mechanism_points): the legs from the DH
 chain of Table I (slider's U joint O2 at height rho + h on the prismatic axis
 through B_i, rod to O3 = O2 + l x3, offset h' along z3 to the leg's end Q_i),
 the platform from the pose (p + Rz(phi) r_Qi). The two meet where the loop
@@ -244,7 +244,7 @@ def main(argv=None):
         log(f"loop closure of the drawing (legs from joints vs platform from pose): max gap {gap:.2e} m")
         if gap > 1e-6:
             log(f"error: the legs and the platform do not meet (gap {gap:.3e} m): "
-                "is the CSV from this geometry (MODEL_SPEC defaults)?")
+                "is the CSV from this geometry (docs/model.md defaults)?")
             return 1
         log(f"rendering {args.frames} GIF frames")
         gif = write_gif(t, rows, args.out / "robot_motion.gif", n_frames=args.frames, fps=args.fps,

@@ -133,7 +133,7 @@ def system_structure(solver="cvode", lead=LEAD, h=H):
         f'      <ssd:Connection startElement="inverse" startConnector="{n}" endElement="plant" endConnector="{n}"/>'
         for n in F)
     return f"""<?xml version="1.0" encoding="UTF-8"?>
-<!-- The paper's auto-test (MODEL_SPEC "Auto-test") as a system: inverse dynamics -> forces -> forward
+<!-- The paper's auto-test (docs/model.md "The paper's two tests") as a system: inverse dynamics -> forces -> forward
      dynamics. The inverse FMU's motion inputs are unconnected: the master sets them every step
      (examples/ssp_cosim.py, libcosim's override manipulator); their values here are the initial ones. -->
 <ssd:SystemStructureDescription {xmlns} name="PKM4PUU_autotest" version="1.0">

@@ -45,7 +45,7 @@ from pkm4puu.validation.references.pinocchio_model import PinocchioPKM
 TOL = 1e-6  # the bound, relative per column (see above)
 TOL_SANITY = 1e-7  # Pinocchio's assembly against differences of its own ydot
 FLOOR = 1e-3  # a column's scale is at least this fraction of its block's largest entry
-LEVER = 0.1  # m: phi as arc length, Me_z as force (MODEL_SPEC's jacobian_condition convention)
+LEVER = 0.1  # m: phi as arc length, Me_z as force (docs/model.md's jacobian_condition convention)
 
 # The machine terms that act in free motion (the end stops stay untouched: every
 # state below has its sliders well inside [rho_min, rho_max]).

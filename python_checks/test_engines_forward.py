@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""Forward dynamics against Pinocchio, the spec's comparison test (MODEL_SPEC
+"""Forward dynamics against Pinocchio, the spec's comparison test (docs/model.md
 "Comparison test": g = 0, F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s), F2 = F3 = 0,
 1.5 s from rest at P0). The runners are in engine_comparison.py.
 

@@ -1,13 +1,13 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Inverse dynamics against Pinocchio (the issue's first requirement): along
-the spec's auto-test trajectory (MODEL_SPEC "Auto-test", gravity on), at every
+the spec's auto-test trajectory (docs/model.md "The paper's two tests", gravity on), at every
 1 ms sample of the 2 s, F1..F4 from this project's C API
 (pkm_inverse_dynamics) and from the inverse FMU must equal Pinocchio's
 (RNEA on the tree, then J^T lambda - S F = -tau for the 12 multipliers and
 4 forces; engines/pinocchio_model.py) within 1e-8 N.
 
 About 99% of each force is static weight and the dynamic part is ~0.013 N
-(MODEL_SPEC), so 1e-8 N is a test of the dynamics, not only of the statics.
+(docs/model.md), so 1e-8 N is a test of the dynamics, not only of the statics.
 """
 import numpy as np
 import pytest

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""The machine around the mechanism (MODEL_SPEC "The machine around the
+"""The machine around the mechanism (docs/model.md "The machine around the
 mechanism") checked against independent engines: rotor inertia, viscous
 friction, Coulomb friction and an off-centre payload, each alone and all together, on the spec's comparison test
 (1.5 s from rest at P0, F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s), F2 = F3 = 0).
@@ -82,7 +82,7 @@ def test_cases_cover_the_issue():
 
 def test_holding_forces_carry_the_payload():
     """The gravity cases start in equilibrium: Pinocchio's holding forces at P0
-    sum to the total weight, the payload's included (MODEL_SPEC's check plus
+    sum to the total weight, the payload's included (docs/model.md's check plus
     m_payload g); an off-centre payload's moment is carried by the legs'
     constraints, not the actuators (the platform cannot tilt)."""
     c = CASES["payload_gravity"]
@@ -197,7 +197,7 @@ def test_inverse_machine_matches_pinocchio(inverse_capi, inverse_pinocchio):
 
 
 def test_inverse_machine_motor_torques(inverse_capi, inverse_pinocchio):
-    """tau = F p / (2 pi) (MODEL_SPEC), from Pinocchio's F."""
+    """tau = F p / (2 pi) (docs/model.md), from Pinocchio's F."""
     tau_pin = inverse_pinocchio[0] * FULL.screw_lead / (2.0 * math.pi)
     d = np.abs(inverse_capi["tau"] - tau_pin).max()
     print(f"\nmotor torques vs Pinocchio's F p / (2 pi): {d:.3e} N m")

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """The independent engine models (engines/pinocchio_model.py, engines/mujoco_model.py)
-checked against MODEL_SPEC itself, never against this project, so that
+checked against docs/model.md itself, never against this project, so that
 test_engines_inverse.py and test_engines_forward.py compare the project with
 a trustworthy second implementation:
 
@@ -33,7 +33,7 @@ from pkm4puu.validation.references.pinocchio_model import PinocchioPKM
 
 RNG = np.random.default_rng(20261121)
 
-GOLDEN = [  # MODEL_SPEC "Golden poses": pose, then (rho, theta1, theta2) of legs 1..4
+GOLDEN = [  # docs/model.md "Bodies": pose, then (rho, theta1, theta2) of legs 1..4
     ((0.0, 0.0, 0.05, 0.0),
      [(0.0443193423, 3.2655932943, -0.8606121019), (0.0443193423, -1.3393164414, -0.8606121019),
       (0.0443193423, 3.2655932943, -0.8606121019), (0.0443193423, -1.3393164414, -0.8606121019)]),
@@ -52,7 +52,7 @@ def random_q():
 
 
 def spec_kinetic_energy(q, v):
-    """T summed body by body from MODEL_SPEC "Bodies" (nothing from Pinocchio)."""
+    """T summed body by body from docs/model.md "Bodies" (nothing from Pinocchio)."""
     T = 0.5 * spec.M_PLATFORM * v[12:15] @ v[12:15] + 0.5 * spec.IZZ_PLATFORM * v[15] ** 2
     for i in range(4):
         rho_d, th1, th2 = v[3 * i], q[3 * i + 1], q[3 * i + 2]
@@ -121,7 +121,7 @@ def test_gravity_is_the_spec_potential(pm):
 
 
 def test_static_check(pm):
-    """MODEL_SPEC "A check anyone can derive", from Pinocchio."""
+    """docs/model.md "Bodies", from Pinocchio."""
     F, _, _ = pm.inverse_dynamics(spec.P0, np.zeros(4), np.zeros(4))
     print(f"\nPinocchio: static forces at P0 {F} N")
     assert np.abs(F - spec.STATIC_FORCE_P0).max() < 1e-9
@@ -171,7 +171,7 @@ def test_capi_binding_matches_pkm_h(pkm_header):
     assert not bad, "\n".join(bad)
 
 
-# --- the machine around the mechanism in the engine models (MODEL_SPEC) --------------------------------------
+# --- the machine around the mechanism in the engine models (docs/model.md) --------------------------------------
 MACHINE = spec.Machine(screw_lead=0.005, rotor_inertia=6e-8, friction_viscous=0.5, friction_coulomb=0.005,
                        friction_velocity=2e-3, payload_mass=0.2, payload_com=(0.02, -0.015), payload_Izz=1.5e-4,
                        payload_z=-0.03, payload_Ixx=1.0e-4, payload_Iyy=1.2e-4)
@@ -180,7 +180,7 @@ MACHINE = spec.Machine(screw_lead=0.005, rotor_inertia=6e-8, friction_viscous=0.
 def spec_machine_kinetic_energy(q, v, mc):
     """T of the mechanism plus the rotors, 1/2 J (2 pi / p)^2 rhod_i^2 each, and
     the payload: 1/2 m |v_P + phid z x Rz(phi) c|^2 + 1/2 Izz phid^2
-    (MODEL_SPEC "Drives", "Payload"; nothing from the engines)."""
+    (docs/model.md "The machine around the mechanism", "Payload"; nothing from the engines)."""
     T = spec_kinetic_energy(q, v)
     gear = 2.0 * math.pi / mc.screw_lead
     T += sum(0.5 * mc.rotor_inertia * (gear * v[3 * i]) ** 2 for i in range(4))

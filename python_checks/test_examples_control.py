@@ -22,7 +22,7 @@ def runs(plant_fmu, inverse_fmu):
 
 def vertical_momentum(drho, dz):
     """The machine's vertical momentum (kg m/s) from the actuator rates and
-    the platform's vertical rate (MODEL_SPEC "Bodies"): sliders move with
+    the platform's vertical rate (docs/model.md "Bodies"): sliders move with
     drho_i; each rod's centre is the midpoint of O2 (height rho_i + h) and
     O3, and O3 is at the platform's height (Q = O3 + h' z3 with z3
     horizontal), so it moves with (drho_i + dz) / 2; platform and payload
@@ -47,7 +47,7 @@ def test_friction_compensation_cuts_the_rms_error(runs, results_dir):
 
 def test_compensation_is_the_spec_friction_along_the_desired_motion(runs):
     """The two feed-forwards differ only by the inverse FMU's friction
-    parameters, so their difference is MODEL_SPEC's friction law at the
+    parameters, so their difference is docs/model.md's friction law at the
     desired rates, b drho_d + F_c tanh(drho_d / v_s), to rounding."""
     runs, _ = runs
     ff, nofric = runs["ff"], runs["ff_nofric"]

@@ -32,7 +32,7 @@ def test_at_rest_the_linearisation_is_a_stiffness(study):
 
 
 def test_hessian_is_the_spec_working_mode(study):
-    """MODEL_SPEC "Working mode": elbow-down, the potential's Hessian at home
+    """docs/model.md "Working mode": elbow-down, the potential's Hessian at home
     has eigenvalues +307, +95, +1.3 and 0 along z (the spec's rounding), and
     the spec's holding forces make P0 an equilibrium (the gradient vanishes
     to the 1e-9 N of the spec's 10 digits)."""

@@ -55,7 +55,7 @@ def test_sweep_results_are_physical(serial, results_dir):
     by = {(r.payload, r.duration): r for r in serial}
     for r in serial:
         assert r.max_pos_err <= TOL_POS, r
-        assert np.isfinite(r.worst_condition) and 1.0 <= r.worst_condition < 26.0, r  # MODEL_SPEC: below 26
+        assert np.isfinite(r.worst_condition) and 1.0 <= r.worst_condition < 26.0, r  # docs/model.md: below 26
     for T in DURATIONS:  # heavier payload, larger peak force
         peaks = [by[(m, T)].peak_force for m in MASSES]
         assert peaks == sorted(peaks) and peaks[0] < peaks[-1]

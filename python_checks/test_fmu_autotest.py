@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""The paper's auto-test (Fig. 4, MODEL_SPEC "Auto-test") through the FMUs:
+"""The paper's auto-test (Fig. 4, docs/model.md "The paper's two tests") through the FMUs:
 the inverse FMU turns the prescribed motion into F1..F4(t); the plant FMU,
 driven open loop by those forces at a 1 ms communication step for 2 s, must
 reproduce the prescribed pose.
@@ -42,7 +42,7 @@ def runs(plant_fmu, half_step_table):
 
 
 def test_inverse_fmu_static_check(inverse_fmu):
-    """MODEL_SPEC: at rest at P0 each actuator carries 2.655616050 N; the four
+    """docs/model.md: at rest at P0 each actuator carries 2.655616050 N; the four
     sum to the total weight 10.622464200 N."""
     with Fmu(inverse_fmu) as inv:
         forces = inverse_forces(inv, [-1.0])[0]  # before the motion: at rest at P0
@@ -50,7 +50,7 @@ def test_inverse_fmu_static_check(inverse_fmu):
     assert abs(forces.sum() - TOTAL_WEIGHT) <= 1e-9, f"sum F = {forces.sum():.12f} N"
 
 
-# MODEL_SPEC "Golden poses": rho1..rho4 at the motion's two ends.
+# docs/model.md "Bodies": rho1..rho4 at the motion's two ends.
 GOLDEN_RHO = {"P0": (P0, [0.0443193423] * 4),
               "P1": (P1, [0.0676488698, 0.0608871697, 0.0407700625, 0.0792527515])}
 

@@ -14,7 +14,7 @@ import pytest
 from fmpy import read_model_description, simulate_fmu
 from fmpy.validation import validate_fmu
 
-HOLD = 2.655616050  # MODEL_SPEC "A check anyone can derive"
+HOLD = 2.655616050  # docs/model.md "Bodies"
 START = {"F[1]": HOLD + 0.0044, "F[2]": HOLD, "F[3]": HOLD, "F[4]": HOLD, "Fe[1]": 0.003, "Me_z": 1e-4}
 OUTPUTS = ["x", "y", "z", "phi", "dx", "dphi"]
 

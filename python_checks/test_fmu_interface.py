@@ -55,7 +55,7 @@ def _check_defaults(path, defaults):
         start = variables[name].start
         if start is None or not math.isclose(float(start), expected, rel_tol=1e-12, abs_tol=1e-15):
             wrong.append(f"{name}: start {start}, spec {expected!r}")
-    assert not wrong, f"{path.name}: parameter defaults differ from MODEL_SPEC:\n" + "\n".join(wrong)
+    assert not wrong, f"{path.name}: parameter defaults differ from docs/model.md:\n" + "\n".join(wrong)
 
 
 def test_plant_contract(plant_fmu):

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""The machine around the mechanism through the FMUs (MODEL_SPEC "The machine
+"""The machine around the mechanism through the FMUs (docs/model.md "The machine
 around the mechanism"): the auto-test chain with every
 term on, the plant's energy audit, and a drop onto the end stops.
 
@@ -93,7 +93,7 @@ def test_energy_audit_is_constant_with_every_term_on(plant_fmu, machine_forces, 
 # --- the drop onto the lower end stops -------------------------------------------
 # F = 0 at the home pose: the machine falls straight down (symmetric, no
 # torque about z), every slider reaches rho_min = 0 at once after falling
-# h0 = rho(P0) = 0.0443193423 m (MODEL_SPEC golden pose). Bound on the
+# h0 = rho(P0) = 0.0443193423 m (docs/model.md golden pose). Bound on the
 # penetration: the four stops in parallel (stiffness 4k) must take up the
 # weight W's work over h0 + delta; without their damping (which only helps)
 # 1/2 (4k) delta^2 = W (h0 + delta), so

@@ -70,7 +70,7 @@ def test_open_by_name_and_version(plant_fmu, plant_fmu3):
 
 @pytest.mark.parametrize("fmi", [2, 3])
 def test_simulate_with_named_inputs_and_parameters(plant_fmu, fmi):
-    """Holding the static forces at P0 (MODEL_SPEC's check anyone can derive)
+    """Holding the static forces at P0 (docs/model.md's check anyone can derive)
     keeps the platform at rest: the pose stays P0 to within the integration's
     rounding, in both FMI versions, through named start values and inputs."""
     hold = dict(zip(pkm.F, [pkm.STATIC_FORCE_P0] * 4))

@@ -40,7 +40,7 @@
 #define PKM_HARNESS_NAME "fmu_alloc_faults"
 #include "harness.h"
 
-#define STATIC_FORCE 2.655616050 /* N, MODEL_SPEC */
+#define STATIC_FORCE 2.655616050 /* N, docs/model.md */
 #define H 1e-3
 #define OTHER_STEPS 20
 #define KNOWN_SUNDIALS_CRASHES 2

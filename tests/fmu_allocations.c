@@ -12,7 +12,7 @@
  * on (the end-stop events and the state restores are logged).
  *
  * Scenario per run: the home pose; 150 steps of 1 ms with F[1..4] at the
- * static holding force (MODEL_SPEC) plus 0.5 sin(2 pi 5 t) N on F[1]; then
+ * static holding force (docs/model.md) plus 0.5 sin(2 pi 5 t) N on F[1]; then
  * 250 steps with F = 0, a drop onto the lower end stops (contacts located:
  * RK4 splits, CVODE roots, both logged). Every 50 steps the FMU state is
  * saved into one existing state and restored; at step 200 the state saved
@@ -33,7 +33,7 @@
 #define PKM_HARNESS_NAME "fmu_allocations"
 #include "harness.h"
 
-#define STATIC_FORCE 2.655616050 /* N, MODEL_SPEC "A check anyone can derive" */
+#define STATIC_FORCE 2.655616050 /* N, docs/model.md "Bodies" */
 #define PI 3.14159265358979323846
 #define STEPS 400
 #define H 1e-3

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // Independent reference model of the 4-PUU PKM, written only from
-// MODEL_SPEC.md (not from src/), for checking the main code.
+// docs/model.md (not from src/), for checking the main code.
 // Kinematics by literal DH products; kinetic energy from body velocities by
 // finite differences (no hand-derived mass matrix).
 #ifndef PKM4PUU_TESTS_REFERENCE_MODEL_HPP

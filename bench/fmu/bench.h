@@ -13,7 +13,7 @@
 #define PKM_FMU_PLANT_SO "PKM4PUU.so"
 #endif
 
-#define STATIC_FORCE 2.655616050 /* N, MODEL_SPEC "A check anyone can derive" */
+#define STATIC_FORCE 2.655616050 /* N, docs/model.md "Bodies" */
 #define PI 3.14159265358979323846
 
 /* The command line after the subcommand (main.c parses it). */

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench compare: the cost of one simulated second of the paper's
- * comparison test (MODEL_SPEC "Comparison test": from rest at P0, g = 0,
+ * comparison test (docs/model.md "The paper's two tests": from rest at P0, g = 0,
  * F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s), F2 = F3 = 0) at a 1 ms step, through
  * this project's plain C API (libpkm.so, pkm.h) and through the plant FMU
  * (raw FMI 2.0 Co-Simulation calls, as a master would).
@@ -63,7 +63,7 @@
 #define MAX_BATCHES 101
 #define NAME PKM_HARNESS_NAME " compare"
 
-static const double P0[4] = {0.0, 0.0, 0.05, 0.0}; /* MODEL_SPEC home pose */
+static const double P0[4] = {0.0, 0.0, 0.05, 0.0}; /* docs/model.md home pose */
 
 static void forces(double t, double F[4]) {
   const double f = AMPLITUDE * sin(2.0 * PI * t / PERIOD);

@@ -23,7 +23,7 @@
  *     the throughput per CPU second, which does not depend on that.
  *
  * Scenario: from the home pose, g as declared, F[1..4] = the static holding
- * force (MODEL_SPEC "A check anyone can derive") plus on F[1] the ramp 0.2 t N
+ * force (docs/model.md "Bodies") plus on F[1] the ramp 0.2 t N
  * given as value and slope each tick, so the inputs continue and CVODE keeps
  * its history across ticks (a held input that jumps every tick restarts it:
  * see docs/performance.md's continuation table). Timings: --batches B (default 7)

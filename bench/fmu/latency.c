@@ -12,7 +12,7 @@
  * Scenario: --batches (default 1000) batches of 1000 ticks, each batch the
  * same simulated second from the home pose (the FMU state saved after
  * initialisation is restored between batches, outside the timing, so the
- * platform never leaves the workspace), F[1..4] = the static holding force (MODEL_SPEC), plus on F[1]
+ * platform never leaves the workspace), F[1..4] = the static holding force (docs/model.md), plus on F[1]
  * with RK4 0.2 cos(2 pi 3 t) N held over each tick (its midpoint value),
  * with CVODE the ramp 0.2 t N given as value and slope each tick (CVODE
  * continues across the ticks; it restarts at each batch's restore).

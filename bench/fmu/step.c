@@ -6,7 +6,7 @@
  *   pkm_fmu_bench step [--batches N] [--solver 0|1] [--fmu SO] [--xml FILE]
  *
  * Scenario: the home pose (default parameters), F[1..4] = 2.655616050 N (the
- * static forces of MODEL_SPEC) plus 0.01 sin(2 pi t) N on F[1], set before
+ * static forces of docs/model.md) plus 0.01 sin(2 pi t) N on F[1], set before
  * every fmi2DoStep of 1 ms. Cases, for solver = 1 (RK4, rk4_step 1e-3) and
  * solver = 0 (CVODE, rtol 1e-8, atol 1e-10):
  *   (a) fmi2SetReal(4 inputs) + fmi2DoStep

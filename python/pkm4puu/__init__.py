@@ -5,7 +5,7 @@
     with pkm.Fmu.open("PKM4PUU", start=pkm.START_P0) as plant:
         r = plant.simulate(1.0, pkm.STEP, inputs={"F[1]": 2.7}, outputs=pkm.POSE)
 
-The library: spec (MODEL_SPEC's numbers and geometry), motions (the test
+The library: spec (docs/model.md's numbers and geometry), motions (the test
 motions), interface (variable names), locate (the build directory and the
 paths in it), fmu (the wrapper), capi (a ctypes binding of the C API,
 pkm.h), linearization (the plant's Jacobians through Model Exchange),

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""Names of the FMUs' variables (MODEL_SPEC "FMU interface contract") and the
+"""Names of the FMUs' variables (docs/model.md "The FMUs' names") and the
 start values the tests and examples use most."""
 from .spec import P0, STEP
 

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""The test motions of MODEL_SPEC: the auto-test's rest-to-rest quintic from
+"""The test motions of docs/model.md: the auto-test's rest-to-rest quintic from
 P0 to P1 (paper section 5.1) and the comparison test's actuator forces
 (section 5.2)."""
 import math

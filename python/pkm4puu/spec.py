@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""The mechanism's numbers, copied once from MODEL_SPEC.md (the project's
+"""The mechanism's numbers, copied once from docs/model.md (the project's
 authoritative definition), and the geometry they define: for the checks, the
 independent reference models (Pinocchio, MuJoCo) and the examples. Nothing
 here is read from this project's code or outputs.
@@ -93,7 +93,7 @@ def constraint_residual(q16):
                            for i in range(4)])
 
 
-# --- The machine around the mechanism (MODEL_SPEC "The machine around the mechanism") ----------
+# --- The machine around the mechanism (docs/model.md "The machine around the mechanism") ----------
 # Defaults of the spec; every one leaves the paper's ideal machine unchanged.
 SCREW_LEAD = 0.004  # m per revolution
 FRICTION_VELOCITY = 1e-3  # m/s, v_s of the tanh regularisation
@@ -101,7 +101,7 @@ RHO_MIN, RHO_MAX = 0.0, 0.15  # m, end stops
 
 
 class Machine:
-    """The machine's parameters (MODEL_SPEC names, SI units; defaults: the
+    """The machine's parameters (docs/model.md names, SI units; defaults: the
     spec's). payload_z (m) is not a spec parameter: the height of the
     payload's centre of mass above P in the platform frame, which the spec
     says cannot matter (the platform only translates and turns about z), so
@@ -147,7 +147,7 @@ class Machine:
                 "payload_com": self.payload_com, "payload_Izz": self.payload_Izz}
 
 
-# --- The FMUs' parameter defaults (MODEL_SPEC "FMU interface contract") -------------------------
+# --- The FMUs' parameter defaults (docs/model.md "The FMUs' names") -------------------------
 PARAMETER_DEFAULTS = {
     "h": H, "l": L, "h_prime": H_PRIME, "r_b": R_B, "r_Q": R_Q,
     **{f"beta[{i + 1}]": BETA[i] for i in range(4)},

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// The paper's auto-test (section 5.1, MODEL_SPEC "Auto-test"): inverse
+// The paper's auto-test (section 5.1, docs/model.md "The paper's two tests"): inverse
 // dynamics along the rest-to-rest path gives F1..F4(t); forward dynamics
 // driven open loop by those forces, evaluated at the integrator's own
 // (stage) times, must reproduce the path.
@@ -45,7 +45,7 @@ struct AutotestResult {
   std::string error;
 };
 
-/// What the round trip must reproduce the path to (MODEL_SPEC "Auto-test"),
+/// What the round trip must reproduce the path to (docs/model.md "The paper's two tests"),
 /// with RK4 at 1 ms and with CVODE at rtol 1e-12, atol 1e-14: the bounds of
 /// the tests (tests/core/autotest.cpp) and of pkm_autotest's verdict.
 struct AutotestBounds {

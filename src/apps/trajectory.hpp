@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// The spec's rest-to-rest motion (MODEL_SPEC "Auto-test"):
+// The spec's rest-to-rest motion (docs/model.md "The paper's two tests"):
 //   pose(t) = P0 + (P1 - P0) s(t/T),  s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5,
 // with zero velocity and acceleration at both ends; held at P0 before t = 0
 // and at P1 after t = T.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// The two FMUs of the project (MODEL_SPEC "FMU interface contract").
+// The two FMUs of the project (docs/model.md "The FMUs' names").
 #pragma once
 
 #include "fmi/variables.hpp"

@@ -270,7 +270,7 @@ TEST(CApi, ForwardDerivativesAreRowMajorInTheInputsOrder) {
       EXPECT_NEAR(an, d[i], 1e-5 * (1 + std::fabs(d[i]))) << "row " << 4 + i << " column " << k;
     }
   }
-  // A motor torque acts as (2 pi / screw_lead) times a force (MODEL_SPEC "Drives").
+  // A motor torque acts as (2 pi / screw_lead) times a force (docs/model.md "The machine around the mechanism").
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j)
       EXPECT_NEAR(B[12 * (4 + i) + 8 + j], 2 * M_PI / 0.004 * B[12 * (4 + i) + j], 1e-12 * std::fabs(B[12 * (4 + i) + 8 + j]));

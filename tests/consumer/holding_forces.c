@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
 /* The holding forces at the home pose through the installed C API: each
- * actuator carries 2.655616050 N (MODEL_SPEC); the header's version must be
+ * actuator carries 2.655616050 N (docs/model.md); the header's version must be
  * the library's. Exit status 0 when both hold. */
 #include <math.h>
 #include <stdio.h>

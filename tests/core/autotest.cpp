@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// The paper's auto-test round trip in process (MODEL_SPEC "Auto-test"):
+// The paper's auto-test round trip in process (docs/model.md "The paper's two tests"):
 // forces from inverse dynamics at the integrator's own stage times, open
 // loop over the full 2 s, reproduce the prescribed path.
 #include <cmath>
@@ -52,7 +52,7 @@ TEST(Autotest, CvodeBdfReproducesThePath) {
 }
 
 TEST(Autotest, ForcesAreMostlyStatic) {
-  // MODEL_SPEC "Auto-test": about 99 % of each force is static; the dynamic
+  // docs/model.md "The paper's two tests": about 99 % of each force is static; the dynamic
   // part is ~0.013 N.
   AutotestOptions opt;
   opt.solver.solver = Solver::Rk4;

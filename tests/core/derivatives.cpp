@@ -41,7 +41,7 @@ struct Case {
   Pose pose, vel;
 };
 
-// Home, the auto-test's end pose (MODEL_SPEC), off-centre and rotated the
+// Home, the auto-test's end pose (docs/model.md), off-centre and rotated the
 // other way; each with rates in every coordinate.
 const Case kCases[] = {
     {"home", Pose(0.0, 0.0, 0.05, 0.0), Pose(0.12, -0.08, 0.10, 0.9)},

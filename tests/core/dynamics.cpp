@@ -63,7 +63,7 @@ TEST(Dynamics, GravityTermsMatchFiniteDifferencesOfThePotential) {
 }
 
 TEST(Dynamics, StaticForcesAtHomeCarryTheWeight) {
-  // MODEL_SPEC "A check anyone can derive": 2.655616050 N per actuator,
+  // docs/model.md "Bodies": 2.655616050 N per actuator,
   // (m_platform + 4 m_slider + 4 m_rod) g = 10.622464200 N in all.
   const Model m = default_model();
   InverseDynamicsResult r;

@@ -273,7 +273,7 @@ struct EnergyRun {
 // max(T) that the motion reaches.
 EnergyRun run_energy(double g, pkm::CvodeMethod method, double duration = 2.0) {
   // The ideal mechanism: in 2 s of free fall the sliders pass any end stop
-  // (MODEL_SPEC's default travel ends at rho = 0), so the stops are made
+  // (docs/model.md's default travel ends at rho = 0), so the stops are made
   // inert here (zero stiffness and damping).
   Params p;
   p.g = g;

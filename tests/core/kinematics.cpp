@@ -17,7 +17,7 @@ double wrap_diff(double a, double b) { return std::remainder(a - b, 2.0 * kPi); 
 
 struct GoldenLeg { double rho, theta1, theta2; };
 
-// MODEL_SPEC "Golden poses" (10 significant digits).
+// docs/model.md "Bodies" (10 significant digits).
 void expect_golden(const Pose& pose, const GoldenLeg (&legs)[4]) {
   const Model m = default_model();
   Vec16 q;
@@ -147,7 +147,7 @@ TEST(Kinematics, ServoProblemsMatchDerivativesOfThePath) {
 }
 
 TEST(Kinematics, LegBlockDeterminantIsLTimesATimesSinTheta2) {
-  // MODEL_SPEC: det(dC_i/d(rho, theta1, theta2)) = l A sin(theta2), with
+  // docs/model.md: det(dC_i/d(rho, theta1, theta2)) = l A sin(theta2), with
   // A = sqrt(qx^2 + qy^2 - h'^2) computed here from the geometry.
   const Model m = default_model();
   for (unsigned seed = 1; seed <= 6; ++seed) {
@@ -183,7 +183,7 @@ TEST(Kinematics, ActuatorJacobianMatchesFiniteDifferences) {
 }
 
 TEST(Kinematics, AutotestPathIsWellConditioned) {
-  // MODEL_SPEC "Auto-test": cond < 26 and 27 deg <= |theta2| <= 71 deg.
+  // docs/model.md "The paper's two tests": cond < 26 and 27 deg <= |theta2| <= 71 deg.
   const Model m = default_model();
   const RestToRest path;
   double worst = 0;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// The machine around the mechanism (MODEL_SPEC "The machine around the
+// The machine around the mechanism (docs/model.md "The machine around the
 // mechanism: drives, friction, end stops, payload"): parameters, the
 // Lagrangian terms of rotors and payload against the independent reference
 // model, an analytic fall with viscous friction, holding forces by virtual
@@ -22,7 +22,7 @@ using namespace pkm_test;
 namespace {
 
 // Every term on, stops far enough not to be hit by the auto-test (its rho
-// stay within 0.040..0.080 m, MODEL_SPEC).
+// stay within 0.040..0.080 m, docs/model.md).
 Params machine_params() {
   Params p;
   p.screw_lead = 0.004;
@@ -377,7 +377,7 @@ TEST(MachineInverse, TorquesAreTheForcesOnTheScrewAndStopsAreReported) {
 
 // From rest at the default pose with F = 0 the machine falls freely (every
 // body at g: the constraints carry nothing) through rho0 = 0.0443193423 m
-// (MODEL_SPEC golden pose) and lands on the four lower stops at
+// (docs/model.md golden pose) and lands on the four lower stops at
 // v0 = sqrt(2 g rho0) ~ 0.93 m/s. By the symmetry argument of the viscous
 // fall above (equal forces on the four rho keep the motion a vertical
 // translation; the test checks x, y, phi stay ~0) it is one body of mass

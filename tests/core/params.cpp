@@ -49,7 +49,7 @@ TEST(Params, ValidationNamesTheOffendingParameter) {
       {"parameter Izz_platform ", [](Params& p) { p.Izz_platform = 0; }},
       {"parameter gamma[3] ", [](Params& p) { p.gamma[2] = NAN; }},
       {"parameter g ", [](Params& p) { p.g = INFINITY; }},
-      // The machine around the mechanism (MODEL_SPEC).
+      // The machine around the mechanism (docs/model.md).
       {"parameter screw_lead ", [](Params& p) { p.screw_lead = 0.0; }},
       {"parameter rotor_inertia ", [](Params& p) { p.rotor_inertia = -1e-6; }},
       {"parameter friction_viscous ", [](Params& p) { p.friction_viscous = NAN; }},

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// The paper's auto-test (MODEL_SPEC "Auto-test") through both FMU binaries,
+// The paper's auto-test (docs/model.md "The paper's two tests") through both FMU binaries,
 // as python_checks/fmu_autotest.py runs it with the midpoint input: the
 // inverse FMU turns the prescribed motion p(t) (pkm::RestToRest) into F1..F4
 // at each 1-ms step's midpoint, and the plant FMU, driven open loop by them

@@ -141,7 +141,7 @@ TEST(HardeningParameters, NonFiniteParametersAreRejectedBeforeInitialisation) {
     ++n;
   }
   // 21 of the mechanism, 8 of the initial state, rk4_step, rtol, atol, the
-  // two guards, 11 of the machine (MODEL_SPEC), the stops' stiffness and
+  // two guards, 11 of the machine (docs/model.md), the stops' stiffness and
   // damping, work_budget and energy_tolerance.
   EXPECT_EQ(n, 49);
   table_row("fmi2SetReal of any Real parameter (all " + std::to_string(n) + " of the plant) to NaN, +Inf, -Inf",

@@ -21,7 +21,7 @@ using pkm_test::PlantFmu;
 
 constexpr int kStates = 10;
 
-// Every machine term on (names of the FMU's parameters, MODEL_SPEC).
+// Every machine term on (names of the FMU's parameters, docs/model.md).
 const std::pair<const char*, double> kMachine[] = {
     {"rotor_inertia", 2e-7},    {"friction_viscous", 1.5}, {"friction_coulomb", 0.2},
     {"friction_velocity", 0.05}, {"payload_mass", 0.3},     {"payload_com[1]", 0.02},

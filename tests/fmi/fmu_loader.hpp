@@ -47,7 +47,7 @@ inline const char* pkm_test_guid(const pkm_fmi::ModelDefinition& d) {
 
 namespace pkm_test {
 
-constexpr double kStaticForce = 2.655616050;  // MODEL_SPEC "A check anyone can derive"
+constexpr double kStaticForce = 2.655616050;  // docs/model.md "Bodies"
 constexpr double kPi = 3.14159265358979323846;
 
 /// `path` as the platform's C library takes it. The build's paths are Linux

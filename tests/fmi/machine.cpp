@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// The plant FMU behaves like the machine when nothing is set (MODEL_SPEC
+// The plant FMU behaves like the machine when nothing is set (docs/model.md
 // "The machine around the mechanism"), and its log stays quiet: with logging
 // on and no category named only warnings, errors and events are written.
 #include <string>
@@ -24,7 +24,7 @@ TEST(Machine, DefaultsHoldTheMachineAndTheLogStaysQuiet) {
     ASSERT_EQ(p.step(k * 1e-3, 1e-3), fmi2OK) << p.log.dump();
     worst = std::max({worst, std::abs(p.get("x")), std::abs(p.get("z") - 0.05), std::abs(p.get("phi"))});
   }
-  EXPECT_LT(worst, 1e-9) << "the default inputs hold the default machine at rest (MODEL_SPEC)";
+  EXPECT_LT(worst, 1e-9) << "the default inputs hold the default machine at rest (docs/model.md)";
   for (int i = 1; i <= 4; ++i) EXPECT_NEAR(p.get("F_hold[" + std::to_string(i) + "]"), kStaticForce, 1e-9);
   EXPECT_EQ(p.log.messages.size(), 2u) << "the 2,000 steps and their gets wrote:\n" << p.log.dump();
 }

@@ -2,7 +2,7 @@
 // The interface as the variable tables declare it (src/models/<id>), from which
 // every modelDescription.xml is generated (the ctest
 // model_descriptions_up_to_date checks that the committed files are those):
-// every name of MODEL_SPEC's "FMU interface contract", start values equal to
+// every name of docs/model.md "The FMUs' names", start values equal to
 // the core's defaults, and a ModelStructure true to the mathematics, checked
 // by perturbing each input and each state of a Model Exchange instance and
 // watching which outputs and derivatives move.

@@ -2,7 +2,7 @@
 // The plant as FMI 2.0 Model Exchange, driven through the dlopen'd binary by
 // an integrator of the test's own: classic RK4 at h = 1 ms with the auto-test's
 // forces evaluated exactly at each stage time (in-process inverse dynamics,
-// set through fmi2SetReal), as MODEL_SPEC "Auto-test" and the paper do.
+// set through fmi2SetReal), as docs/model.md "The paper's two tests" and the paper do.
 // The in-process auto-test (pkm::run_autotest, RK4 at 1 ms) integrates the
 // same ODE with the same method, so the two trajectories must agree to
 // rounding (bound 1e-10 m and rad): a Model Exchange state,
@@ -158,7 +158,7 @@ TEST(ModelExchange, OwnRk4WithExactStageForcesMatchesTheInProcessAutoTest) {
   EXPECT_EQ(x[9], 0.0) << "nothing dissipates in the default machine";
   EXPECT_LE(worst_position, 1e-10);
   EXPECT_LE(worst_angle, 1e-10);
-  EXPECT_GT(min_indicator, 0.0) << "the auto-test stays inside both guards and the sliders' travel (MODEL_SPEC)";
+  EXPECT_GT(min_indicator, 0.0) << "the auto-test stays inside both guards and the sliders' travel (docs/model.md)";
   // Not trivially zero: the platform moved 2 cm and 4 degrees.
   EXPECT_NEAR(x[2], 0.07, 1e-7);
   EXPECT_NEAR(x[3], 4.0 * pkm_test::kPi / 180.0, 1e-7);

@@ -245,7 +245,7 @@ TEST(HardeningSingularities, AStepThatLeavesTheWorkspaceEntirelyIsDiscardedToo) 
 
 // ---------------------------------------------------------------- the inverse FMU
 
-/// The guards' quantities of a pose from MODEL_SPEC's closed-form leg
+/// The guards' quantities of a pose from docs/model.md's closed-form leg
 /// inverse kinematics alone: with d = p + Rz(phi) r_Qi - B_i and
 /// A^2 = d_x^2 + d_y^2 - h'^2 (invariant to Rz(beta_i)), cos theta2 = A / l
 /// and rho = z - h + sqrt(l^2 - A^2) (elbow-down), so

@@ -105,7 +105,7 @@ TEST_F(StateMachine, ResetReturnsToTheStartValues) {
   ASSERT_EQ(lib.fmi2Reset(a.c), fmi2OK);
   a.initialize();
   EXPECT_EQ(a.get("z0"), 0.05);
-  EXPECT_EQ(a.get("F[2]"), kStaticForce);  // its start value (MODEL_SPEC)
+  EXPECT_EQ(a.get("F[2]"), kStaticForce);  // its start value (docs/model.md)
   EXPECT_EQ(a.get("z"), 0.05);
   PlantFmu b;
   b.initialize();

@@ -43,7 +43,7 @@ TEST_F(Stepping, HoldsTheHomePoseWithTheStaticForces) {
   ASSERT_EQ(lib.fmi2GetRealStatus(p.c, fmi2LastSuccessfulTime, &last), fmi2OK);
   EXPECT_NEAR(last, 2.0, 1e-12);
   EXPECT_LT(p.get("constraint_residual"), 1e-12);
-  EXPECT_NEAR(p.get("rho[1]"), 0.0443193423, 1e-10);  // MODEL_SPEC golden pose
+  EXPECT_NEAR(p.get("rho[1]"), 0.0443193423, 1e-10);  // docs/model.md golden pose
   EXPECT_NEAR(p.get("theta2[2]"), -0.8606121019, 1e-10);
   EXPECT_TRUE(std::isfinite(p.get("jacobian_condition")));
   EXPECT_EQ(lib.fmi2Terminate(p.c), fmi2OK);
@@ -180,7 +180,7 @@ TEST_F(Stepping, InverseAtRestAtHomeGivesTheStaticForces) {
   ASSERT_EQ(inv.set("y", -0.005), fmi2OK);
   ASSERT_EQ(inv.set("z", 0.07), fmi2OK);
   ASSERT_EQ(inv.set("phi", 4.0 * kPi / 180.0), fmi2OK);
-  EXPECT_NEAR(inv.get("rho[1]"), 0.0676488698, 1e-10);  // MODEL_SPEC golden pose
+  EXPECT_NEAR(inv.get("rho[1]"), 0.0676488698, 1e-10);  // docs/model.md golden pose
   EXPECT_NEAR(inv.get("rho[4]"), 0.0792527515, 1e-10);
   // Gravity off, at rest: no force.
   InverseFmu zero_g;

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""The paper's auto-test (Fig. 4, MODEL_SPEC "Auto-test") through the FMUs:
+"""The paper's auto-test (Fig. 4, docs/model.md "The paper's two tests") through the FMUs:
 the inverse FMU turns the prescribed motion into F1..F4(t); the plant FMU,
 driven open loop by those forces at a 1 ms communication step for 2 s, must
 reproduce the prescribed pose.

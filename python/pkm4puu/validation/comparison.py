@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""The paper's comparison test (section 5.2, MODEL_SPEC "Comparison test")
+"""The paper's comparison test (section 5.2, docs/model.md "The paper's two tests")
 through the plant FMU: 1.5 s from rest at P0, gravity off, F2 = F3 = 0,
 F1(t) = 0.02 N sin(2 pi t / 1.5 s) = -F4(t), midpoint-held at a 1 ms step.
 

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Validation against independent multibody engines (the paper's section 5.2,
 done with open tools): Pinocchio and MuJoCo models of the same mechanism,
-built from MODEL_SPEC's numbers only (engines/), against this project's C API
+built from docs/model.md's numbers only (engines/), against this project's C API
 (libpkm.so) and FMUs.
 
 This module holds the runners, the quantities the checks look at and the
@@ -17,11 +17,11 @@ everything, prints the tables and writes to --out DIR:
                             over time, and each one's ||C(q)||
 
 What is compared:
-- inverse dynamics along the auto-test (MODEL_SPEC "Auto-test", every 1 ms
+- inverse dynamics along the auto-test (docs/model.md "The paper's two tests", every 1 ms
   sample of the 2 s): F1..F4 from the C API (pkm_inverse_dynamics) and the
   inverse FMU against Pinocchio's (RNEA on the tree, then the 16 equations
   J^T lambda - S F = -tau for the 12 multipliers and 4 forces);
-- forward dynamics, the comparison test (MODEL_SPEC "Comparison test", g = 0,
+- forward dynamics, the comparison test (docs/model.md "The paper's two tests", g = 0,
   F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s), 1.5 s from rest at P0): the
   reference is Pinocchio's constrained forward dynamics (KKT system with
   M from CRBA, nle from RNEA and the 12 point-constraint Jacobians, all
@@ -34,7 +34,7 @@ What is compared:
   constraints it allows). A second Pinocchio run with the same midpoint-held
   forces (each 1 ms interval integrated at the same tolerance) separates the
   hold's own error from the integrators' and MuJoCo's constraint softness.
-- the machine around the mechanism (MODEL_SPEC; machine_cases): rotor
+- the machine around the mechanism (docs/model.md; machine_cases): rotor
   inertia, viscous and Coulomb friction, an off-centre payload (with g = 0
   and with gravity on, then from the holding forces plus the sine) and all
   terms together (the C API driven by motor torques), each built into
@@ -297,7 +297,7 @@ def mujoco_sweep():
     return cases
 
 
-# --- the machine around the mechanism (MODEL_SPEC) ---------------------------------------------------
+# --- the machine around the mechanism (docs/model.md) ---------------------------------------------------
 # Each term of the machine is checked on the comparison test against the
 # same term built into the engines independently: rotor inertia (Pinocchio's
 # armature, MuJoCo's joint armature), viscous friction (a joint force in the

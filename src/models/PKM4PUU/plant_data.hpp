@@ -61,7 +61,7 @@ constexpr pkm::SolverSettings kDefaultSolver{};
 constexpr int kStates = 10;  // pose, velocity, actuator_work, dissipated_energy
 constexpr int kIndicators = pkm::kGuardIndicators + pkm::kContactIndicators;
 constexpr int kInputs = 12;  // F[1..4], Fe[1..3], Me_z, tau[1..4]
-// MODEL_SPEC "A check anyone can derive": each actuator's share of the
+// docs/model.md "Bodies": each actuator's share of the
 // weight at the default initial pose, the start value of F[1..4] (so that a
 // plant nothing drives stays where it is).
 constexpr double kHoldingForce = 2.655616050;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// What both FMUs share: the mechanism's parameters (MODEL_SPEC: Tables II
+// What both FMUs share: the mechanism's parameters (docs/model.md: Tables II
 // and III, leg placement, gravity) as FMI variables, stored straight in a
 // pkm::Params, and the singularity guards' limits in a pkm::GuardLimits,
 // with the core's defaults as start values.
@@ -111,7 +111,7 @@ constexpr Variable mechanism_parameter(std::uint32_t vr, const char* name, const
                  PKM_FMI_LIMIT(min_leg_measure), 0, 0.0, pkm::kGreatestLegMeasureLimit)
 
 // Value references 150..160, identical in both FMUs: the machine around the
-// mechanism (MODEL_SPEC "The machine around the mechanism"). Every default
+// mechanism (docs/model.md "The machine around the mechanism"). Every default
 // leaves the paper's ideal machine unchanged.
 #define PKM_FMI_MACHINE_PARAMETERS                                                                                    \
   mechanism_parameter(150, "screw_lead", "m",                                                                         \

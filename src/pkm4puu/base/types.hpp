@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // Fixed-size Eigen types and index conventions shared by the whole core.
 //
-// Coordinates (MODEL_SPEC "Coordinates"), n = 16:
+// Coordinates (docs/model.md "Coordinates and equations"), n = 16:
 //   q = [rho1, th1_1, th2_1, rho2, th1_2, th2_2, rho3, th1_3, th2_3,
 //        rho4, th1_4, th2_4, x, y, z, phi]
 // Constraints: m = 12, three per leg (Eq. 15). Degrees of freedom: 4.

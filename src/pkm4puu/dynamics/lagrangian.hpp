@@ -5,7 +5,7 @@
 //   rod:    1/2 m_r |v_c|^2 + 1/2 w3^T I w3,       U = m_r g (rho + h + l/2 s2)
 //           v_c = d/dt[O2 + l/2 x3],  w3 (frame 3) = (s2 th1d, c2 th1d, th2d)
 //   platform: 1/2 m_p |pd|^2 + 1/2 Izz phid^2,     U = m_p g z
-// The machine (MODEL_SPEC "The machine around the mechanism") adds
+// The machine (docs/model.md "The machine around the mechanism") adds
 //   rotor:   1/2 J (2 pi/p)^2 rhod^2 per leg: M_leg(0,0) += J (2 pi/p)^2
 //   payload: mass m_l at c_w = Rz(phi) c (platform frame c, at P's height),
 //            inertia I_l: 1/2 m_l |pd + phid e_z x c_w|^2 + 1/2 I_l phid^2, U = m_l g z.

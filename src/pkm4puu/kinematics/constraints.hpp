@@ -30,7 +30,7 @@ Mat3 leg_block(const Model& m, int leg, const LegConfig& c);
 Status actuator_jacobian(const Model& m, const Vec16& q, Mat4& J);
 
 /// Condition number (2-norm) of the actuator Jacobian with its phi column
-/// divided by 0.1 m (MODEL_SPEC "FMU interface contract"). Returns +inf at
+/// divided by 0.1 m (docs/model.md "The FMUs' names"). Returns +inf at
 /// a singularity.
 double actuator_jacobian_condition(const Mat4& J);
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// One leg's kinematics in its base frame 0_i (MODEL_SPEC "Leg kinematics",
+// One leg's kinematics in its base frame 0_i (docs/model.md "One leg",
 // Table I, standard DH). Everything here is per leg and allocation free.
 #pragma once
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// Guards against singular configurations (MODEL_SPEC "Working mode"):
+// Guards against singular configurations (docs/model.md "Working mode"):
 //   - leg (serial) singularities: det(dC_i/d(rho, theta1, theta2)) / l^2 =
 //     |cos theta2 sin theta2| goes to 0 when a rod turns horizontal
 //     (theta2 -> 0, the edge of its reach) or vertical (theta2 -> -pi/2);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// The sliders' joint friction (MODEL_SPEC "The machine around the
+// The sliders' joint friction (docs/model.md "The machine around the
 // mechanism"): viscous plus a Coulomb term regularised by tanh,
 //   F_fric,i = -b rhod_i - F_c tanh(rhod_i / v_s)   on rho_i, opposing rhod_i.
 #pragma once

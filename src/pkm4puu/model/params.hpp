@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// Model parameters (MODEL_SPEC: Tables II and III, leg placement, gravity),
+// Model parameters (docs/model.md: Tables II and III, leg placement, gravity),
 // in SI units. Defaults are the spec's values, converted once here.
 #pragma once
 
@@ -30,7 +30,7 @@ struct Params {
   // Gravity along -z_G, m/s^2. Zero is allowed (the comparison test).
   double g = 9.81;
 
-  // The machine around the mechanism (MODEL_SPEC "The machine around the
+  // The machine around the mechanism (docs/model.md "The machine around the
   // mechanism"). Every default leaves the paper's ideal mechanism unchanged.
   // Drives: a motor on a ball screw per actuator.
   double screw_lead = 0.004;       // m per revolution, > 0

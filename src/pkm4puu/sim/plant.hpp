@@ -30,7 +30,7 @@ struct EnergyIntegrals {
   double dissipated = 0;     // friction plus the end stops' damping
 };
 
-/// The machine's outputs at the current time (MODEL_SPEC "The machine
+/// The machine's outputs at the current time (docs/model.md "The machine
 /// around the mechanism").
 struct MachineOutputs {
   Vec4 rho = Vec4::Zero(), rhod = Vec4::Zero();  // m, m/s
@@ -160,7 +160,7 @@ class Plant {
 
   /// ||C(q)|| at the current state (m).
   double constraint_residual() const;
-  /// Condition number of the actuator Jacobian (MODEL_SPEC), +inf if singular.
+  /// Condition number of the actuator Jacobian (docs/model.md), +inf if singular.
   double jacobian_condition() const;
 
   long rhs_evaluations() const { return rhs_count_; }

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """An independent model of the 4-PUU mechanism in MuJoCo (MJCF), built from
-MODEL_SPEC's numbers only (pkm4puu.spec).
+docs/model.md's numbers only (pkm4puu.spec).
 
 Bodies (the same tree as engines/pinocchio_model.py):
 - leg i: body "slider{i}" at B_i + h z, oriented Rz(beta_i), with a slide
@@ -24,7 +24,7 @@ Bodies (the same tree as engines/pinocchio_model.py):
   soft by design).
 - actuators: a motor with gear 1 on each rho_i, so ctrl = F (N).
 - contacts disabled (there are no geoms that matter).
-- the machine around the mechanism (MODEL_SPEC; spec.Machine, optional):
+- the machine around the mechanism (docs/model.md; spec.Machine, optional):
   rotor inertia as the slider joints' armature, J (2 pi / p)^2; viscous
   friction as their damping b (MuJoCo's joint damper, -b qvel; the damper
   flag is on only when a machine is given); the payload as a body

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """An independent model of the 4-PUU mechanism in Pinocchio, built from
-MODEL_SPEC's numbers only (pkm4puu.spec), used as the reference for the
+docs/model.md's numbers only (pkm4puu.spec), used as the reference for the
 project's dynamics.
 
 Structure (a kinematic tree plus loop closures):
@@ -22,12 +22,12 @@ Structure (a kinematic tree plus loop closures):
 - the legs are added first, so Pinocchio's q is the spec's order
   [rho1, th1_1, th2_1, ..., rho4, th1_4, th2_4, x, y, z, phi].
 - the loop closures are 12 point constraints C_i = p(Q_i) - p(R_i) = 0
-  (MODEL_SPEC Eq. 15, same sign), with Jacobian J = J_Q - J_R from the frame
+  (docs/model.md Eq. 15, same sign), with Jacobian J = J_Q - J_R from the frame
   Jacobians (LOCAL_WORLD_ALIGNED, linear rows) and the bias
   gamma = (classical acceleration of Q_i - of R_i at qdd = 0), so
   C_dd = J qdd + gamma.
 
-The machine around the mechanism (MODEL_SPEC; spec.Machine, optional):
+The machine around the mechanism (docs/model.md; spec.Machine, optional):
 - rotor inertia: Pinocchio's model.armature on the rho_i joints,
   J (2 pi / p)^2, which crba and rnea add to M's diagonal and to the joint
   torque (armature * rho_i_dd);
