@@ -197,7 +197,7 @@ Status PlantData::check_step(Context& ctx, double h) const {
   const double steps = pkm::rk4_steps_for(h, step);
   if (steps <= pkm::kMaxRk4StepsPerAdvance) return Status::OK;
   ctx.log.error("DoStep: a communication step of %.6g s needs %.3g fixed steps of rk4_step = %.6g s, more than the "
-                "work budget of %.0e per step: use shorter communication steps or a larger rk4_step; the call has "
+                "%.0e one call may take: use shorter communication steps or a larger rk4_step; the call has "
                 "no effect",
                 h, steps, step, pkm::kMaxRk4StepsPerAdvance);
   return Status::Error;

@@ -14,10 +14,4 @@ Status stop_indicators(const Model& m, const Pose& pose, unsigned stops, double 
   return s;
 }
 
-double stop_contact_step(const Model& m) {
-  const double mass = m.p.m_slider + m.reflected_mass;
-  const double rate = std::sqrt(m.p.stop_stiffness / mass) + m.p.stop_damping / mass;
-  return rate > 0.0 ? 0.1 / rate : std::numeric_limits<double>::infinity();
-}
-
 }  // namespace pkm

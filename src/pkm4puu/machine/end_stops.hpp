@@ -211,12 +211,4 @@ inline unsigned stops_after_crossings(unsigned stops, const int dirs[kContactInd
   return stops;
 }
 
-/// The time scale of a contact (s): a tenth of the inverse of the fastest
-/// rate a stop can excite, its spring and damper against the least mass
-/// that can sit behind rho_i (the slider with its rotor; the rest of the
-/// mechanism only adds mass). A fixed-step integrator that substeps by it
-/// keeps RK4's error per step near (0.1)^5 / 120 ~ 1e-7 of the contact's
-/// motion. +inf without stiffness and damping.
-double stop_contact_step(const Model& m);
-
 }  // namespace pkm
