@@ -28,6 +28,21 @@ inline Model model_of(const Params& p) {
   return m;
 }
 
+/// Every machine term of the dynamics on: rotors, an off-centre payload,
+/// viscous and Coulomb friction with a velocity scale that keeps tanh's
+/// slope visible (the derivatives' and the inverse dynamics' tests).
+inline Params every_machine_term() {
+  Params p;
+  p.rotor_inertia = 2e-7;
+  p.friction_viscous = 1.5;
+  p.friction_coulomb = 0.2;
+  p.friction_velocity = 0.05;
+  p.payload_mass = 0.3;
+  p.payload_com = {0.02, -0.012};
+  p.payload_Izz = 1.2e-4;
+  return p;
+}
+
 inline Model default_model(double g = 9.81) {
   Params p;
   p.g = g;

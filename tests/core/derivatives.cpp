@@ -22,20 +22,6 @@ using namespace pkm_test;
 
 namespace {
 
-/// Every machine term on: rotors, payload off the centre, viscous and
-/// Coulomb friction with a velocity scale that keeps tanh's slope visible.
-Params machine_params() {
-  Params p;
-  p.rotor_inertia = 2e-7;
-  p.friction_viscous = 1.5;
-  p.friction_coulomb = 0.2;
-  p.friction_velocity = 0.05;
-  p.payload_mass = 0.3;
-  p.payload_com = {0.02, -0.012};
-  p.payload_Izz = 1.2e-4;
-  return p;
-}
-
 struct Case {
   const char* name;
   Pose pose, vel;
@@ -134,14 +120,14 @@ TEST(ForwardDerivatives, IdealMechanismMatchesRichardsonDifferences) {
 }
 
 TEST(ForwardDerivatives, EveryMachineTermOnMatchesRichardsonDifferences) {
-  const Model m = model_of(machine_params());
+  const Model m = model_of(every_machine_term());
   for (const Case& c : kCases) check_forward(m, c, 1.0);
 }
 
 TEST(ForwardDerivatives, PushingEndStopMatchesRichardsonDifferences) {
   // Leg 1's upper stop 1 mm below its joint at the case's pose: the stop
   // pushes (k delta = 100 N dominates d delta_dot), smooth within 1 mm.
-  Params p = machine_params();
+  Params p = every_machine_term();
   const Case& c = kCases[2];
   Vec4 rho;
   ASSERT_EQ(actuator_positions(default_model(), c.pose, rho), Status::Ok);
@@ -187,7 +173,7 @@ double relative_to_largest(const M1& a, const M2& b) {
 }  // namespace
 
 TEST(ForwardDerivatives, LanesMatchTheLegByLegAssemblyToRounding) {
-  for (const Model& m : {default_model(), model_of(machine_params())}) {
+  for (const Model& m : {default_model(), model_of(every_machine_term())}) {
     for (const Case& c : kCases) {
       SCOPED_TRACE(c.name);
       Vec8 y;
@@ -215,7 +201,7 @@ TEST(ForwardDerivatives, LanesMatchTheLegByLegAssemblyToRounding) {
 
 TEST(ForwardDerivatives, EveryLaneVariantGivesTheSameBits) {
   // The same template for one leg, SSE2/NEON pairs and AVX, no contraction.
-  const Model m = model_of(machine_params());
+  const Model m = model_of(every_machine_term());
   for (const Case& c : kCases) {
     SCOPED_TRACE(c.name);
     const Vec16 f = generalized_forces(m, kF, kTau, kWe);
@@ -236,7 +222,7 @@ TEST(ForwardDerivatives, EveryLaneVariantGivesTheSameBits) {
 }
 
 TEST(InverseDerivatives, MatchRichardsonDifferencesOfTheInverseDynamics) {
-  const Model m = model_of(machine_params());
+  const Model m = model_of(every_machine_term());
   const Pose acc(0.8, -0.5, 1.1, 6.0);
   for (const Case& c : kCases) {
     SCOPED_TRACE(c.name);
@@ -275,7 +261,7 @@ TEST(MachineDerivatives, PassiveForceAndDissipationSlopesMatchRichardsonDifferen
   // Friction alone (within the travel), a pushing stop, a released stop
   // (k delta + d delta_dot < 0: the force is held at 0, the spring's energy
   // flows back), each stop from the state and held on (machine.hpp).
-  const Params p = machine_params();
+  const Params p = every_machine_term();
   struct Joint { const char* what; double rho, rhod; unsigned stops; };
   const Joint joints[] = {
       {"within the travel", 0.06, 0.03, kStopsFromState},
@@ -308,7 +294,7 @@ TEST(ForwardDerivatives, LinearisationPredictsAPerturbedMotionToSecondOrder) {
   // nonlinear plant y' = f(y, u) for 50 ms; the linearisation
   // dy' = A dy + B du at the equilibrium predicts it with an error that
   // shrinks as eps^2 (Taylor): halving eps divides it by about 4.
-  const Model m = model_of(machine_params());
+  const Model m = model_of(every_machine_term());
   Vec16 q;
   ASSERT_EQ(closed_form_position(m, Pose(0.0, 0.0, 0.05, 0.0), q), Status::Ok);
   Vec4 F0;

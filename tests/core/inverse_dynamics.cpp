@@ -14,20 +14,6 @@ using namespace pkm_test;
 
 namespace {
 
-// Every machine term of inverse_dynamics: rotor, viscous and Coulomb
-// friction, an eccentric payload.
-Params machine_params() {
-  Params p;
-  p.rotor_inertia = 2e-7;
-  p.friction_viscous = 1.5;
-  p.friction_coulomb = 0.2;
-  p.friction_velocity = 0.05;
-  p.payload_mass = 0.3;
-  p.payload_com = {0.02, -0.012};
-  p.payload_Izz = 1.2e-4;
-  return p;
-}
-
 /// The two paths agree to 1e-12 relative in every output; returns the
 /// largest relative difference of F.
 double expect_paths_agree(const Model& m, const Pose& p, const Pose& v, const Pose& a, const Wrench& we) {
@@ -69,7 +55,7 @@ double expect_paths_agree(const Model& m, const Pose& p, const Pose& v, const Po
 }  // namespace
 
 TEST(InverseDynamics, ReducedMatchesGeneralAtRandomReachableStates) {
-  for (const Params& params : {Params{}, machine_params()}) {
+  for (const Params& params : {Params{}, every_machine_term()}) {
     const Model m = model_of(params);
     double worst = 0.0;
     for (unsigned seed = 1; seed <= 200; ++seed) {
@@ -84,7 +70,7 @@ TEST(InverseDynamics, ReducedMatchesGeneralAtRandomReachableStates) {
 }
 
 TEST(InverseDynamics, ReducedMatchesGeneralAlongTheAutotestPath) {
-  for (const Params& params : {Params{}, machine_params()}) {
+  for (const Params& params : {Params{}, every_machine_term()}) {
     const Model m = model_of(params);
     const RestToRest path;
     double worst = 0.0;
@@ -103,13 +89,13 @@ TEST(InverseDynamics, ReducedMatchesGeneralBeyondAnEndStop) {
   // The highest slider's upper stop 1 mm below its joint, the lowest
   // slider's lower stop 1 mm above its: both stops' forces enter F, on
   // both paths.
-  const RandomState s = random_state(model_of(machine_params()), 7);
+  const RandomState s = random_state(model_of(every_machine_term()), 7);
   Vec4 rho;
-  ASSERT_EQ(actuator_positions(model_of(machine_params()), s.pose, rho), Status::Ok);
+  ASSERT_EQ(actuator_positions(model_of(every_machine_term()), s.pose, rho), Status::Ok);
   int hi = 0, lo = 0;
   rho.maxCoeff(&hi);
   rho.minCoeff(&lo);
-  Params p = machine_params();
+  Params p = every_machine_term();
   p.rho_max = rho[hi] - 1e-3;
   p.rho_min = rho[lo] + 1e-3;
   ASSERT_LT(p.rho_min, p.rho_max);
@@ -124,7 +110,7 @@ TEST(InverseDynamics, ReducedMatchesGeneralBeyondAnEndStop) {
 }
 
 TEST(InverseDynamics, ReducedGivesTheGeneralPathsStatuses) {
-  const Model m = model_of(machine_params());
+  const Model m = model_of(every_machine_term());
   const Pose z = Pose::Zero();
   InverseDynamicsResult r, g;
   InverseActuators act;
@@ -147,7 +133,7 @@ TEST(InverseDynamics, ReducedGivesTheGeneralPathsStatuses) {
 TEST(InverseDynamics, BaselineLanesGiveTheSameBitsAsAvx) {
   // Model::avx picks the lanes' AVX variant where the processor has it; the
   // baseline variant (SSE2 pairs) runs the same expressions in the same order.
-  Model avx = model_of(machine_params());
+  Model avx = model_of(every_machine_term());
   Model base = avx;
   base.avx = false;
   if (!avx.avx) GTEST_SKIP() << "no AVX here: only the baseline variant runs";
