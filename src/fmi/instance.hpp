@@ -221,6 +221,10 @@ class Instance {
   Interface interface_;
   Logger log_;
   std::unique_ptr<ModelData> data_;
+  // Each variable's value (its Ref asked once, at instantiation; nullptr
+  // without one), by table index: get and set call no Ref per value.
+  std::vector<void*> address_;
+  void* address(const Variable* v) const { return address_[static_cast<std::size_t>(v - def_.variables)]; }
   std::uint32_t mode_ = kInstantiated;
   double start_time_ = 0.0;
   double stop_time_ = 0.0;

@@ -68,7 +68,7 @@ Status Instance::get_values(const char* function, VarType type, const std::uint3
   }
   for (std::size_t k = 0; k < n; ++k) {
     const Variable* v = k < kFoundCache ? found[k] : def_.find(vr[k]);
-    value[k] = v->causality == Causality::Independent ? static_cast<T>(time_) : *static_cast<T*>(v->value(*data_, v->index));
+    value[k] = v->causality == Causality::Independent ? static_cast<T>(time_) : *static_cast<T*>(address(v));
   }
   return s;
 }
@@ -132,13 +132,14 @@ Status Instance::set_values(const char* function, VarType type, const std::uint3
     valid_groups_ = 0;
     if (s != Status::OK) return s;
   }
+  const bool log_calls = log_.enabled(LogCategory::Calls);
   for (std::size_t k = 0; k < n; ++k) {
     const Variable* v = k < kFoundCache ? found[k] : def_.find(vr[k]);
     if (sets_states && v->state >= 0) {
-      if (log_.enabled(LogCategory::Calls)) log_.call("%s: %s = %.17g (state)", function, v->name, static_cast<double>(value[k]));
+      if (log_calls) log_.call("%s: %s = %.17g (state)", function, v->name, static_cast<double>(value[k]));
       continue;
     }
-    void* p = v->value(*data_, v->index);
+    void* p = address(v);
     if (type == VarType::Boolean) {
       *static_cast<T*>(p) = value[k] != 0 ? 1 : 0;
     } else {
@@ -146,7 +147,7 @@ Status Instance::set_values(const char* function, VarType type, const std::uint3
     }
     // A derivative refers to the value it was given with.
     if (v->derivative) *static_cast<double*>(v->derivative(*data_, v->index)) = 0.0;
-    if (log_.enabled(LogCategory::Calls)) log_.call("%s: %s = %.17g", function, v->name, static_cast<double>(value[k]));
+    if (log_calls) log_.call("%s: %s = %.17g", function, v->name, static_cast<double>(value[k]));
   }
   valid_groups_ = 0;
   return Status::OK;
