@@ -194,7 +194,14 @@ class Instance {
   Status get_values(const char* function, VarType type, const std::uint32_t vr[], std::size_t n, T value[]);
   template <class T>
   Status set_values(const char* function, VarType type, const std::uint32_t vr[], std::size_t n, const T value[]);
-  const Variable* lookup(const char* function, VarType type, std::uint32_t vr);
+  /// The variable of this type with this value reference (inline: every
+  /// value of every get and set), else nullptr with unknown_reference's error.
+  const Variable* lookup(const char* function, VarType type, std::uint32_t vr) {
+    const Variable* v = def_.find(vr);
+    if (v && v->type == type && (v->value || v->causality == Causality::Independent)) return v;
+    return unknown_reference(function, type, vr);
+  }
+  const Variable* unknown_reference(const char* function, VarType type, std::uint32_t vr);
 
   SavedState* new_state();
   /// allowed(Call::FmuState) and the FMU state argument: the saved state,

@@ -13,14 +13,10 @@ namespace pkm_fmi {
 // (every control tick's) are kept on the stack, beyond them found again.
 constexpr std::size_t kFoundCache = 32;
 
-const Variable* Instance::lookup(const char* function, VarType type, std::uint32_t vr) {
-  const Variable* v = def_.find(vr);
-  if (!v || v->type != type || (!v->value && v->causality != Causality::Independent)) {
-    log_.error("%s: unknown value reference %u (no %s variable has it)", function, static_cast<unsigned>(vr),
-               version_ == 2 ? fmi2_type_name(type) : fmi3_type_name(type));
-    return nullptr;
-  }
-  return v;
+const Variable* Instance::unknown_reference(const char* function, VarType type, std::uint32_t vr) {
+  log_.error("%s: unknown value reference %u (no %s variable has it)", function, static_cast<unsigned>(vr),
+             version_ == 2 ? fmi2_type_name(type) : fmi3_type_name(type));
+  return nullptr;
 }
 
 Status Instance::ensure_outputs(const char* function, unsigned needed) {
