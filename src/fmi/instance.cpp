@@ -69,6 +69,11 @@ Instance* Instance::create(const ModelDefinition& def, int fmi_version, Interfac
   }
   std::unique_ptr<Instance> inst(new Instance(def, fmi_version, interface, std::move(log)));
   inst->data_ = def.create();
+  inst->address_.resize(def.n_variables);
+  for (std::size_t i = 0; i < def.n_variables; ++i) {
+    const Variable& v = def.variables[i];
+    inst->address_[i] = v.value ? v.value(*inst->data_, v.index) : nullptr;
+  }
   inst->apply_start_values();
   inst->data_->reset();
   inst->log_.call("%s(%s, %s): %s, %s", fn, inst->log_.instance_name().c_str(), token, def.identifier,

@@ -194,7 +194,14 @@ class Instance {
   Status get_values(const char* function, VarType type, const std::uint32_t vr[], std::size_t n, T value[]);
   template <class T>
   Status set_values(const char* function, VarType type, const std::uint32_t vr[], std::size_t n, const T value[]);
-  const Variable* lookup(const char* function, VarType type, std::uint32_t vr);
+  /// The variable of this type with this value reference (inline: every
+  /// value of every get and set), else nullptr with unknown_reference's error.
+  const Variable* lookup(const char* function, VarType type, std::uint32_t vr) {
+    const Variable* v = def_.find(vr);
+    if (v && v->type == type && (v->value || v->causality == Causality::Independent)) return v;
+    return unknown_reference(function, type, vr);
+  }
+  const Variable* unknown_reference(const char* function, VarType type, std::uint32_t vr);
 
   SavedState* new_state();
   /// allowed(Call::FmuState) and the FMU state argument: the saved state,
@@ -221,6 +228,10 @@ class Instance {
   Interface interface_;
   Logger log_;
   std::unique_ptr<ModelData> data_;
+  // Each variable's value (its Ref asked once, at instantiation; nullptr
+  // without one), by table index: get and set call no Ref per value.
+  std::vector<void*> address_;
+  void* address(const Variable* v) const { return address_[static_cast<std::size_t>(v - def_.variables)]; }
   std::uint32_t mode_ = kInstantiated;
   double start_time_ = 0.0;
   double stop_time_ = 0.0;

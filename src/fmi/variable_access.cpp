@@ -13,14 +13,10 @@ namespace pkm_fmi {
 // (every control tick's) are kept on the stack, beyond them found again.
 constexpr std::size_t kFoundCache = 32;
 
-const Variable* Instance::lookup(const char* function, VarType type, std::uint32_t vr) {
-  const Variable* v = def_.find(vr);
-  if (!v || v->type != type || (!v->value && v->causality != Causality::Independent)) {
-    log_.error("%s: unknown value reference %u (no %s variable has it)", function, static_cast<unsigned>(vr),
-               version_ == 2 ? fmi2_type_name(type) : fmi3_type_name(type));
-    return nullptr;
-  }
-  return v;
+const Variable* Instance::unknown_reference(const char* function, VarType type, std::uint32_t vr) {
+  log_.error("%s: unknown value reference %u (no %s variable has it)", function, static_cast<unsigned>(vr),
+             version_ == 2 ? fmi2_type_name(type) : fmi3_type_name(type));
+  return nullptr;
 }
 
 Status Instance::ensure_outputs(const char* function, unsigned needed) {
@@ -68,7 +64,7 @@ Status Instance::get_values(const char* function, VarType type, const std::uint3
   }
   for (std::size_t k = 0; k < n; ++k) {
     const Variable* v = k < kFoundCache ? found[k] : def_.find(vr[k]);
-    value[k] = v->causality == Causality::Independent ? static_cast<T>(time_) : *static_cast<T*>(v->value(*data_, v->index));
+    value[k] = v->causality == Causality::Independent ? static_cast<T>(time_) : *static_cast<T*>(address(v));
   }
   return s;
 }
@@ -132,13 +128,14 @@ Status Instance::set_values(const char* function, VarType type, const std::uint3
     valid_groups_ = 0;
     if (s != Status::OK) return s;
   }
+  const bool log_calls = log_.enabled(LogCategory::Calls);
   for (std::size_t k = 0; k < n; ++k) {
     const Variable* v = k < kFoundCache ? found[k] : def_.find(vr[k]);
     if (sets_states && v->state >= 0) {
-      if (log_.enabled(LogCategory::Calls)) log_.call("%s: %s = %.17g (state)", function, v->name, static_cast<double>(value[k]));
+      if (log_calls) log_.call("%s: %s = %.17g (state)", function, v->name, static_cast<double>(value[k]));
       continue;
     }
-    void* p = v->value(*data_, v->index);
+    void* p = address(v);
     if (type == VarType::Boolean) {
       *static_cast<T*>(p) = value[k] != 0 ? 1 : 0;
     } else {
@@ -146,7 +143,7 @@ Status Instance::set_values(const char* function, VarType type, const std::uint3
     }
     // A derivative refers to the value it was given with.
     if (v->derivative) *static_cast<double*>(v->derivative(*data_, v->index)) = 0.0;
-    if (log_.enabled(LogCategory::Calls)) log_.call("%s: %s = %.17g", function, v->name, static_cast<double>(value[k]));
+    if (log_calls) log_.call("%s: %s = %.17g", function, v->name, static_cast<double>(value[k]));
   }
   valid_groups_ = 0;
   return Status::OK;

@@ -64,18 +64,7 @@ const char* fmi3_type_name(VarType t) {
   return "?";
 }
 
-const Variable* ModelDefinition::find(std::uint32_t vr) const {
-  if (n_variables == 0 || vr < variables[0].vr) return nullptr;
-  // The value references are unique and increasing, so the variable with
-  // vr sits at index vr - vr_0 or before it: the tables are nearly dense
-  // (a few gaps), so a few steps back from there find it, called for every
-  // value of every get and set; a binary search below that otherwise.
-  std::size_t last = std::min<std::size_t>(vr - variables[0].vr, n_variables - 1);
-  for (int k = 0; k < 4; ++k) {
-    if (variables[last].vr == vr) return &variables[last];
-    if (variables[last].vr < vr || last == 0) return nullptr;
-    --last;
-  }
+const Variable* ModelDefinition::find_sparse(std::uint32_t vr, std::size_t last) const {
   const Variable* end = variables + last + 1;
   const Variable* it =
       std::lower_bound(variables, end, vr, [](const Variable& v, std::uint32_t r) { return v.vr < r; });

@@ -32,7 +32,8 @@ const char* fmi3_type_name(VarType t);
 
 /// Where a variable lives in an instance's data: returns a pointer to a
 /// double (Real), std::int32_t (Integer) or int (Boolean, 0 or 1). `index` is the
-/// variable's element index (arrays), 0 for scalars.
+/// variable's element index (arrays), 0 for scalars. The address must stay
+/// the same for the instance's life: the layer asks once, at instantiation.
 using Ref = void* (*)(ModelData& data, int index);
 
 /// What a computed variable depends on, for ModelStructure: a bit set of
@@ -173,8 +174,23 @@ struct ModelDefinition {
   /// providesDirectionalDerivative(s), providesAdjointDerivatives.
   bool provides_derivatives = false;
 
-  /// The variable with this value reference, nullptr if none.
-  const Variable* find(std::uint32_t vr) const;
+  /// The variable with this value reference, nullptr if none. Called for
+  /// every value of every get and set, so inline: the value references are
+  /// unique and increasing and the tables nearly dense (a few gaps), so the
+  /// variable sits at index vr - vr_0 or a few steps before it; a binary
+  /// search below that (find_sparse) otherwise.
+  const Variable* find(std::uint32_t vr) const {
+    if (n_variables == 0 || vr < variables[0].vr) return nullptr;
+    std::size_t last = vr - variables[0].vr < n_variables ? vr - variables[0].vr : n_variables - 1;
+    for (int k = 0; k < 4; ++k) {
+      if (variables[last].vr == vr) return &variables[last];
+      if (variables[last].vr < vr || last == 0) return nullptr;
+      --last;
+    }
+    return find_sparse(vr, last);
+  }
+  /// find's binary search in variables[0..last].
+  const Variable* find_sparse(std::uint32_t vr, std::size_t last) const;
   const Variable* find(const char* name) const;
   /// The instantiation token (FMI 3.0) = GUID (FMI 2.0): a hash of the
   /// table, so that it changes whenever the interface does. Computed on each

@@ -43,9 +43,17 @@ const pkm::Model* InverseData::current_model(Context& ctx, const char* function,
 }
 
 Status InverseData::update_outputs(Context& ctx, unsigned groups) {
+  // After initialisation the instance's model, as current_model gives it,
+  // without the optional (its storage zeroed on every call: 20 ns of a tick).
+  if (!ctx.initialization_mode && model) return compute_outputs(ctx, *model, groups);
   std::optional<pkm::Model> temporary;
   const pkm::Model* m = current_model(ctx, "get", temporary);
   if (!m) return Status::Error;
+  return compute_outputs(ctx, *m, groups);
+}
+
+Status InverseData::compute_outputs(Context& ctx, const pkm::Model& with, unsigned groups) {
+  const pkm::Model* m = &with;
   const pkm::Pose p(pose[0], pose[1], pose[2], pose[3]);
   const pkm::Pose pd(vel[0], vel[1], vel[2], vel[3]);
   const pkm::Pose pdd(acc[0], acc[1], acc[2], acc[3]);

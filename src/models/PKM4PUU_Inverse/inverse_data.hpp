@@ -64,6 +64,8 @@ struct InverseData final : MechanismData {
   }
   bool step_has_effects() const override { return false; }
   Status update_outputs(Context& ctx, unsigned groups) override;
+  /// update_outputs with the model to evaluate with.
+  Status compute_outputs(Context& ctx, const pkm::Model& with, unsigned groups);
   void save(StateWriter& w) const override;
   bool load(StateReader& r, Context& ctx) override;
 

@@ -45,7 +45,8 @@ Status holding_forces(const Model& m, const Vec16& q, const Wrench& we, Vec4& F)
 /// forces from the reduced system, lambda leg by leg. No iteration:
 /// `warm_start` and `opt` are not used (kept for inverse_dynamics_general's
 /// signature). Status::Unreachable off the workspace, ::Singular at a leg or
-/// parallel singularity, ::NonFinite for a non-finite argument.
+/// parallel singularity, ::NonFinite for a non-finite argument; on a
+/// failure `out` holds no result (parts of it may have been written).
 Status inverse_dynamics(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd,
                         const Wrench& we, InverseDynamicsResult& out, bool warm_start = false,
                         const NewtonOptions& opt = {});

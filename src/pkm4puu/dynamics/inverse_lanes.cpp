@@ -32,6 +32,10 @@ PKM_LANES_INLINE Pack choose(const lanes::Mask& m, const Pack& a, const Pack& b)
 // atan there (a rational approximation of degree 4/5 in z = t^2 after the
 // reduction t -> (t - 1)/(t + 1) above 0.66, with pi/4's lower bits), then
 // the octant. No libm call: the legs' angles for four legs at once.
+// kLowerRight: x >= +0 and y <= 0 in every lane (theta2 of the elbow-down
+// branch), so the x < 0 branch never applies and y's sign is the result's:
+// 0 - r is r's negative, and +0 for y = -0 as the general case's r = +0.
+template <bool kLowerRight = false>
 PKM_LANES_INLINE Pack atan2_lanes(const Pack& y, const Pack& x) {
   const Pack ay = lanes::abs(y), ax = lanes::abs(x);
   const auto steep = lanes::gt(ay - ax, 0.0);
@@ -49,6 +53,7 @@ PKM_LANES_INLINE Pack atan2_lanes(const Pack& y, const Pack& x) {
   const double kPio4 = 0.78539816339744830962, kMoreBits = 6.123233995736765886130e-17;
   Pack r = choose(upper, w + 0.5 * kMoreBits + kPio4, w);                     // atan(t), t in [0, 1]
   r = choose(steep, (1.5707963267948966 - r) + kMoreBits, r);                // |y| > |x|
+  if (kLowerRight) return zero - r;
   r = choose(lanes::lt(x, 0.0), (3.141592653589793 - r) + 2.0 * kMoreBits, r);  // x < 0
   return choose(lanes::lt(y, 0.0), zero - r, r);
 }
@@ -75,6 +80,21 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
   if (lanes::any(lp.out_of_reach)) return Status::Unreachable;
   const Pack c1 = lp.c1, s1 = lp.s1, c2 = lp.c2, s2 = lp.s2, ax = lp.ax, ay = lp.ay;
   if (lanes::any(lanes::lt(lanes::abs(c2 * s2), kLegSingularFloor))) return Status::Singular;
+  if (kFull) {
+    // The angles (q only) first, stored at once: their divisions and
+    // polynomials then run beside the forces' work instead of after it (the
+    // compiler would otherwise sink them to their use, 25 ns later).
+    // leg_inverse_kinematics' theta1 = atan2(qy, qx) + atan2(h', A) lies in
+    // (-pi, 3 pi/2]: atan2(s1, c1) + 2 pi where that is below 0 and qy is not.
+    const Pack th1 = atan2_lanes(s1, c1);
+    const Pack th2 = atan2_lanes<true>(s2, c2);  // theta2 in [-pi/2, 0]: elbow-down, c2 >= 0 >= s2
+    for (int i = 0; i < kLegs; ++i) {
+      double t1 = lanes::lane(th1, i);
+      if (!std::signbit(lanes::lane(lp.qy, i)) && t1 < 0.0) t1 += 6.283185307179586;
+      full->q[leg_offset(i) + 1] = t1;
+      full->q[leg_offset(i) + 2] = lanes::lane(th2, i);
+    }
+  }
   // L_i^{-1} = J_i^{-1} Rz(beta_i)^T in closed form (prepare_leg_kinematics).
   const double l = p.l, hp = p.h_prime;
   const Pack a = -l * s1 * c2 + hp * c1, b = l * c1 * c2 + hp * s1;
@@ -156,17 +176,12 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
   const Pack rho = lp.rho;
   if (kFull) {
     InverseDynamicsResult& o = *full;
-    // leg_inverse_kinematics' theta1 = atan2(qy, qx) + atan2(h', A) lies in
-    // (-pi, 3 pi/2]: atan2(s1, c1) + 2 pi where that is below 0 and qy is not.
-    const Pack th1 = atan2_lanes(s1, c1), th2 = atan2_lanes(s2, c2);  // theta2 in (-pi/2, 0): elbow-down
     // Leg i's rows of Eq. 1: lambda_i = L_i^{-T} ((F_i + F_passive,i) e_0 - tau_i) (Eq. 10).
     const Pack v0 = lanes::pack(Ft[0], Ft[1], Ft[2], Ft[3]) - tau0;
     const Pack lam0 = l00 * v0 - l10 * tau1 - l20 * tau2, lam1 = l01 * v0 - l11 * tau1 - l21 * tau2;
     for (int i = 0; i < kLegs; ++i) {
       const int at = leg_offset(i);
-      double t1 = lanes::lane(th1, i);
-      if (!std::signbit(lanes::lane(lp.qy, i)) && t1 < 0.0) t1 += 6.283185307179586;
-      o.q.segment<3>(at) << lanes::lane(rho, i), t1, lanes::lane(th2, i);
+      o.q[at] = lanes::lane(rho, i);  // the angles are in place
       o.qd.segment<3>(at) << lanes::lane(rd, i), lanes::lane(t1d, i), lanes::lane(t2d, i);
       o.qdd.segment<3>(at) << lanes::lane(rdd, i), lanes::lane(t1dd, i), lanes::lane(t2dd, i);
       o.lambda.segment<3>(3 * i) << lanes::lane(lam0, i), lanes::lane(lam1, i), lanes::lane(v0, i);
