@@ -5,6 +5,7 @@
 #include <string>
 
 #include "pkm4puu/dynamics/reduced_dynamics.hpp"
+#include "pkm4puu/dynamics/regressor_lanes.hpp"
 #include "pkm4puu/machine/end_stops.hpp"
 #include "pkm4puu/machine/friction.hpp"
 
@@ -153,12 +154,10 @@ Status apply_parameter_vector(const ParamVector& pi, Params& p, std::string* err
 Status regressor(const Model& m, const Pose& pose, const Pose& pose_d, const Pose& pose_dd, const Wrench& we,
                  RegressorSample& out) {
   if (!pose.allFinite() || !pose_d.allFinite() || !pose_dd.allFinite() || !we.allFinite()) return Status::NonFinite;
-  ReducedDynamics rd;
-  Mat4 Arho;
-  const Status s = prepare_legs(m, platform_config(pose), rd, out.rho, Arho);
-  if (s != Status::Ok) return s;
-  out.pose = pose;
-  return assemble(m, rd, Arho, pose_d, pose_dd, we, out);
+  // The reduced, leg-partitioned form (regressor_lanes.hpp).
+  const Status s = regressor_lanes(m, platform_config(pose), pose_d, pose_dd, we, out);
+  if (s == Status::Ok) out.pose = pose;
+  return s;
 }
 
 Status forward_position(const Model& m, const Vec4& rho, Pose& pose) {

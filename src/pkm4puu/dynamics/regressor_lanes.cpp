@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: BSD-2-Clause
+#include "pkm4puu/dynamics/regressor_lanes.hpp"
+
+#include <cmath>
+
+#include "pkm4puu/base/lanes.hpp"
+#include "pkm4puu/dynamics/leg_motion_lanes.hpp"
+#include "pkm4puu/dynamics/leg_position_lanes.hpp"
+#include "pkm4puu/machine/end_stops.hpp"
+
+namespace pkm {
+namespace {
+
+using lanes::Pack;
+
+/// Sum over the legs (lanes), in the inverse dynamics' order.
+PKM_LANES_INLINE double leg_sum(const Pack& x) {
+  return (lanes::lane(x, 0) + lanes::lane(x, 1)) + (lanes::lane(x, 2) + lanes::lane(x, 3));
+}
+
+/// Column j of Z = sum_i A_i^T D_i from D_i's column (d0, d1, d2) per leg.
+PKM_LANES_INLINE void add_leg_column(const lane_legs::LegMotion& lm, const Pack& d0, const Pack& d1, const Pack& d2,
+                                     Eigen::Matrix<double, 4, kParams - 2>& Z, int j) {
+  Z(0, j) = leg_sum(lm.l00 * d0 + lm.l10 * d1 + lm.l20 * d2);
+  Z(1, j) = leg_sum(lm.l01 * d0 + lm.l11 * d1 + lm.l21 * d2);
+  Z(2, j) = leg_sum(d0);
+  Z(3, j) = leg_sum(lm.a03 * d0 + lm.a13 * d1 + lm.a23 * d2);
+}
+
+PKM_LANES_INLINE Status legs_regressor(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd,
+                                       const Wrench& we, RegressorSample& out) {
+  const Params& p = m.p;
+  const lane_legs::LegPosition<Pack> lp = lane_legs::leg_position(p, pc, lane_legs::lane_inputs(m));
+  if (lanes::any(lp.out_of_reach)) return Status::Unreachable;
+  const Pack c2 = lp.c2, s2 = lp.s2;
+  if (lanes::any(lanes::lt(lanes::abs(c2 * s2), kLegSingularFloor))) return Status::Singular;
+  const lane_legs::LegMotion lm = lane_legs::leg_motion(m, lp, pd, pdd);
+  const Pack rdd = lm.rdd, t1dd = lm.t1dd, t2dd = lm.t2dd, t1d = lm.t1d, t2d = lm.t2d;
+  // D_i: the leg's rows of M qdd + V + G per parameter (lagrangian.hpp's
+  // M_leg, leg_coriolis, leg_gravity differentiated in each parameter).
+  const double g = p.g, l = p.l, k2 = m.drive_ratio * m.drive_ratio;
+  const Pack zero = lanes::broadcast(0.0);
+  const Pack sc = s2 * c2, cc = c2 * c2, w11 = t1d * t1d, w12 = 2.0 * sc * t1d * t2d;
+  const Pack rg = rdd + g;
+  Eigen::Matrix<double, 4, kParams - 2> Z;  // B^T D for pi's entries before the friction's
+  add_leg_column(lm, rg, zero, zero, Z, kPiSlider);
+  add_leg_column(lm, rg + 0.5 * l * (c2 * t2dd - s2 * t2d * t2d), 0.25 * l * l * (cc * t1dd - w12),
+                 0.5 * l * c2 * rg + 0.25 * l * l * (t2dd + sc * w11), Z, kPiRod);
+  add_leg_column(lm, zero, s2 * s2 * t1dd + w12, zero - sc * w11, Z, kPiRodIx);
+  add_leg_column(lm, zero, cc * t1dd - w12, sc * w11, Z, kPiRodIy);
+  // I_rod[3] and the rotor touch one row each: A_i^T e_2 t2dd, A_i^T e_0 k2 rdd.
+  Z(0, kPiRodIz) = leg_sum(lm.l20 * t2dd);
+  Z(1, kPiRodIz) = leg_sum(lm.l21 * t2dd);
+  Z(2, kPiRodIz) = 0.0;
+  Z(3, kPiRodIz) = leg_sum(lm.a23 * t2dd);
+  const Pack kr = k2 * rdd;
+  Z(0, kPiRotor) = leg_sum(lm.l00 * kr);
+  Z(1, kPiRotor) = leg_sum(lm.l01 * kr);
+  Z(2, kPiRotor) = leg_sum(kr);
+  Z(3, kPiRotor) = leg_sum(lm.a03 * kr);
+  // The platform with its payload (lagrangian.hpp's M_p and V_p per parameter).
+  const double c = pc.cphi, s = pc.sphi, w2 = pd[3] * pd[3];
+  const Vec4 translational(pdd[0], pdd[1], pdd[2] + g, 0.0);
+  Z.col(kPiPlatform) = translational;
+  Z.col(kPiPayload) = translational;
+  Z.col(kPiPlatformIzz) << 0.0, 0.0, 0.0, pdd[3];
+  Z.col(kPiPayloadIzzP) << 0.0, 0.0, 0.0, pdd[3];
+  Z.col(kPiPayloadMx) << -s * pdd[3] - c * w2, c * pdd[3] - s * w2, 0.0, -s * pdd[0] + c * pdd[1];
+  Z.col(kPiPayloadMy) << -c * pdd[3] + s * w2, -s * pdd[3] - c * w2, 0.0, -c * pdd[0] - s * pdd[1];
+  // J_rho^T Y = Z with J_rho^T's rows (l00_i), (l01_i), (1), (a03_i): the
+  // closed-form 4x4 inverse as the inverse dynamics; not finite at a
+  // parallel singularity.
+  Mat4 JrT;
+  for (int j = 0; j < kLegs; ++j) JrT.col(j) << lanes::lane(lm.l00, j), lanes::lane(lm.l01, j), 1.0, lanes::lane(lm.a03, j);
+  const Mat4 Jinv = JrT.inverse();
+  out.Y.leftCols<kParams - 2>().noalias() = Jinv * Z;
+  out.F0.noalias() = -(Jinv * we);
+  for (int i = 0; i < kLegs; ++i) {
+    const double rho = lanes::lane(lp.rho, i), rhod = lanes::lane(lm.rd, i);
+    out.rho[i] = rho;
+    out.rhod[i] = rhod;
+    // F = ... - F_fric - F_stop with F_fric = -b rhod - F_c tanh(rhod / v_s) (friction.hpp).
+    out.Y(i, kPiViscous) = rhod;
+    out.Y(i, kPiCoulomb) = std::tanh(rhod / p.friction_velocity);
+    out.F0[i] -= stop_force(p, rho, rhod);
+  }
+  out.pose_d = pd;
+  out.pose_dd = pdd;
+  out.beyond_stops = stops_passed(p, out.rho);
+  return out.Y.allFinite() && out.F0.allFinite() ? Status::Ok : Status::Singular;
+}
+
+Status regressor_generic(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd, const Wrench& we,
+                         RegressorSample& out) {
+  return legs_regressor(m, pc, pd, pdd, we, out);
+}
+
+#if PKM_LANES_AVX_DISPATCH
+__attribute__((target("avx"))) Status regressor_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
+                                                    const Pose& pdd, const Wrench& we, RegressorSample& out) {
+  return legs_regressor(m, pc, pd, pdd, we, out);
+}
+#endif
+
+}  // namespace
+
+Status regressor_lanes(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd, const Wrench& we,
+                       RegressorSample& out) {
+#if PKM_LANES_AVX_DISPATCH
+  if (m.avx) return regressor_avx(m, pc, pd, pdd, we, out);
+#endif
+  return regressor_generic(m, pc, pd, pdd, we, out);
+}
+
+}  // namespace pkm
