@@ -2,6 +2,7 @@
 #include "pkm4puu/dynamics/regressor_lanes.hpp"
 
 #include <cmath>
+#include <cstring>
 
 #include "pkm4puu/base/lanes.hpp"
 #include "pkm4puu/dynamics/leg_motion_lanes.hpp"
@@ -13,18 +14,29 @@ namespace {
 
 using lanes::Pack;
 
-/// Sum over the legs (lanes), in the inverse dynamics' order.
-PKM_LANES_INLINE double leg_sum(const Pack& x) {
-  return (lanes::lane(x, 0) + lanes::lane(x, 1)) + (lanes::lane(x, 2) + lanes::lane(x, 3));
+/// The sums over the legs (lanes) of a, b, c, d as one pack, each in the
+/// inverse dynamics' order (x0 + x1) + (x2 + x3): a 4x4 transpose by pair sums.
+PKM_LANES_INLINE Pack leg_sums(const Pack& a, const Pack& b, const Pack& c, const Pack& d) {
+#if PKM_LANES_VECTOR_EXTENSIONS
+  const Pack ab = __builtin_shufflevector(a, b, 0, 4, 2, 6) + __builtin_shufflevector(a, b, 1, 5, 3, 7);
+  const Pack cd = __builtin_shufflevector(c, d, 0, 4, 2, 6) + __builtin_shufflevector(c, d, 1, 5, 3, 7);
+  return __builtin_shufflevector(ab, cd, 0, 1, 4, 5) + __builtin_shufflevector(ab, cd, 2, 3, 6, 7);
+#else
+  auto sum = [](const Pack& x) {
+    return (lanes::lane(x, 0) + lanes::lane(x, 1)) + (lanes::lane(x, 2) + lanes::lane(x, 3));
+  };
+  return lanes::pack(sum(a), sum(b), sum(c), sum(d));
+#endif
 }
+
+using ZMatrix = Eigen::Matrix<double, 4, kParams - 2>;  // B^T D for pi's entries before the friction's
 
 /// Column j of Z = sum_i A_i^T D_i from D_i's column (d0, d1, d2) per leg.
 PKM_LANES_INLINE void add_leg_column(const lane_legs::LegMotion& lm, const Pack& d0, const Pack& d1, const Pack& d2,
-                                     Eigen::Matrix<double, 4, kParams - 2>& Z, int j) {
-  Z(0, j) = leg_sum(lm.l00 * d0 + lm.l10 * d1 + lm.l20 * d2);
-  Z(1, j) = leg_sum(lm.l01 * d0 + lm.l11 * d1 + lm.l21 * d2);
-  Z(2, j) = leg_sum(d0);
-  Z(3, j) = leg_sum(lm.a03 * d0 + lm.a13 * d1 + lm.a23 * d2);
+                                     ZMatrix& Z, int j) {
+  const Pack col = leg_sums(lm.l00 * d0 + lm.l10 * d1 + lm.l20 * d2, lm.l01 * d0 + lm.l11 * d1 + lm.l21 * d2, d0,
+                            lm.a03 * d0 + lm.a13 * d1 + lm.a23 * d2);
+  std::memcpy(Z.col(j).data(), &col, 4 * sizeof(double));
 }
 
 PKM_LANES_INLINE Status legs_regressor(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd,
@@ -42,22 +54,14 @@ PKM_LANES_INLINE Status legs_regressor(const Model& m, const PlatformConfig& pc,
   const Pack zero = lanes::broadcast(0.0);
   const Pack sc = s2 * c2, cc = c2 * c2, w11 = t1d * t1d, w12 = 2.0 * sc * t1d * t2d;
   const Pack rg = rdd + g;
-  Eigen::Matrix<double, 4, kParams - 2> Z;  // B^T D for pi's entries before the friction's
+  ZMatrix Z;
   add_leg_column(lm, rg, zero, zero, Z, kPiSlider);
   add_leg_column(lm, rg + 0.5 * l * (c2 * t2dd - s2 * t2d * t2d), 0.25 * l * l * (cc * t1dd - w12),
                  0.5 * l * c2 * rg + 0.25 * l * l * (t2dd + sc * w11), Z, kPiRod);
   add_leg_column(lm, zero, s2 * s2 * t1dd + w12, zero - sc * w11, Z, kPiRodIx);
   add_leg_column(lm, zero, cc * t1dd - w12, sc * w11, Z, kPiRodIy);
-  // I_rod[3] and the rotor touch one row each: A_i^T e_2 t2dd, A_i^T e_0 k2 rdd.
-  Z(0, kPiRodIz) = leg_sum(lm.l20 * t2dd);
-  Z(1, kPiRodIz) = leg_sum(lm.l21 * t2dd);
-  Z(2, kPiRodIz) = 0.0;
-  Z(3, kPiRodIz) = leg_sum(lm.a23 * t2dd);
-  const Pack kr = k2 * rdd;
-  Z(0, kPiRotor) = leg_sum(lm.l00 * kr);
-  Z(1, kPiRotor) = leg_sum(lm.l01 * kr);
-  Z(2, kPiRotor) = leg_sum(kr);
-  Z(3, kPiRotor) = leg_sum(lm.a03 * kr);
+  add_leg_column(lm, zero, zero, t2dd, Z, kPiRodIz);
+  add_leg_column(lm, k2 * rdd, zero, zero, Z, kPiRotor);
   // The platform with its payload (lagrangian.hpp's M_p and V_p per parameter).
   const double c = pc.cphi, s = pc.sphi, w2 = pd[3] * pd[3];
   const Vec4 translational(pdd[0], pdd[1], pdd[2] + g, 0.0);
@@ -76,18 +80,20 @@ PKM_LANES_INLINE Status legs_regressor(const Model& m, const PlatformConfig& pc,
   out.Y.leftCols<kParams - 2>().noalias() = Jinv * Z;
   out.F0.noalias() = -(Jinv * we);
   for (int i = 0; i < kLegs; ++i) {
-    const double rho = lanes::lane(lp.rho, i), rhod = lanes::lane(lm.rd, i);
-    out.rho[i] = rho;
+    const double rhod = lanes::lane(lm.rd, i);
+    out.rho[i] = lanes::lane(lp.rho, i);
     out.rhod[i] = rhod;
     // F = ... - F_fric - F_stop with F_fric = -b rhod - F_c tanh(rhod / v_s) (friction.hpp).
     out.Y(i, kPiViscous) = rhod;
     out.Y(i, kPiCoulomb) = std::tanh(rhod / p.friction_velocity);
-    out.F0[i] -= stop_force(p, rho, rhod);
   }
+  out.beyond_stops = stops_passed(p, out.rho);
+  if (out.beyond_stops != 0)  // F_stop is 0 within the travel
+    for (int i = 0; i < kLegs; ++i) out.F0[i] -= stop_force(p, out.rho[i], out.rhod[i]);
   out.pose_d = pd;
   out.pose_dd = pdd;
-  out.beyond_stops = stops_passed(p, out.rho);
-  return out.Y.allFinite() && out.F0.allFinite() ? Status::Ok : Status::Singular;
+  // A non-finite entry makes the sum non-finite (Inf - Inf, NaN propagate).
+  return std::isfinite(out.Y.sum() + out.F0.sum()) ? Status::Ok : Status::Singular;
 }
 
 Status regressor_generic(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd, const Wrench& we,
