@@ -97,7 +97,7 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
     }
   }
   // A_i, qd_i, qdd_i (leg_motion_lanes.hpp).
-  const lane_legs::LegMotion lm = lane_legs::leg_motion(m, lp, pd, pdd);
+  const lane_legs::LegMotion lm = lane_legs::leg_motion(m, lp, lane_legs::leg_jacobian(m, lp), pd, pdd);
   const Pack l00 = lm.l00, l01 = lm.l01, l10 = lm.l10, l11 = lm.l11, l20 = lm.l20, l21 = lm.l21;
   const Pack a03 = lm.a03, a13 = lm.a13, a23 = lm.a23;
   const Pack rd = lm.rd, t1d = lm.t1d, t2d = lm.t2d, rdd = lm.rdd, t1dd = lm.t1dd, t2dd = lm.t2dd;

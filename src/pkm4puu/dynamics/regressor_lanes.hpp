@@ -7,6 +7,7 @@
 #pragma once
 
 #include "pkm4puu/dynamics/regressor.hpp"
+#include "pkm4puu/kinematics/leg_kinematics.hpp"
 
 namespace pkm {
 
@@ -16,5 +17,14 @@ namespace pkm {
 /// or parallel singularity.
 Status regressor_lanes(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd, const Wrench& we,
                        RegressorSample& out);
+
+/// (R1) at the pose pc from the sliders' rates and accelerations: pd =
+/// A_rho^{-1} rhod, pdd = A_rho^{-1} (rhodd - b_rho), then as regressor_lanes.
+Status joint_regressor_lanes(const Model& m, const PlatformConfig& pc, const Vec4& rhod, const Vec4& rhodd,
+                             const Wrench& we, RegressorSample& out);
+
+/// The sliders' positions rho at pc and A_rho = d rho / d pose (the forward
+/// kinematics' Newton step). Unreachable, Singular as regressor_lanes.
+Status slider_positions_lanes(const Model& m, const PlatformConfig& pc, Vec4& rho, Mat4& Arho);
 
 }  // namespace pkm
