@@ -71,7 +71,7 @@ PKM_LANES_INLINE Status regressor_columns(const Model& m, const PlatformConfig& 
   RegressorZ Z;
   regressor_leg_column(lm, rg, zero, zero, Z, kPiSlider);
   regressor_leg_column(lm, rg + 0.5 * l * (c2 * t2dd - s2 * t2d * t2d), 0.25 * l * l * (cc * t1dd - w12),
-                 0.5 * l * c2 * rg + 0.25 * l * l * (t2dd + sc * w11), Z, kPiRod);
+                       0.5 * l * c2 * rg + 0.25 * l * l * (t2dd + sc * w11), Z, kPiRod);
   regressor_leg_column(lm, zero, s2 * s2 * t1dd + w12, zero - sc * w11, Z, kPiRodIx);
   regressor_leg_column(lm, zero, cc * t1dd - w12, sc * w11, Z, kPiRodIy);
   regressor_leg_column(lm, zero, zero, t2dd, Z, kPiRodIz);
@@ -104,7 +104,8 @@ PKM_LANES_INLINE Status regressor_columns(const Model& m, const PlatformConfig& 
     for (int i = 0; i < kLegs; ++i) out.F0[i] -= stop_force(p, out.rho[i], out.rhod[i]);
   out.pose_d = pd;
   out.pose_dd = pdd;
-  // A non-finite entry makes the sum non-finite (Inf - Inf, NaN propagate).
+  // One check for all 60 entries: a non-finite entry makes the sum non-finite
+  // (Inf - Inf and NaN propagate); finite entries near 1e308 would too.
   return std::isfinite(out.Y.sum() + out.F0.sum()) ? Status::Ok : Status::Singular;
 }
 
