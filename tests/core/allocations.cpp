@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // No heap allocation inside a time step of the core: 1000 state derivatives
 // (each formulation), inverse dynamics solves (warm and cold), the analytic
-// derivatives, and 1000 one-ms RK4 Plant::advance calls after initialisation
+// derivatives, the regressor (from the platform motion and from the
+// sliders), and 1000 one-ms RK4 Plant::advance calls after initialisation
 // (the FMU's tick, tests/fmu_allocations.c, rests on these). Counted by the
 // malloc interposer (tests/alloc_interposer.c: every malloc-family call of
 // the process, operator new included); pkm_bench prints the same windows'
@@ -15,6 +16,7 @@
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/dynamics/regressor.hpp"
 #include "pkm4puu/sim/plant.hpp"
 #include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
 #include "apps/trajectory.hpp"
@@ -82,6 +84,23 @@ TEST_F(AllocationsTest, InverseDynamicsWarmAndCold) {
     EXPECT_EQ(alloc_count() - before, 0) << (warm ? "warm" : "cold");
     EXPECT_EQ(s, Status::Ok);
   }
+}
+
+TEST_F(AllocationsTest, RegressorFromThePlatformAndFromTheSliders) {
+  // The identification's per-sample calls: 1000 each along the path.
+  pkm::RegressorSample from_pose, from_joints;
+  from_joints.pose = p;
+  Status s = Status::Ok, sj = Status::Ok;
+  const long before = alloc_count();
+  for (long j = 1; j <= 1000 && s == Status::Ok && sj == Status::Ok; ++j) {
+    Pose q, qd, qdd;
+    path.eval(1.0 + 0.5e-3 * static_cast<double>(j % 100), q, qd, qdd);
+    s = pkm::regressor(model, q, qd, qdd, Wrench::Zero(), from_pose);
+    sj = pkm::joint_regressor(model, from_pose.rho, from_pose.rhod, Vec4::Zero(), Wrench::Zero(), from_joints);
+  }
+  EXPECT_EQ(alloc_count() - before, 0);
+  EXPECT_EQ(s, Status::Ok);
+  EXPECT_EQ(sj, Status::Ok);
 }
 
 TEST_F(AllocationsTest, AnalyticDerivatives) {

@@ -7,6 +7,7 @@
 #include "pkm4puu/base/lanes.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
+#include "pkm4puu/dynamics/leg_motion_lanes.hpp"
 #include "pkm4puu/dynamics/leg_position_lanes.hpp"
 #include "pkm4puu/machine/passive_force.hpp"
 
@@ -78,7 +79,7 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
   const Params& p = m.p;
   const lane_legs::LegPosition<Pack> lp = lane_legs::leg_position(p, pc, lane_legs::lane_inputs(m));
   if (lanes::any(lp.out_of_reach)) return Status::Unreachable;
-  const Pack c1 = lp.c1, s1 = lp.s1, c2 = lp.c2, s2 = lp.s2, ax = lp.ax, ay = lp.ay;
+  const Pack c2 = lp.c2, s2 = lp.s2;
   if (lanes::any(lanes::lt(lanes::abs(c2 * s2), kLegSingularFloor))) return Status::Singular;
   if (kFull) {
     // The angles (q only) first, stored at once: their divisions and
@@ -86,7 +87,7 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
     // compiler would otherwise sink them to their use, 25 ns later).
     // leg_inverse_kinematics' theta1 = atan2(qy, qx) + atan2(h', A) lies in
     // (-pi, 3 pi/2]: atan2(s1, c1) + 2 pi where that is below 0 and qy is not.
-    const Pack th1 = atan2_lanes(s1, c1);
+    const Pack th1 = atan2_lanes(lp.s1, lp.c1);
     const Pack th2 = atan2_lanes<true>(s2, c2);  // theta2 in [-pi/2, 0]: elbow-down, c2 >= 0 >= s2
     for (int i = 0; i < kLegs; ++i) {
       double t1 = lanes::lane(th1, i);
@@ -95,35 +96,12 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
       full->q[leg_offset(i) + 2] = lanes::lane(th2, i);
     }
   }
-  // L_i^{-1} = J_i^{-1} Rz(beta_i)^T in closed form (prepare_leg_kinematics).
-  const double l = p.l, hp = p.h_prime;
-  const Pack a = -l * s1 * c2 + hp * c1, b = l * c1 * c2 + hp * s1;
-  const Pack e = -l * c1 * s2, f = -l * s1 * s2, g = l * c2;
-  const Pack inv_D = 1.0 / (a * f - b * e);
-  const Pack j00 = b * g * inv_D, j01 = -a * g * inv_D;
-  const Pack j10 = f * inv_D, j11 = -e * inv_D;
-  const Pack j20 = -b * inv_D, j21 = a * inv_D;
-  const Pack cb = lanes::pack(m.cos_beta[0], m.cos_beta[1], m.cos_beta[2], m.cos_beta[3]);
-  const Pack sb = lanes::pack(m.sin_beta[0], m.sin_beta[1], m.sin_beta[2], m.sin_beta[3]);
-  const Pack l00 = cb * j00 - sb * j01, l10 = cb * j10 - sb * j11, l20 = cb * j20 - sb * j21;
-  const Pack l01 = sb * j00 + cb * j01, l11 = sb * j10 + cb * j11, l21 = sb * j20 + cb * j21;
-  // A_i = [L_i^{-1}, L_i^{-1} (e_z x attach)].
-  const Pack a03 = l01 * ax - l00 * ay, a13 = l11 * ax - l10 * ay, a23 = l21 * ax - l20 * ay;
-  // qd_i = A_i pd.
-  const double phid = pd[3];
-  const Pack rd = l00 * pd[0] + l01 * pd[1] + pd[2] + a03 * phid;
-  const Pack t1d = l10 * pd[0] + l11 * pd[1] + a13 * phid;
-  const Pack t2d = l20 * pd[0] + l21 * pd[1] + a23 * phid;
-  // b_i = -L_i^{-1} gamma_i, gamma_i = Rz(beta_i) leg_point_quadratic + attach phid^2.
-  const Pack q0 = (-l * c1 * c2 - hp * s1) * t1d * t1d + 2 * l * s1 * s2 * t1d * t2d - l * c1 * c2 * t2d * t2d;
-  const Pack q1 = (-l * s1 * c2 + hp * c1) * t1d * t1d - 2 * l * c1 * s2 * t1d * t2d - l * s1 * c2 * t2d * t2d;
-  const Pack q2 = -l * s2 * t2d * t2d;
-  const double w2 = phid * phid;
-  const Pack g0 = (cb * q0 - sb * q1) + ax * w2, g1 = (sb * q0 + cb * q1) + ay * w2;
-  // qdd_i = A_i pdd + b_i.
-  const Pack rdd = l00 * pdd[0] + l01 * pdd[1] + pdd[2] + a03 * pdd[3] - (l00 * g0 + l01 * g1 + q2);
-  const Pack t1dd = l10 * pdd[0] + l11 * pdd[1] + a13 * pdd[3] - (l10 * g0 + l11 * g1);
-  const Pack t2dd = l20 * pdd[0] + l21 * pdd[1] + a23 * pdd[3] - (l20 * g0 + l21 * g1);
+  // A_i, qd_i, qdd_i (leg_motion_lanes.hpp).
+  const lane_legs::LegMotion lm = lane_legs::leg_motion(m, lp, lane_legs::leg_jacobian(m, lp), pd, pdd);
+  const Pack l00 = lm.l00, l01 = lm.l01, l10 = lm.l10, l11 = lm.l11, l20 = lm.l20, l21 = lm.l21;
+  const Pack a03 = lm.a03, a13 = lm.a13, a23 = lm.a23;
+  const Pack rd = lm.rd, t1d = lm.t1d, t2d = lm.t2d, rdd = lm.rdd, t1dd = lm.t1dd, t2dd = lm.t2dd;
+  const double l = p.l, w2 = pd[3] * pd[3];
   // tau_i = M_i qdd_i + V_i + G_i - F_passive e_0 (leg_mass_matrix with the
   // rotor, leg_coriolis, leg_gravity; M01 = M12 = 0).
   const double m00 = p.m_slider + p.m_rod + m.reflected_mass, m22 = 0.25 * p.m_rod * l * l + p.I_rod[2];
