@@ -502,7 +502,9 @@ InverseDynamicsFigures inverse_dynamics_section(Bench& b, const Figure& sd) {
         seed);
   }
   const std::array<int, 2> it = newton_iterations(b, static_cast<size_t>(b.n_out));  // t = 1 s
-  const double ratio = f.reduced.median / sd.median;
+  // Mins for the target: section 1 measured sd(LegP) minutes apart, and on a
+  // loaded machine the min is the figure load disturbs least.
+  const double ratio = f.reduced.min / sd.min;
 
   std::printf("2. Inverse dynamics: one call per point of the stage-time grid (t = j*0.5 ms, 4001 points)\n");
   std::printf("   %-44s %12s %12s %10s %12s %8s\n", "evaluation", "median/call", "min/call", "N/batch", "vs sd(LegP)",
@@ -516,7 +518,7 @@ InverseDynamicsFigures inverse_dynamics_section(Bench& b, const Figure& sd) {
   row("inverse_dynamics, RK4 stage sequence [**]", f.stages, "-");
   row("inverse_dynamics_general, cold (closed form)", f.general_cold, std::to_string(it[0]));
   row("inverse_dynamics_general, warm (0.5 ms away)", f.general_warm, std::to_string(it[1]));
-  std::printf("   target: inverse_dynamics / sd(LegP) = %.2fx <= %gx: %s (stretch <= %gx: %s); "
+  std::printf("   target: inverse_dynamics / sd(LegP), mins = %.2fx <= %gx: %s (stretch <= %gx: %s); "
               "general cold / reduced = %.1fx\n",
               ratio, kInverseTarget, ok_mark(ratio, kInverseTarget), kInverseStretch, ok_mark(ratio, kInverseStretch),
               f.general_cold.median / f.reduced.median);
