@@ -73,3 +73,30 @@ def test_parameter_defaults_are_the_spec(which, request):
 
 def test_plant_solver_defaults(plant_fmu):
     _check_defaults(plant_fmu, SOLVER_DEFAULTS)
+
+
+@pytest.mark.parametrize("model", ["PKM4PUU", "PKM4PUU_Inverse"])
+@pytest.mark.parametrize("fmi", ["fmi2", "fmi3"])
+def test_time_is_the_independent_variable_without_start(model, fmi):
+    """FMI 2.0 section 2.2.7 (causality "independent"): the independent
+    variable "must be defined as Real without a start attribute"; FMI 3.0's
+    definition of causality "independent" likewise gives it no start. The FMI Library that
+    libcosim uses reports an error for exactly this ("Start attribute is
+    required for this causality, variability and initial combination"):
+    there the standard wins (docs/importers.md, "Where an importer and the
+    standard disagree")."""
+    import xml.etree.ElementTree as ET
+    from pathlib import Path
+
+    root = ET.parse(Path(__file__).resolve().parents[1] / "src" / "models" / model / fmi / "modelDescription.xml").getroot()
+    variables = root.find("ModelVariables")
+    if fmi == "fmi2":
+        independent = [v for v in variables if v.get("causality") == "independent"]
+        assert [v.get("name") for v in independent] == ["time"]
+        real = independent[0].find("Real")
+        assert real is not None and real.get("start") is None and real.get("unit") == "s"
+        assert independent[0].get("variability") == "continuous" and independent[0].get("initial") is None
+    else:
+        independent = [v for v in variables if v.get("causality") == "independent"]
+        assert [v.get("name") for v in independent] == ["time"] and independent[0].tag == "Float64"
+        assert independent[0].get("start") is None and independent[0].get("initial") is None
