@@ -47,8 +47,11 @@
 #if PKM_LANES_VECTOR_EXTENSIONS && defined(__x86_64__) && !defined(__AVX__) && \
     (!defined(_WIN32) || defined(PKM_UNALIGNED_VECTOR_MOVES))
 #define PKM_LANES_AVX_DISPATCH 1
+// Marks a kernel's AVX copy (no FMA: no contraction, the same bits).
+#define PKM_LANES_AVX_TARGET __attribute__((target("avx")))
 #else
 #define PKM_LANES_AVX_DISPATCH 0
+#define PKM_LANES_AVX_TARGET
 #endif
 
 // Every function here is inlined: GCC's note that a 32-byte vector is

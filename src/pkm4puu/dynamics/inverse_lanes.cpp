@@ -197,7 +197,7 @@ Status inverse_legs_generic(const Model& m, const PlatformConfig& pc, const Pose
 
 #if PKM_LANES_AVX_DISPATCH
 template <bool kFull>
-__attribute__((target("avx"))) Status inverse_legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
+PKM_LANES_AVX_TARGET Status inverse_legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
                                                        const Pose& pdd, const Wrench& we, InverseDynamicsResult* full,
                                                        InverseActuators* act) {
   return legs_inverse<kFull>(m, pc, pd, pdd, we, full, act);

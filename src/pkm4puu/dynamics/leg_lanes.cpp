@@ -76,11 +76,11 @@ Status legs_generic(const Model& m, const PlatformConfig& pc, const Pose& pd, co
 #if PKM_LANES_AVX_DISPATCH
 // The same source compiled for AVX (no FMA: no contraction, the same bits),
 // taken where the processor has it (Model::avx, asked once by make_model).
-__attribute__((target("avx"))) Status legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
+PKM_LANES_AVX_TARGET Status legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
                                                const Vec16& f, unsigned stops, LegSums& sums) {
   return legs_as_lanes(m, pc, pd, f, stops, sums);
 }
-__attribute__((target("avx"))) Status positions_avx(const Model& m, const PlatformConfig& pc, Vec4& rho) {
+PKM_LANES_AVX_TARGET Status positions_avx(const Model& m, const PlatformConfig& pc, Vec4& rho) {
   return positions_as_lanes(m, pc, rho);
 }
 #endif

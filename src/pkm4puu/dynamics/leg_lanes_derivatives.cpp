@@ -235,7 +235,7 @@ Status partials_generic(const Model& m, const PlatformConfig& pc, const Pose& pd
 }
 
 #if PKM_LANES_AVX_DISPATCH
-__attribute__((target("avx"))) Status partials_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
+PKM_LANES_AVX_TARGET Status partials_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
                                                    const Vec16& f, unsigned stops, LegPartialSums& out) {
   return partials_as_lanes(m, pc, pd, f, stops, out);
 }

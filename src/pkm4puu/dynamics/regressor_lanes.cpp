@@ -145,11 +145,6 @@ PKM_LANES_INLINE Status legs_sliders(const Model& m, const PlatformConfig& pc, V
 
 // One copy of each kernel for the baseline instruction set, one for AVX
 // (chosen by m.avx, as the inverse dynamics).
-#if PKM_LANES_AVX_DISPATCH
-#define PKM_AVX_TARGET __attribute__((target("avx")))
-#else
-#define PKM_AVX_TARGET
-#endif
 template <bool kAvx>
 struct RegressorKernels;
 template <>
@@ -168,19 +163,18 @@ struct RegressorKernels<false> {
 };
 template <>
 struct RegressorKernels<true> {
-  PKM_AVX_TARGET static Status regressor(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd,
+  PKM_LANES_AVX_TARGET static Status regressor(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd,
                                          const Wrench& we, RegressorSample& out) {
     return legs_regressor(m, pc, pd, pdd, we, out);
   }
-  PKM_AVX_TARGET static Status joint(const Model& m, const PlatformConfig& pc, const Vec4& rhod, const Vec4& rhodd,
+  PKM_LANES_AVX_TARGET static Status joint(const Model& m, const PlatformConfig& pc, const Vec4& rhod, const Vec4& rhodd,
                                      const Wrench& we, RegressorSample& out) {
     return legs_joint_regressor(m, pc, rhod, rhodd, we, out);
   }
-  PKM_AVX_TARGET static Status sliders(const Model& m, const PlatformConfig& pc, Vec4& rho, Mat4& Arho) {
+  PKM_LANES_AVX_TARGET static Status sliders(const Model& m, const PlatformConfig& pc, Vec4& rho, Mat4& Arho) {
     return legs_sliders(m, pc, rho, Arho);
   }
 };
-#undef PKM_AVX_TARGET
 
 bool regressor_use_avx(const Model& m) { return PKM_LANES_AVX_DISPATCH && m.avx; }
 
