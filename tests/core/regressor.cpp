@@ -15,7 +15,8 @@ using namespace pkm_test;
 namespace {
 
 /// A machine with every term of pi non-zero: rotors, friction, an
-/// off-centre payload (the values of tests/core/machine.cpp).
+/// off-centre payload (its payload values are spelled out again by the
+/// round-trip test below).
 Params machine_params() {
   Params p;
   p.rotor_inertia = 2e-7;
