@@ -196,9 +196,9 @@ Status Instance::setup_experiment(bool tolerance_defined, double tolerance, doub
 // past it (EnterEventMode, and FMI 2.0's SetTime in Event Mode). A
 // variable-step integrator's trial evaluations in Continuous-Time Mode
 // (SetTime, SetContinuousStates, GetDerivatives, GetEventIndicators, Get)
-// accept nothing: it may go back over them (FMI 3.0.2 3.2.1, fmi3SetTime's
-// bounds are all lower ones), and importers evaluate past their last output
-// point and interpolate back.
+// accept nothing: the importer may go back over them (FMI 3.0.2 2.2.6 and
+// 3.2.1: fmi3SetTime's bounds are all lower ones), and importers evaluate
+// past their last output point and interpolate back.
 bool Instance::past_stop_time(const char* fn, double t, const char* what) {
   if (!stop_time_defined_ || !(t > stop_time_ + 1e-9 * std::max(1.0, std::abs(stop_time_)))) return false;
   log_.error("%s: %s at t = %.17g lies past stopTime = %.17g (computing past a defined stopTime is an error); the "

@@ -7,7 +7,7 @@
 // and FMI 3.0.2 sections 2.3 (common states), 3.2 (Model Exchange) and 4.2
 // (Co-Simulation) literally. Then the departures of issue 27 items 4 and 5,
 // one test each, citing the clause: FMI 3.0's Discard, Model Exchange time
-// rules, FMI 3.0 logging.
+// rules and stopTime (what is computed past it), FMI 3.0 logging.
 #include <dlfcn.h>
 
 #include <cmath>
@@ -383,8 +383,9 @@ TEST(StateTable, ModelExchangeTimeStaysWithinStartAndHistory) {
 // stopTime the FMU has to return Error". What is computed is what is accepted:
 // in Continuous-Time Mode a variable-step integrator evaluates trial points
 // (SetTime, SetContinuousStates, GetDerivatives, GetEventIndicators, Get) and
-// may go back over them (FMI 3.0.2 section 3.2.1: fmi3SetTime's bounds are
-// all lower ones); fmi2/fmi3CompletedIntegratorStep says "all inputs and state
+// may go back over them (FMI 3.0.2 section 2.2.6: "solvers might need to jump
+// back and forth in time"; section 3.2.1: fmi3SetTime's bounds are all lower
+// ones); fmi2/fmi3CompletedIntegratorStep says "all inputs and state
 // variables have valid (accepted) values" (FMI 2.0.4 section 3.2.2, FMI 3.0.2
 // section 3.2.1); an event is handled at its time; a communication step ends
 // at t + h. Each of these past stopTime is an Error with no effect. Event
