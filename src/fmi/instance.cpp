@@ -188,17 +188,10 @@ Status Instance::setup_experiment(bool tolerance_defined, double tolerance, doub
 }
 
 // "If the environment tries to compute past stopTime, the FMU has to return
-// Error" (FMI 2.0.4 2.1.6 fmi2SetupExperiment, FMI 3.0.2 2.3.2
-// fmi3EnterInitializationMode). What advances the simulation is asked: a
-// communication step ending past stopTime (DoStep), an integrator step
-// accepted past it (CompletedIntegratorStep: "all inputs and state variables
-// have valid (accepted) values", FMI 2.0.4 3.2.2, FMI 3.0.2 3.2.1), an event
-// past it (EnterEventMode, and FMI 2.0's SetTime in Event Mode). A
-// variable-step integrator's trial evaluations in Continuous-Time Mode
-// (SetTime, SetContinuousStates, GetDerivatives, GetEventIndicators, Get)
-// accept nothing: the importer may go back over them (FMI 3.0.2 2.2.6 and
-// 3.2.1: fmi3SetTime's bounds are all lower ones), and importers evaluate
-// past their last output point and interpolate back.
+// Error" (FMI 2.0.4 2.1.6, FMI 3.0.2 2.3.2): asked by what advances the
+// simulation (DoStep, CompletedIntegratorStep's "accepted values", an event),
+// not by an integrator's trial evaluations in Continuous-Time Mode, which it
+// may go back over (FMI 3.0.2 2.2.6, 3.2.1). docs/importers.md, "stopTime".
 bool Instance::past_stop_time(const char* fn, double t, const char* what) {
   if (!stop_time_defined_ || !(t > stop_time_ + 1e-9 * std::max(1.0, std::abs(stop_time_)))) return false;
   log_.error("%s: %s at t = %.17g lies past stopTime = %.17g (computing past a defined stopTime is an error); the "
