@@ -27,7 +27,7 @@ extensions = [
 ]
 source_suffix = {".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "_ext", "snippets", "requirements.txt"]
+exclude_patterns = ["_build", "_ext", "requirements.txt"]
 myst_heading_anchors = 4  # README-style links to section anchors (#the-model)
 suppress_warnings = ["myst.header"]  # the included CHANGELOG.md starts at level 1 below the page's title
 

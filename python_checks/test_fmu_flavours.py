@@ -40,20 +40,15 @@ def test_every_archive_validates_and_offers_both_interfaces(fmu, request):
     assert md.fmiVersion == ("3.0" if "fmu3" in fmu else "2.0")
 
 
-# fmpy's CVode runs in CV_NORMAL mode without a CVODE stop time: its steps
-# overshoot the last output point, and the FMU refuses a time past a defined
-# stopTime (FMI 2.0.4 2.1.6, FMI 3.0.2 2.3.2; the standard wins over the
-# importer), so the Model Exchange runs leave stopTime undefined.
 def test_model_exchange_reproduces_co_simulation(plant_fmu, plant_fmu3):
     cs = as_array(simulate(plant_fmu, "CoSimulation"))
-    me = as_array(simulate(plant_fmu, "ModelExchange", solver="CVode", relative_tolerance=1e-10, set_stop_time=False))
+    me = as_array(simulate(plant_fmu, "ModelExchange", solver="CVode", relative_tolerance=1e-10))
     moved = np.abs(cs[-1] - cs[0])
     assert moved[0] > 1e-6 and moved[3] > 1e-5, "the test motion must move the platform"
     err = np.max(np.abs(me - cs), axis=0)
     assert err[:3].max() < 1e-8, f"ME vs CS position error {err[:3].max():.3g} m (bound 1e-8)"
     assert err[3] < 1e-8, f"ME vs CS phi error {err[3]:.3g} rad (bound 1e-8)"
-    me3 = as_array(simulate(plant_fmu3, "ModelExchange", solver="CVode", relative_tolerance=1e-10,
-                            set_stop_time=False))
+    me3 = as_array(simulate(plant_fmu3, "ModelExchange", solver="CVode", relative_tolerance=1e-10))
     assert np.max(np.abs(me3 - cs)) < 1e-8
 
 

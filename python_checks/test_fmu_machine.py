@@ -155,7 +155,7 @@ def test_model_exchange_drop_locates_the_stops_as_events(archive, request, capfd
     from fmpy import simulate_fmu
     lower = indexed_names("stop_margin_lower", 4)
     r = simulate_fmu(str(request.getfixturevalue(archive)), fmi_type="ModelExchange", solver="CVode",
-                     relative_tolerance=1e-10, stop_time=T_DROP, set_stop_time=False,  # test_fmu_flavours.py: why
+                     relative_tolerance=1e-10, stop_time=T_DROP,
                      output_interval=1e-3, debug_logging=True,
                      start_values={**START, **{n: 0.0 for n in F}}, output=lower + RHO + ["dz"])
     log = capfd.readouterr().out

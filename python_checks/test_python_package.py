@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""The Python package pkm4puu (python/pkm4puu): the getting-started page's
-session and the README's first look run as written, and the wrapper opens the FMUs by name, runs them with named inputs
+"""The Python package pkm4puu (python/pkm4puu): the README's first look runs
+as written (the getting-started page's session: test_docs.py), and the wrapper opens the FMUs by name, runs them with named inputs
 and outputs, and says clearly what is wrong with a bad request; the library
 imports without matplotlib, finds the build directory from what it is given
 (not from where it is installed), and python -m pkm4puu runs the reports."""
@@ -9,7 +9,6 @@ import re
 import subprocess
 import sys
 
-import matplotlib
 import numpy as np
 import pytest
 
@@ -18,9 +17,7 @@ from conftest import REPO
 from pkm4puu import capi, locate
 from pkm4puu.__main__ import COMMANDS
 
-# The getting-started page's Python session (docs/getting_started.md includes
-# the file) and the README's first look, both run as written.
-AUTOTEST_SNIPPET = REPO / "docs" / "snippets" / "first_python.py"
+# The README's first look, run as written.
 README_MARKER = "## A first look from Python"
 
 
@@ -29,21 +26,6 @@ def readme_session():
     m = re.search(re.escape(README_MARKER) + r"\s*```python\n(.*?)```", text, re.S)
     assert m, f"README.md has no python block after {README_MARKER!r}"
     return m.group(1)
-
-
-def test_getting_started_session_runs_the_auto_test(plant_fmu, inverse_fmu, capsys, monkeypatch):
-    """Executed as written (plt.show on a non-interactive backend); the error
-    it prints is the FMU auto-test's bound (docs/model.md: the pose follows the
-    prescribed path to 5e-8 with midpoint-held forces, test_fmu_autotest)."""
-    matplotlib.use("Agg")
-    monkeypatch.setenv("PKM_BUILD_DIR", str(plant_fmu.parent))
-    scope = {}
-    exec(compile(AUTOTEST_SNIPPET.read_text(), str(AUTOTEST_SNIPPET), "exec"), scope)
-    out = capsys.readouterr().out
-    m = re.search(r"largest position error (\S+) m", out)
-    assert m, out
-    assert float(m.group(1)) < 5e-8
-    assert scope["run"].t[-1] == pytest.approx(pkm.T_MOVE)
 
 
 def test_readme_first_look_holds_the_platform_at_home(plant_fmu, capsys, monkeypatch):

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-2-Clause
 #include "fmi/instance.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <utility>
@@ -184,6 +185,19 @@ Status Instance::setup_experiment(bool tolerance_defined, double tolerance, doub
   stop_time_ = stop_time_defined_ ? stop_time : 0.0;
   time_ = last_successful_time_ = start_time;
   return Status::OK;
+}
+
+// "If the environment tries to compute past stopTime, the FMU has to return
+// Error" (FMI 2.0.4 2.1.6, FMI 3.0.2 2.3.2): asked by what advances the
+// simulation (DoStep, CompletedIntegratorStep's "accepted values", an event),
+// not by an integrator's trial evaluations in Continuous-Time Mode, which it
+// may go back over (FMI 3.0.2 2.2.6, 3.2.1). docs/importers.md, "stopTime".
+bool Instance::past_stop_time(const char* fn, double t, const char* what) {
+  if (!stop_time_defined_ || !(t > stop_time_ + 1e-9 * std::max(1.0, std::abs(stop_time_)))) return false;
+  log_.error("%s: %s at t = %.17g lies past stopTime = %.17g (computing past a defined stopTime is an error); the "
+             "call has no effect",
+             fn, what, t, stop_time_);
+  return true;
 }
 
 Status Instance::enter_initialization_mode() {

@@ -184,6 +184,11 @@ class Instance {
   /// (logged) refuses the call.
   bool array_call_allowed(Call call, const char* fn, const char* what, std::size_t given,
                           std::size_t expected, const void* array);
+  /// Whether `t` lies past a defined stopTime (beyond rounding: 1e-9
+  /// relative); if so logs "fn: <what> at t = .. lies past stopTime" and the
+  /// caller refuses the call with Error and no effect. Asked only by the
+  /// calls that advance the simulation (instance.cpp says which and why).
+  bool past_stop_time(const char* fn, double t, const char* what);
   Context context() {
     return Context{log_, interface_, mode_ == kInitializationMode, start_time_};
   }

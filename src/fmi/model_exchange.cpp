@@ -12,6 +12,7 @@ namespace pkm_fmi {
 Status Instance::enter_event_mode() {
   const char* fn = PKM_FN(EnterEventMode);
   if (!allowed(Call::EnterEventMode, fn)) return Status::Error;
+  if (past_stop_time(fn, time_, "an event")) return Status::Error;
   mode_ = kEventMode;
   time_floor_ = std::max(time_floor_, time_);  // no going back past an event
   log_.event("%s at t = %.17g", fn, time_);
@@ -47,6 +48,7 @@ Status Instance::enter_continuous_time_mode() {
 Status Instance::completed_integrator_step(bool* enter_event_mode, bool* terminate) {
   const char* fn = PKM_FN(CompletedIntegratorStep);
   if (!allowed(Call::CompletedIntegratorStep, fn)) return Status::Error;
+  if (past_stop_time(fn, time_, "the integrator step accepted")) return Status::Error;
   if (enter_event_mode) *enter_event_mode = false;  // no step events: the indicators locate every event
   if (terminate) *terminate = false;
   return Status::OK;
@@ -59,16 +61,15 @@ Status Instance::set_time(double t) {
     log_.error("%s: time = %g is not finite; the call has no effect", fn, t);
     return Status::Error;
   }
-  // FMI 2.0.4 2.1.6 and FMI 3.0.2 2.3.2: computing past a defined stopTime is
-  // an error; FMI 3.0.2 3.2.1: time >= startTime and the time of the last
+  // FMI 3.0.2 3.2.1: time >= startTime and the time of the last
   // EnterEventMode (FMI 2.0.4 3.2.2 alike: no going back past an event). The
   // third bound, the second last CompletedIntegratorStep, is not enforced:
   // importers locating roots (fmpy with CVODE) go back over several of them
-  // within one internal step, and nothing in this model depends on it.
-  if (stop_time_defined_ && t > stop_time_ + 1e-9 * std::max(1.0, std::abs(stop_time_))) {
-    log_.error("%s: time = %.17g lies past stopTime = %.17g; the call has no effect", fn, t, stop_time_);
-    return Status::Error;
-  }
+  // within one internal step, and nothing in this model depends on it. No
+  // upper bound in Continuous-Time Mode: a trial evaluation past stopTime
+  // computes nothing that is kept (past_stop_time, instance.cpp); in Event
+  // Mode (FMI 2.0) the time is the event's.
+  if (mode_ == kEventMode && past_stop_time(fn, t, "the event")) return Status::Error;
   if (t < time_floor_) {
     log_.error("%s: time = %.17g lies before %.17g (%s); the call has no effect", fn, t, time_floor_,
                time_floor_ == start_time_ ? "startTime"

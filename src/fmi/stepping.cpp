@@ -98,12 +98,7 @@ Status Instance::do_step(double t, double h, bool* terminate, double* last_succe
       return Status::Error;
     }
   }
-  // Computing past a defined stopTime is an error (fmi2SetupExperiment, fmi3EnterInitializationMode).
-  if (stop_time_defined_ && t + h > stop_time_ + 1e-9 * std::max(1.0, std::abs(stop_time_))) {
-    log_.error("%s: the step to t = %.17g would pass stopTime = %.17g; the call has no effect", fn, t + h,
-               stop_time_);
-    return Status::Error;
-  }
+  if (past_stop_time(fn, t + h, "the end of the communication step")) return Status::Error;
   Context ctx = context();
   if (data_->check_step(ctx, h) != Status::OK) return Status::Error;
   // FMI 3.0.2 4.2.3: a Discard leaves the FMU in the state before the call.

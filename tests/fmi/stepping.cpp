@@ -376,6 +376,9 @@ TEST_F(Stepping, AStepTooLongForCvodeIsDiscarded) {
             "yes: every variable bit-identical at fmi2LastSuccessfulTime = the step start");
 }
 
+// FMI 2.0.4 section 2.1.6 (fmi2SetupExperiment): "if the environment tries to
+// compute past stopTime the FMU has to return fmi2Error"; a communication step
+// ending past it computes past it.
 TEST_F(Stepping, AStepPastTheStopTimeIsAnError) {
   PlantFmu p;
   p.initialize(0.0, 0.01);
@@ -383,13 +386,14 @@ TEST_F(Stepping, AStepPastTheStopTimeIsAnError) {
   for (int k = 0; k < 9; ++k) ASSERT_EQ(p.step(k * 1e-3, 1e-3), fmi2OK);
   const std::vector<double> before = p.all_reals();
   EXPECT_EQ(p.step(0.009, 2e-3), fmi2Error);
-  EXPECT_TRUE(p.log.contains("would pass stopTime")) << p.log.dump();
+  EXPECT_TRUE(p.log.contains("the end of the communication step at t = 0.0109")) << p.log.dump();
+  EXPECT_TRUE(p.log.contains("lies past stopTime = 0.01")) << p.log.dump();
   EXPECT_TRUE(bit_identical(p.all_reals(), before));
   EXPECT_EQ(p.step(0.009, 1e-3 + 1e-15), fmi2OK) << "rounding of the last step is tolerated\n" << p.log.dump();
   EXPECT_EQ(p.step(0.01, 1e-3), fmi2Error);
   table_row("fmi2SetupExperiment(stopTimeDefined, stopTime = 0.01 s), then fmi2DoStep(0.009, 0.002) past it",
-            "fmi2Error (FMI 2.0: computing past a defined stopTime), \"the step to t = 0.011 would pass stopTime "
-            "= 0.01 ...; the call has no effect\"",
+            "fmi2Error (FMI 2.0: computing past a defined stopTime), \"the end of the communication step at t = "
+            "0.011 lies past stopTime = 0.01 ...; the call has no effect\"",
             "yes: every variable bit-identical; the step to exactly stopTime (within 1e-9 relative) succeeds");
 }
 
