@@ -65,7 +65,7 @@ def plan_cycle(payload=spec.CYCLE_PAYLOAD, f_max=spec.CYCLE_F_MAX, v_max=spec.CY
     """The time-optimal pick-and-place cycle on the arch
     x = -a cos(pi s), y = 0, z = z0 + h sin(pi s), phi = -(theta/2) cos(pi s)
     (m, rad): `payload` kg carried from A (s = 0) to B (s = 1), back empty;
-    |F_i| <= f_max (N), |drho_i/dt| <= v_max (m/s), optionally the motors'
+    abs(F_i) <= f_max (N), abs(drho_i/dt) <= v_max (m/s), optionally the motors'
     torque_max (N m) and motor_speed_max (rad/s) through the screw. The
     defaults are the standard cycle. machine: pkm_machine_params fields
     (screw_lead, rotor_inertia, friction_viscous, friction_coulomb, ...);

@@ -46,11 +46,11 @@ def check_value(name, value, minimum=0.0, strict=False, unit=""):
 
 @dataclass(frozen=True)
 class Limits:
-    """|F_i| <= f_max (N) and |drho_i/dt| <= v_max (m/s) for each actuator;
-    optionally the motors' torque |tau_i| <= torque_max (N m) and speed
-    |omega_i| <= motor_speed_max (rad/s), which the lossless ball screw of
-    lead p turns into |F_i| <= 2 pi torque_max / p and
-    |drho_i/dt| <= p motor_speed_max / (2 pi)."""
+    """abs(F_i) <= f_max (N) and abs(drho_i/dt) <= v_max (m/s) for each actuator;
+    optionally the motors' torque abs(tau_i) <= torque_max (N m) and speed
+    abs(omega_i) <= motor_speed_max (rad/s), which the lossless ball screw of
+    lead p turns into abs(F_i) <= 2 pi torque_max / p and
+    abs(drho_i/dt) <= p motor_speed_max / (2 pi)."""
     f_max: float = 10.0
     v_max: float = 0.5
     torque_max: Optional[float] = None

@@ -5,7 +5,7 @@ samples (pose, rates, forces, slider rates) and which limit is active where.
 
 Friction is not of the form a sdd + b sd^2 + c (it goes with sign(drho) and
 drho, not sd^2), so the plan keeps the friction-free forces within the
-force limit less a bound on friction, |F_fric,i| <= b v_lim + F_c (b
+force limit less a bound on friction, abs(F_fric,i) <= b v_lim + F_c (b
 friction_viscous, F_c friction_coulomb, v_lim the speed limit), and the
 samples are then checked with friction (the C API's machine inverse
 dynamics). With friction off, the default, nothing is taken off.
@@ -130,7 +130,7 @@ class Segment:
             return self.speed_limit ** 2 / (self.drho_ds ** 2).max(axis=1)
 
     def activity(self):
-        """Per interval, the largest use of the force limit (|F_i| over the
+        """Per interval, the largest use of the force limit (abs(F_i) over the
         limit less the friction bound) and of the speed limit (x over x_max)
         at its two ends."""
         start, end = self.grid_forces()
@@ -164,7 +164,7 @@ class Segment:
         return ", ".join(parts) or "none"
 
     def excess(self):
-        """(max |F_i| / force limit, max |drho_i| / speed limit) over the samples."""
+        """(max abs(F_i) / force limit, max abs(drho_i) / speed limit) over the samples."""
         return (float(np.abs(self.F).max() / self.force_limit), float(np.abs(self.drho).max() / self.speed_limit))
 
 

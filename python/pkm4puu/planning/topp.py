@@ -10,7 +10,7 @@ F(p, v, a) = M(p) a + h(p, v) + g(p), with h quadratic in v, becomes
     a = F(p, 0, p') - c,  b = F(p, p', p'') - c,  c = F(p, 0, 0),
 
 three calls of the inverse dynamics per grid point. The slider rates are
-drho/dt = (drho/ds) sd, so |drho_i/dt| <= v_max is the first-order bound
+drho/dt = (drho/ds) sd, so abs(drho_i/dt) <= v_max is the first-order bound
 sd^2 <= v_max^2 / max_i (drho_i/ds)^2. toppra's variables are x = sd^2 and
 u = sdd, constant on each grid interval (x_{i+1} = x_i + 2 ds_i u_i); the
 force bound is imposed at both ends of every interval (toppra's
@@ -43,7 +43,7 @@ def path_coefficients(dynamics, path, s):
 
 
 class _ForceBound(LinearConstraint):
-    """|a_i u + b_i x + c_i| <= limit for each actuator i (toppra's canonical
+    """abs(a_i u + b_i x + c_i) <= limit for each actuator i (toppra's canonical
     linear form a u + b x + c = v, F v <= g), at both ends of each interval."""
 
     def __init__(self, a, b, c, limit):
@@ -95,7 +95,7 @@ class NoTraversal(RuntimeError):
 
 def solve(s, a, b, c, force_limit, x_max):
     """The fastest rest-to-rest traversal: x = sd^2 at the grid points (N+1)
-    and u = sdd on the intervals (N), with |F_i| <= force_limit and
+    and u = sdd on the intervals (N), with abs(F_i) <= force_limit and
     sd^2 <= x_max. Time is rescaled for toppra so that its variables are
     of order SCALE: its forward pass steps each x back by an absolute 1e-8
     (to stay within the controllable sets), which is then 1e-10 of x."""
