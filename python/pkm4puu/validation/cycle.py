@@ -43,24 +43,17 @@ def parser():
     from pkm4puu.planning import DT, GRID
     ap = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--payload", type=float, default=spec.CYCLE_PAYLOAD, metavar="KG",
-                    help="mass carried from A to B, at P (default %(default)g kg)")
-    ap.add_argument("--f-max", type=float, default=spec.CYCLE_F_MAX, metavar="N",
-                    help="limit of each |F_i| (default %(default)g N)")
-    ap.add_argument("--v-max", type=float, default=spec.CYCLE_V_MAX, metavar="M/S",
-                    help="limit of each slider speed |drho_i/dt| (default %(default)g m/s)")
-    ap.add_argument("--a", type=float, default=spec.CYCLE_A, metavar="M",
-                    help="half the distance from A to B along x (default %(default)g m)")
-    ap.add_argument("--h", type=float, default=spec.CYCLE_H, metavar="M",
-                    help="height of the arch (default %(default)g m)")
-    ap.add_argument("--z0", type=float, default=spec.CYCLE_Z0, metavar="M",
-                    help="height of A and B (default %(default)g m)")
-    ap.add_argument("--theta-deg", type=float, default=math.degrees(spec.CYCLE_THETA), metavar="DEG",
-                    help="turn of the platform from A to B (default %(default)g deg)")
-    ap.add_argument("--grid", type=int, default=GRID, metavar="N",
-                    help="grid intervals per leg (default %(default)d)")
-    ap.add_argument("--dt", type=float, default=DT, metavar="S",
-                    help="spacing of the samples in cycle.csv (default %(default)g s)")
+    for flag, kind, default, metavar, unit, what in (
+            ("--payload", float, spec.CYCLE_PAYLOAD, "KG", "kg", "mass carried from A to B, at P"),
+            ("--f-max", float, spec.CYCLE_F_MAX, "N", "N", "limit of each actuator force |F_i|"),
+            ("--v-max", float, spec.CYCLE_V_MAX, "M/S", "m/s", "limit of each slider speed |drho_i/dt|"),
+            ("--a", float, spec.CYCLE_A, "M", "m", "half the distance from A to B along x"),
+            ("--h", float, spec.CYCLE_H, "M", "m", "height of the arch"),
+            ("--z0", float, spec.CYCLE_Z0, "M", "m", "height of A and B"),
+            ("--theta-deg", float, math.degrees(spec.CYCLE_THETA), "DEG", "deg", "turn of the platform from A to B"),
+            ("--grid", int, GRID, "N", "intervals", "grid intervals per leg"),
+            ("--dt", float, DT, "S", "s", "spacing of the samples in cycle.csv")):
+        ap.add_argument(flag, type=kind, default=default, metavar=metavar, help=f"{what} (default %(default)g {unit})")
     ap.add_argument("--build", type=Path, default=None, metavar="DIR",
                     help="build directory holding lib/libpkm.so (default: $PKM_BUILD_DIR, else the installed "
                          "package's own, else ./build)")
@@ -68,7 +61,8 @@ def parser():
     out.add_argument("--out", type=Path, default=None, metavar="DIR",
                      help="write cycle.csv and cycle.png into DIR (default: write nothing)")
     out.add_argument("--table", action="store_true",
-                     help="print the table of the cycle time against payload and f_max (Markdown)")
+                     help="print the table of the cycle time against payload and f_max (Markdown; its own "
+                          "payloads and force limits, the other values as given)")
     return ap
 
 
