@@ -151,9 +151,10 @@ def test_speed_limited_time_is_the_integral_of_the_speed_limit():
     drho/ds from the spec's closed-form inverse kinematics (differences on
     a fine grid), plus what the grid's first and last interval cost at rest
     (2 ds / sd instead of ds / sd, sd = v_max / (pi h) at A and B where only
-    z moves): the remainder is second order, below 1e-5 T."""
+    z moves): the remainder is second order, below 1e-5 T. (The quadrature
+    on 5001 points is second order too: 1.4e-7 T from 100001 points'.)"""
     path = arch()
-    s = np.linspace(0.0, 1.0, 100001)
+    s = np.linspace(0.0, 1.0, 5001)
     rho = np.array([spec.leg_inverse_kinematics(p)[:, 0] for p in path(s)])
     integral = np.trapezoid(np.abs(np.gradient(rho, s, axis=0, edge_order=2)).max(axis=1), s) / spec.CYCLE_V_MAX
     seg = plan_segment(path, spec.CYCLE_PAYLOAD, Limits(1e5, spec.CYCLE_V_MAX), dt=1e-2)
