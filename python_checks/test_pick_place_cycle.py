@@ -117,7 +117,7 @@ def test_table_lists_every_payload_and_force_limit():
 def _one_error_line(status, stdout, stderr):
     lines = stderr.strip().splitlines()
     assert status == 2, (status, stderr)
-    assert len(lines) == 1 and lines[0].startswith("pkm4puu cycle: error: "), stderr
+    assert len(lines) == 1 and lines[0].startswith(f"{program.PROG}: error: "), stderr
     assert "Traceback" not in stderr and stdout == ""
     return lines[0]
 

@@ -1,10 +1,11 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""pkm4puu cycle: the time-optimal pick-and-place cycle (docs/pick_and_place.md).
-Plans the arch x = -a cos(pi s), y = 0, z = z0 + h sin(pi s),
-phi = -(theta/2) cos(pi s) from A (s = 0) to B (s = 1) carrying the payload
-and back empty, each leg the fastest rest-to-rest traversal with every
-|F_i| <= f_max and |drho_i/dt| <= v_max (TOPP-RA over the C API's inverse
-dynamics), and prints the cycle time. The defaults are the standard cycle.
+"""python -m pkm4puu cycle (or pkm4puu cycle): the time-optimal pick-and-place
+cycle (docs/pick_and_place.md). Plans the arch x = -a cos(pi s), y = 0,
+z = z0 + h sin(pi s), phi = -(theta/2) cos(pi s) from A (s = 0) to B (s = 1)
+carrying the payload and back empty, each leg the fastest rest-to-rest
+traversal with every |F_i| <= f_max and |drho_i/dt| <= v_max (TOPP-RA over
+the C API's inverse dynamics), and prints the cycle time. The defaults are
+the standard cycle.
 
 With --out DIR it writes
   cycle.csv   t, x, y, z, phi, their rates and accelerations, F[1..4] and
@@ -21,8 +22,8 @@ a path that leaves the workspace or crosses a singularity, limits too low
 to hold the payload), one line on stderr saying which and where; 1 when
 the C API library cannot be loaded.
 
-usage: pkm4puu cycle [--payload KG] [--f-max N] [--v-max M/S] [--a M] [--h M] [--z0 M] [--theta-deg DEG]
-                     [--grid N] [--dt S] [--build DIR] [--out DIR | --table]
+usage: python -m pkm4puu cycle [--payload KG] [--f-max N] [--v-max M/S] [--a M] [--h M] [--z0 M]
+                               [--theta-deg DEG] [--grid N] [--dt S] [--build DIR] [--out DIR | --table]
 """
 import argparse
 import math
@@ -33,7 +34,7 @@ import tempfile
 import time
 from pathlib import Path
 
-PROG = "pkm4puu cycle"
+PROG = "python -m pkm4puu cycle"
 TABLE_PAYLOADS = (0.0, 0.1, 0.25, 0.5)  # kg
 TABLE_F_MAX = (5.0, 10.0, 20.0)  # N
 
