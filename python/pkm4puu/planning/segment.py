@@ -27,11 +27,25 @@ FRICTIONLESS = {"friction_viscous": 0.0, "friction_coulomb": 0.0}
 DEFAULT_SCREW_LEAD = 0.004  # m, pkm_default_machine_params
 
 
+def shown_s(path, s):
+    """The s a message gives for this path's s: an Arch's own (A at 0, B at 1)."""
+    return float(path.arch_s(s) if hasattr(path, "arch_s") else s)
+
+
 def where(path, s):
-    """'s = ... (x = ... mm, y, z, phi = ... deg)' at this path's s, as the arch's s."""
+    """'s = ... (x = ... mm, y, z, phi = ... deg)' at this path's s."""
     x, y, z, phi = path(np.array([s]))[0]
-    return (f"s = {float(path.arch_s(s)):.4f} (x = {1e3 * x:.2f} mm, y = {1e3 * y:.2f} mm, z = {1e3 * z:.2f} mm, "
+    return (f"s = {shown_s(path, s):.4f} (x = {1e3 * x:.2f} mm, y = {1e3 * y:.2f} mm, z = {1e3 * z:.2f} mm, "
             f"phi = {math.degrees(phi):.2f} deg)")
+
+
+def dynamics(payload_mass, machine, params, build):
+    """capi_adapter.InverseDynamics without friction; BadValue naming a
+    parameter the C API refuses."""
+    try:
+        return InverseDynamics(payload_mass, {**(machine or {}), **FRICTIONLESS}, params, build)
+    except ValueError as e:
+        raise BadValue(str(e)) from None
 
 
 def grid_points(grid):
@@ -44,7 +58,7 @@ def grid_points(grid):
 def check_path(path, s, machine=None, params=None, build=None, name="the path"):
     """OutsideWorkspace or SingularPath at the first pose of path(s) the C
     API's guards refuse, saying where, which leg and why."""
-    with InverseDynamics(0.0, {**(machine or {}), **FRICTIONLESS}, params, build) as dyn:
+    with dynamics(0.0, machine, params, build) as dyn:
         try:
             dyn.check_poses(path(s))
         except PoseError as e:
@@ -194,18 +208,15 @@ def plan_segment(path, payload_mass=0.0, limits=None, machine=None, params=None,
     if f_eff <= 0:
         raise Infeasible(f"{f_src} leaves nothing once friction is allowed for "
                          f"(|F_fric| <= b v_lim + F_c = {friction:.4g} N)", "friction takes the whole force limit")
-    try:
-        with InverseDynamics(payload_mass, {**machine, **FRICTIONLESS}, params, build) as dyn:
-            a, b, c, drho_ds = topp.path_coefficients(dyn, path, s)
-    except ValueError as e:
-        raise BadValue(str(e)) from None
+    with dynamics(payload_mass, machine, params, build) as dyn:
+        a, b, c, drho_ds = topp.path_coefficients(dyn, path, s)
     need = np.abs(c) - f_eff
     k, i = np.unravel_index(np.argmax(need), need.shape)
     if need[k, i] >= 0:
         less = f" less the friction bound {friction:.4g} N" if friction else ""
         raise Infeasible(f"{name}: holding the {payload_mass:g} kg payload at rest at {where(path, s[k])} needs "
                          f"F[{i + 1}] = {c[k, i]:.4g} N, beyond {f_src}{less}",
-                         f"F[{i + 1}] = {c[k, i]:.3g} N to hold at s = {float(path.arch_s(s[k])):.2f}")
+                         f"F[{i + 1}] = {c[k, i]:.3g} N to hold at s = {shown_s(path, s[k]):.2f}")
     den = (drho_ds ** 2).max(axis=1)
     with np.errstate(divide="ignore"):
         x_max = np.where(den > 0, v_lim ** 2 / den, np.inf)
