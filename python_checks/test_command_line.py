@@ -17,7 +17,7 @@ from pkm4puu.validation.checks import check, write_checks
 from pkm4puu.validation.cli import writable_dir
 
 # The commands with --build and --out.
-REPORTS = ["autotest", "comparison", "engines"]
+REPORTS = ["autotest", "comparison", "engines", "cycle"]
 
 
 def run_cli(*args, cwd):

@@ -11,7 +11,9 @@ paths in it), fmu (the wrapper), capi (a ctypes binding of the C API,
 pkm.h), linearization (the plant's Jacobians through Model Exchange),
 closed_loop (the sampled loop the control examples share), calibration
 (identification of the dynamic parameters from a drive log,
-pkm4puu.identify; it needs scipy). The rest needs numpy and fmpy only.
+pkm4puu.identify; it needs scipy), planning (the time-optimal pick-and-place
+cycle, pkm4puu.plan_cycle; it needs toppra, imported when first used). The
+rest needs numpy and fmpy only.
 
 The reports (the paper's tests through the FMUs, the engine comparison
 against the independent Pinocchio and MuJoCo models, figures) are in
@@ -28,4 +30,12 @@ from .spec import P0, P1, STATIC_FORCE_P0, STEP, T_MOVE
 __all__ = ["__version__", "Fmu", "Result", "build_dir", "find_fmu", "inverse_forces", "run", "ACC", "DRHO", "F", "POSE", "RHO",
            "RK4", "START_P0", "THETA1", "THETA2", "VEL", "WRENCH", "indexed_names", "start_pose", "autotest_motion",
            "blend", "comparison_forces", "motion", "pose_at", "velocity_at", "acceleration_at", "P0", "P1",
-           "STATIC_FORCE_P0", "STEP", "T_MOVE", "identify"]
+           "STATIC_FORCE_P0", "STEP", "T_MOVE", "identify", "plan_cycle"]
+
+
+def __getattr__(name):
+    # pkm4puu.plan_cycle: the planning extra (toppra) is imported when first used
+    if name == "plan_cycle":
+        from .planning import plan_cycle
+        return plan_cycle
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

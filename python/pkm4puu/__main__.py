@@ -17,6 +17,7 @@ COMMANDS = {
     "verdict": ("checks", "the main job's verdict: the checks its stages wrote, PASS/FAIL per bound"),
     "excitation": ("excitation", "an exciting trajectory for the identification: its condition number, CSV"),
     "identify": ("identify", "the dynamic parameters from a drive log (CSV of t, rho, F): FMU start values"),
+    "cycle": ("cycle", "the time-optimal pick-and-place cycle within the drives' limits: time, CSV, figure"),
 }
 
 

@@ -43,6 +43,17 @@ P1 = np.array([0.005, -0.005, 0.07, math.radians(4.0)])
 CMP_DURATION = 1.5  # s
 CMP_AMPLITUDE = 0.02  # N
 
+# --- Pick-and-place: the standard cycle (docs/pick_and_place.md) -----------------------------
+# The arch x = -a cos(pi s), y = 0, z = z0 + h sin(pi s), phi = -(theta/2) cos(pi s),
+# s in [0, 1], from A (s = 0) to B (s = 1) with the payload (at P), back empty.
+CYCLE_A = 0.010  # m
+CYCLE_H = 0.020  # m
+CYCLE_Z0 = 0.050  # m
+CYCLE_THETA = math.radians(10.0)  # rad
+CYCLE_F_MAX = 10.0  # N, |F_i|
+CYCLE_V_MAX = 0.5  # m/s, |drho_i/dt|
+CYCLE_PAYLOAD = 0.25  # kg
+
 # The paper's RK4 step, and the communication step of the tests and examples.
 STEP = 1e-3  # s
 

@@ -1,0 +1,19 @@
+# SPDX-License-Identifier: BSD-2-Clause
+"""Time-optimal pick-and-place (needs the `planning` extra: toppra).
+
+    cycle = pkm4puu.plan_cycle()             # the standard cycle
+    cycle.duration                           # s
+    cycle.segments[0].at(t)                  # the plan A -> B at times t
+
+plan_cycle plans the arch from A to B with the payload and back empty, each
+leg the fastest rest-to-rest traversal within the actuator-force and
+slider-speed limits (TOPP-RA over the C API's inverse dynamics);
+plan_segment plans one path. Every call into the C API is in capi_adapter.
+"""
+from .cycle import COLUMNS, Cycle, arch, plan_cycle
+from .limits import BadValue, Infeasible, Limits, OutsideWorkspace, PlanningError, SingularPath
+from .paths import Arch
+from .segment import DT, GRID, Segment, plan_segment
+
+__all__ = ["COLUMNS", "Cycle", "arch", "plan_cycle", "BadValue", "Infeasible", "Limits", "OutsideWorkspace",
+           "PlanningError", "SingularPath", "Arch", "DT", "GRID", "Segment", "plan_segment"]

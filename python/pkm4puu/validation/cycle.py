@@ -1,0 +1,243 @@
+# SPDX-License-Identifier: BSD-2-Clause
+"""python -m pkm4puu cycle (or pkm4puu cycle): the time-optimal pick-and-place
+cycle (docs/pick_and_place.md). Plans the arch x = -a cos(pi s), y = 0,
+z = z0 + h sin(pi s), phi = -(theta/2) cos(pi s) from A (s = 0) to B (s = 1)
+carrying the payload and back empty, each leg the fastest rest-to-rest
+traversal with every |F_i| <= f_max and |drho_i/dt| <= v_max (TOPP-RA over
+the C API's inverse dynamics), and prints the cycle time. The defaults are
+the standard cycle.
+
+With --out DIR it writes
+  cycle.csv   t, x, y, z, phi, their rates and accelerations, F[1..4] and
+              payload_mass, every --dt over the whole cycle (SI units; the
+              release at B appears twice, with and without the payload)
+  cycle.png   the forces against their limit, the slider speeds against
+              theirs, the path velocity against its speed limit, the path in 3D
+both complete or neither: they are written into a temporary folder beside
+DIR and moved into it at the end. --table prints instead the Markdown table
+of the cycle time against payload and f_max (the documentation's).
+
+Exit status: 0; 2 for bad input (a value that is not finite or negative,
+a path that leaves the workspace or crosses a singularity, limits too low
+to hold the payload), one line on stderr saying which and where; 1 when
+the C API library cannot be loaded.
+
+usage: python -m pkm4puu cycle [--payload KG] [--f-max N] [--v-max M/S] [--a M] [--h M] [--z0 M]
+                               [--theta-deg DEG] [--grid N] [--dt S] [--build DIR] [--out DIR | --table]
+"""
+import argparse
+import math
+import os
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+PROG = "python -m pkm4puu cycle"
+TABLE_PAYLOADS = (0.0, 0.1, 0.25, 0.5)  # kg
+TABLE_F_MAX = (5.0, 10.0, 20.0)  # N
+
+
+def parser():
+    from pkm4puu import spec
+    from pkm4puu.planning import DT, GRID
+    ap = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    for flag, kind, default, metavar, unit, what in (
+            ("--payload", float, spec.CYCLE_PAYLOAD, "KG", "kg", "mass carried from A to B, at P"),
+            ("--f-max", float, spec.CYCLE_F_MAX, "N", "N", "limit of each actuator force |F_i|"),
+            ("--v-max", float, spec.CYCLE_V_MAX, "M/S", "m/s", "limit of each slider speed |drho_i/dt|"),
+            ("--a", float, spec.CYCLE_A, "M", "m", "half the distance from A to B along x"),
+            ("--h", float, spec.CYCLE_H, "M", "m", "height of the arch"),
+            ("--z0", float, spec.CYCLE_Z0, "M", "m", "height of A and B"),
+            ("--theta-deg", float, math.degrees(spec.CYCLE_THETA), "DEG", "deg", "turn of the platform from A to B"),
+            ("--grid", int, GRID, "N", "intervals", "grid intervals per leg"),
+            ("--dt", float, DT, "S", "s", "spacing of the samples in cycle.csv")):
+        ap.add_argument(flag, type=kind, default=default, metavar=metavar, help=f"{what} (default %(default)g {unit})")
+    ap.add_argument("--build", type=Path, default=None, metavar="DIR",
+                    help="build directory holding lib/libpkm.so (default: $PKM_BUILD_DIR, else the installed "
+                         "package's own, else ./build)")
+    out = ap.add_mutually_exclusive_group()
+    out.add_argument("--out", type=Path, default=None, metavar="DIR",
+                     help="write cycle.csv and cycle.png into DIR (default: write nothing)")
+    out.add_argument("--table", action="store_true",
+                     help="print the table of the cycle time against payload and f_max (Markdown; its own "
+                          "payloads and force limits, the other values as given)")
+    return ap
+
+
+def error(message, status=2):
+    print(f"{PROG}: error: {message}", file=sys.stderr, flush=True)
+    return status
+
+
+def writable_out(path):
+    """None if `path` is (or can be made) a writable folder, else why not."""
+    probe = path
+    while not probe.exists() and probe.parent != probe:
+        probe = probe.parent
+    if not probe.is_dir():
+        return f"--out {path}: {probe} is not a directory"
+    if not os.access(probe, os.W_OK | os.X_OK):
+        return f"--out {path}: {probe} is not writable"
+    return None
+
+
+def write_csv(cycle, path):
+    import numpy as np
+    from pkm4puu.planning import COLUMNS
+    np.savetxt(path, cycle.samples(), delimiter=",", header=",".join(COLUMNS), comments="", fmt="%.12g")
+
+
+def plot(cycle, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    fig = plt.figure(figsize=(12, 8.5))
+    ax_f, ax_v, ax_s = fig.add_subplot(2, 2, 1), fig.add_subplot(2, 2, 2), fig.add_subplot(2, 2, 3)
+    ax_p = fig.add_subplot(2, 2, 4, projection="3d")
+    t0 = 0.0
+    for k, seg in enumerate(cycle.segments):
+        t = 1e3 * (t0 + seg.t)
+        for i in range(4):
+            label = f"leg {i + 1}" if k == 0 else None
+            ax_f.plot(t, seg.F[:, i], f"C{i}", lw=1.2, label=label)
+            ax_v.plot(t, seg.drho[:, i], f"C{i}", lw=1.2, label=label)
+        ax_s.plot(seg.path.arch_s(seg.s), seg.sd, f"C{4 + k}", lw=1.5, label=f"{seg.name}: ds/dt")
+        ax_s.plot(seg.path.arch_s(seg.s), np.sqrt(seg.x_max()), f"C{4 + k}", ls=":", lw=1.0,
+                  label=f"{seg.name}: slider-speed limit")
+        ax_p.plot(1e3 * seg.pose[:, 0], 1e3 * seg.pose[:, 1], 1e3 * seg.pose[:, 2], f"C{4 + k}",
+                  label=f"{seg.name} ({seg.payload_mass:g} kg), {seg.duration:.3f} s")
+        t0 += seg.duration
+        for ax in (ax_f, ax_v):
+            ax.axvline(1e3 * t0, color="0.6", lw=0.8)
+    seg = cycle.segments[0]
+    for ax, lim, unit, what in ((ax_f, seg.force_limit, "N", r"actuator force $F_i$"),
+                                (ax_v, seg.speed_limit, "m/s", r"slider speed $\dot\rho_i$")):
+        for sign in (1, -1):
+            ax.axhline(sign * lim, color="k", ls="--", lw=1.0)
+        ax.set_xlabel("t (ms)")
+        ax.set_ylabel(f"{what} ({unit})")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7, loc="lower right")
+    ax_f.set_title(f"forces against ±{seg.force_limit:g} N (release at B: grey line)", fontsize=9)
+    ax_v.set_title(f"slider speeds against ±{seg.speed_limit:g} m/s", fontsize=9)
+    ax_s.set_xlabel("s of the arch (A at 0, B at 1)")
+    ax_s.set_ylabel("ds/dt (1/s)")
+    ax_s.set_ylim(0, 1.3 * max(s.sd.max() for s in cycle.segments))
+    ax_s.set_title("path speed and the slider-speed limit curve", fontsize=9)
+    ax_s.grid(True, alpha=0.3)
+    ax_s.legend(fontsize=7)
+    a, b = cycle.segments[0].pose[0], cycle.segments[0].pose[-1]
+    for p, name in ((a, "A"), (b, "B")):
+        ax_p.scatter(*(1e3 * p[:3]), color="k", s=12)
+        ax_p.text(*(1e3 * p[:3]), f" {name}", fontsize=9)
+    half = 1e3 * max(cycle.arch.a, cycle.arch.h / 2, 1e-3)
+    ax_p.set_ylim(-half, half)
+    ax_p.set_xlabel("x (mm)")
+    ax_p.set_ylabel("y (mm)")
+    ax_p.set_zlabel("z (mm)")
+    ax_p.set_title("the path of P", fontsize=9)
+    ax_p.legend(fontsize=7, loc="upper left")
+    fig.suptitle(f"pick-and-place cycle: {cycle.duration:.4f} s ({cycle.arch.describe()})", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def write_outputs(cycle, out):
+    """cycle.csv and cycle.png into `out`, both or neither: written into a
+    temporary folder beside it, then moved in (each move atomic)."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.cycle-", dir=out.parent))
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o777 & ~umask)  # mkdtemp's is private; the folder may become `out`
+    try:
+        write_csv(cycle, tmp / "cycle.csv")
+        plot(cycle, tmp / "cycle.png")
+        if not out.exists():
+            tmp.rename(out)
+            return [out / "cycle.csv", out / "cycle.png"]
+        paths = []
+        for name in ("cycle.csv", "cycle.png"):
+            os.replace(tmp / name, out / name)
+            paths.append(out / name)
+        return paths
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def table(args):
+    """The Markdown table of cycle time against payload and f_max."""
+    from pkm4puu.planning import Infeasible, Limits, arch, plan_segment
+    arch = arch(args.a, args.h, args.z0, math.radians(args.theta_deg))
+    lines = [f"Cycle time on the {arch.describe()}, |drho_i/dt| <= {args.v_max:g} m/s; the payload is carried "
+             "from A to B, the platform returns empty. Active: the share of each leg's time with a force or the "
+             "speed limit at its bound.", "",
+             "| payload (kg) | f_max (N) | A → B (s) | active on A → B | B → A (s) | active on B → A | cycle (s) |",
+             "|---:|---:|---:|---|---:|---|---:|"]
+    for f_max in TABLE_F_MAX:
+        limits = Limits(f_max, args.v_max)
+        for payload in TABLE_PAYLOADS:
+            cells, total = [], 0.0
+            for path, mass, name in ((arch, payload, "A -> B"), (arch.reversed(), 0.0, "B -> A")):
+                try:
+                    seg = plan_segment(path, mass, limits, grid=args.grid, dt=args.dt, name=name, build=args.build)
+                    cells += [f"{seg.duration:.4f}", seg.active_summary()]
+                    total += seg.duration
+                except Infeasible as e:
+                    cells += ["—", f"infeasible: {e.short}"]
+                    total = math.nan
+            cycle = "—" if math.isnan(total) else f"{total:.4f}"
+            lines.append(f"| {payload:g} | {f_max:g} | {' | '.join(cells)} | {cycle} |")
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    args = parser().parse_args(argv)
+    if args.out is not None:
+        wrong = writable_out(args.out)
+        if wrong:
+            return error(wrong)
+    try:
+        from pkm4puu.planning import PlanningError, plan_cycle
+        if args.out is not None:
+            import matplotlib  # noqa: F401
+    except ImportError as e:
+        extra = "plots" if e.name == "matplotlib" else "planning"
+        return error(f"{e.name} is missing: pip install 'pkm4puu[{extra}]'", 1)
+    try:
+        from pkm4puu.planning.capi_adapter import _library
+        _library(args.build)
+    except OSError as e:
+        return error(f"cannot load the C API library: {e}", 1)
+    try:
+        if args.table:
+            from pkm4puu.planning import Limits, arch
+            from pkm4puu.planning.segment import check_path, grid_points
+            Limits(args.f_max, args.v_max)  # the values checked before the sweep
+            check_path(arch(args.a, args.h, args.z0, math.radians(args.theta_deg)), grid_points(args.grid),
+                       build=args.build, name="the arch")
+            print(table(args), flush=True)
+            return 0
+        t0 = time.perf_counter()
+        cycle = plan_cycle(args.payload, args.f_max, args.v_max, args.a, args.h, args.z0, math.radians(args.theta_deg),
+                           grid=args.grid, dt=args.dt, build=args.build)
+        planned = time.perf_counter() - t0
+    except PlanningError as e:
+        return error(str(e))
+    print("\n".join(cycle.summary()), flush=True)
+    print(f"{PROG}: planned in {planned:.2f} s ({args.grid} grid intervals per leg, samples every {args.dt:g} s)",
+          file=sys.stderr, flush=True)
+    if args.out is not None:
+        for path in write_outputs(cycle, args.out):
+            print(f"{PROG}: wrote {path}", file=sys.stderr, flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,232 @@
+# SPDX-License-Identifier: BSD-2-Clause
+"""`pkm4puu cycle` (python -m pkm4puu cycle): the standard pick-and-place
+cycle's CSV and figure, its table, and bad input answered in one line with
+exit status 2 and nothing written: values that are not finite or are
+negative, a path that leaves the workspace or crosses a singularity (where
+and which leg, checked against the spec's closed-form inverse kinematics),
+limits below what holding the payload needs (which actuator and where,
+checked against the C API's inverse dynamics)."""
+import contextlib
+import io
+import math
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from pkm4puu import capi, spec
+from pkm4puu.planning import segment
+from pkm4puu.validation import cycle as program
+
+# The columns of cycle.csv as docs/pick_and_place.md (and the issue) list them.
+CSV_COLUMNS = ("t x y z phi dx dy dz dphi ddx ddy ddz ddphi F[1] F[2] F[3] F[4] payload_mass").split()
+
+
+def run(*args):
+    """The program's main(ARGS) in this process: (exit status, stdout, stderr)."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            status = program.main(list(args))
+        except SystemExit as e:  # argparse
+            status = e.code
+    return status, out.getvalue(), err.getvalue()
+
+
+@pytest.fixture(scope="module")
+def standard(tmp_path_factory):
+    """python -m pkm4puu cycle --out DIR, as a user runs it."""
+    out = tmp_path_factory.mktemp("cycle") / "out"
+    r = subprocess.run([sys.executable, "-m", "pkm4puu", "cycle", "--out", str(out)], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    return out, r.stdout
+
+
+def test_standard_cycle_csv(standard, pkm_library):
+    """cycle.csv holds the whole cycle at 0.1 ms (1 ms or finer is asked),
+    from rest at A to rest at A through B, where the payload (0.25 kg from
+    A, none back) is released at rest; the printed cycle time is its last
+    time; its forces are the C API's inverse dynamics at its motion."""
+    out, stdout = standard
+    with open(out / "cycle.csv") as f:
+        header = f.readline().strip().split(",")
+    data = np.loadtxt(out / "cycle.csv", delimiter=",", skiprows=1)
+    assert header == CSV_COLUMNS
+    col = {name: k for k, name in enumerate(header)}
+    t = data[:, col["t"]]
+    assert t[0] == 0.0 and np.all(np.diff(t) >= 0) and np.diff(t).max() <= 1e-3 + 1e-15
+    cycle_time = float(re.search(r"cycle time: ([0-9.]+) s", stdout).group(1))
+    assert t[-1] == pytest.approx(cycle_time, abs=5e-5)
+    release = np.flatnonzero(np.diff(t) == 0)
+    assert len(release) == 1
+    k = release[0]
+    mass = data[:, col["payload_mass"]]
+    assert np.all(mass[:k + 1] == spec.CYCLE_PAYLOAD) and np.all(mass[k + 1:] == 0.0)
+    pose = data[:, 1:5]
+    vel = data[:, 5:9]
+    A = (-spec.CYCLE_A, 0.0, spec.CYCLE_Z0, -spec.CYCLE_THETA / 2)
+    B = (spec.CYCLE_A, 0.0, spec.CYCLE_Z0, spec.CYCLE_THETA / 2)
+    np.testing.assert_allclose(pose[[0, -1]], [A, A], atol=1e-12)
+    np.testing.assert_allclose(pose[[k, k + 1]], [B, B], atol=1e-12)
+    assert np.all(vel[[0, k, k + 1, -1]] == 0.0)
+    F = data[:, 13:17]
+    rows = np.append(np.arange(0, len(data), 97), [k, k + 1])
+    with capi.Plant(capi.load(pkm_library), machine={"payload_mass": spec.CYCLE_PAYLOAD}) as loaded, \
+            capi.Plant(capi.load(pkm_library)) as empty:
+        ref = np.array([(loaded if mass[r] else empty).inverse_dynamics_machine(pose[r], vel[r], data[r, 9:13]).F
+                        for r in rows])
+    np.testing.assert_allclose(F[rows], ref, rtol=0, atol=1e-9)  # the CSV's 12 digits
+    assert np.abs(F).max() <= spec.CYCLE_F_MAX * (1 + 1e-5)
+
+
+def test_standard_cycle_figure_and_summary(standard):
+    out, stdout = standard
+    png = (out / "cycle.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 50_000
+    for line in ("A -> B:", "B -> A:", "active: force", "cycle time:"):
+        assert line in stdout, stdout
+
+
+def test_table_lists_every_payload_and_force_limit():
+    """--table: a row per f_max and payload, the cycle time the sum of the
+    two legs; a leg whose holding force exceeds f_max somewhere is marked
+    infeasible with the actuator and a force beyond f_max. The sweep on a
+    coarse grid (the docs build runs the default)."""
+    status, stdout, stderr = run("--table", "--grid", "200", "--dt", "0.01")
+    assert status == 0, stderr
+    rows = [line for line in stdout.splitlines() if re.match(r"\| [0-9.]+ \| [0-9.]+ \|", line)]
+    assert [tuple(float(c) for c in row.strip("|").split("|")[:2]) for row in rows] == \
+        [(m, f) for f in program.TABLE_F_MAX for m in program.TABLE_PAYLOADS]
+    for row in rows:
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        for time, active in ((cells[2], cells[3]), (cells[4], cells[5])):
+            if time == "—":
+                force = float(re.fullmatch(r"infeasible: F\[\d\] = ([-0-9.]+) N to hold at s = [0-9.]+", active)[1])
+                assert abs(force) > float(cells[1])
+            else:
+                assert re.fullmatch(r"(force \d+ %)?(, )?(speed \d+ %)?", active), active
+        if cells[6] != "—":
+            assert float(cells[6]) == pytest.approx(float(cells[2]) + float(cells[4]), abs=2e-4)
+        else:
+            assert "—" in (cells[2], cells[4])
+
+
+def _one_error_line(status, stdout, stderr):
+    lines = stderr.strip().splitlines()
+    assert status == 2, (status, stderr)
+    assert len(lines) == 1 and lines[0].startswith(f"{program.PROG}: error: "), stderr
+    assert "Traceback" not in stderr and stdout == ""
+    return lines[0]
+
+
+@pytest.mark.parametrize("args, says", [
+    (["--payload", "-0.1"], "payload = -0.1 kg must be >= 0"),
+    (["--payload", "inf"], "payload = inf is not finite"),
+    (["--f-max", "nan"], "f_max = nan is not finite"),
+    (["--f-max", "0"], "f_max = 0 N must be > 0"),
+    (["--v-max", "-0.5"], "v_max = -0.5 m/s must be > 0"),
+    (["--a", "-0.01"], "a = -0.01 m must be >= 0"),
+    (["--h", "nan"], "h = nan is not finite"),
+    (["--z0=-inf"], "z0 = -inf is not finite"),
+    (["--theta-deg", "inf"], "theta = inf is not finite"),
+    (["--grid", "1"], "grid = 1 must be an integer >= 2"),
+    (["--dt", "0"], "dt = 0 s must be > 0"),
+    (["--a", "0", "--h", "0", "--theta-deg", "0"], "does not move"),
+    (["--z0", "0.2"], "leaves the sliders' travel at s = 0.0000"),
+])
+def test_bad_values_one_line_exit_2_nothing_written(tmp_path, args, says):
+    (tmp_path / "keep.txt").write_text("kept")
+    new = tmp_path / "new"
+    for out in (new, tmp_path):
+        line = _one_error_line(*run(*args, "--out", str(out)))
+        assert says in line, line
+    assert not new.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.txt"]
+
+
+def _reach(pose):
+    """Per leg: can it reach `pose` elbow-down (docs' closed form: h' <= the
+    distance of Q_i from the prismatic axis <= sqrt(l^2 + h'^2))?"""
+    out = []
+    for i in range(4):
+        qt = spec.rz(spec.BETA[i]).T @ (np.asarray(pose[:3]) + spec.rz(pose[3]) @ spec.platform_point(i)
+                                        - spec.base_point(i))
+        out.append(spec.H_PRIME ** 2 <= qt[0] ** 2 + qt[1] ** 2 <= spec.L ** 2 + spec.H_PRIME ** 2)
+    return out
+
+
+def _arch_pose(a, s):
+    th = spec.CYCLE_THETA
+    return (-a * math.cos(math.pi * s), 0.0, spec.CYCLE_Z0 + spec.CYCLE_H * math.sin(math.pi * s),
+            -th / 2 * math.cos(math.pi * s))
+
+
+def _reported(line):
+    """(s, leg) of an error line."""
+    return float(re.search(r"at s = ([0-9.]+)", line).group(1)), int(re.search(r"\(leg (\d)\)", line).group(1))
+
+
+def test_path_out_of_reach_names_where_and_the_leg():
+    """a = 50 mm: x = -50 mm at A, where the spec's geometry leaves some leg
+    unable to reach; the message names s = 0 and one of those legs."""
+    status, stdout, stderr = run("--a", "0.05")
+    line = _one_error_line(status, stdout, stderr)
+    s, leg = _reported(line)
+    assert "leaves the workspace" in line and s == 0.0
+    assert not _reach(_arch_pose(0.05, 0.0))[leg - 1]
+
+
+def test_path_through_a_singularity_names_where_and_the_leg():
+    """The widest arch whose ends the legs still reach (bisected on the
+    spec's closed form) ends 0.1 um inside the reach, where a rod stands
+    nearly vertical or horizontal: the path enters the C API's leg
+    singularity guard, |cos theta2 sin theta2| < 0.01, before it. The
+    message names the first grid point past the guard and the leg; the
+    spec's inverse kinematics puts that leg's measure below 0.01 there and
+    above it one grid step before."""
+    lo, hi = spec.CYCLE_A, 0.05
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if all(all(_reach(_arch_pose(mid, s))) for s in (0.0, 1.0)) else (lo, mid)
+    a = lo - 1e-7
+    line = _one_error_line(*run("--a", repr(a)))
+    s, leg = _reported(line)
+    assert "crosses a singularity" in line
+
+    def measure(s):
+        th2 = spec.leg_inverse_kinematics(_arch_pose(a, s))[leg - 1, 2]
+        return abs(math.cos(th2) * math.sin(th2))
+
+    assert measure(s) < 1e-2 <= measure(s - 1.0 / segment.GRID)
+
+
+def test_limits_below_holding_the_payload_name_the_actuator(pkm_library):
+    """f_max = 3 N: the machine and the payload weigh 13.1 N on four vertical
+    actuators, so some share exceeds 3 N. The message names the actuator,
+    the force and where; the C API's inverse dynamics at rest there gives
+    that force."""
+    assert (spec.TOTAL_WEIGHT + spec.CYCLE_PAYLOAD * spec.G) / 4 > 3.0
+    line = _one_error_line(*run("--f-max", "3"))
+    assert "holding the 0.25 kg payload" in line and "beyond f_max = 3 N" in line
+    s = float(re.search(r"at s = ([0-9.]+)", line).group(1))
+    i, force = re.search(r"needs F\[(\d)\] = ([-0-9.]+) N", line).groups()
+    pose = _arch_pose(spec.CYCLE_A, s)
+    with capi.Plant(capi.load(pkm_library), machine={"payload_mass": spec.CYCLE_PAYLOAD}) as plant:
+        F = plant.inverse_dynamics_machine(pose, [0.0] * 4, [0.0] * 4).F
+    assert abs(F[int(i) - 1]) > 3.0
+    assert F[int(i) - 1] == pytest.approx(float(force), abs=1e-3)
+
+
+def test_library_errors_are_planning_errors():
+    """The same checks from Python: PlanningError subclasses (ValueError)."""
+    import pkm4puu
+    from pkm4puu.planning import BadValue, Infeasible, OutsideWorkspace
+    with pytest.raises(BadValue, match="payload = -1 kg"):
+        pkm4puu.plan_cycle(payload=-1.0)
+    with pytest.raises(OutsideWorkspace, match="leg"):
+        pkm4puu.plan_cycle(a=0.05)
+    with pytest.raises(Infeasible, match=r"F\[\d\]"):
+        pkm4puu.plan_cycle(f_max=3.0, grid=100)
