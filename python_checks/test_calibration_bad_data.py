@@ -1,13 +1,14 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""pkm4puu.identify and `python -m pkm4puu identify` refuse bad data with a
-message that says what and where (docs/calibration.md): too short,
-non-exciting (naming what is not identifiable), NaN samples, time going
-back, slider positions out of reach or beyond the travel, a CSV without
-the columns. The logs here are made with the C API's regressor, exact
-forces F = Y pi + F0 along a random Fourier trajectory (no FMU needed)."""
+"""pkm4puu.identify and `pkm4puu identify` refuse bad data with a message
+that says what and where (docs/calibration.md): too short, non-exciting
+(naming what is not identifiable), NaN samples, time going back, slider
+positions out of reach or beyond the travel, a CSV without the columns, a
+cut-off or trim that is no number of the kind. The logs here are made with the C API's regressor, exact forces
+F = Y pi + F0 along a random Fourier trajectory (no FMU needed)."""
 import csv
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -135,6 +136,15 @@ def test_cutoff_above_nyquist(good, lib):
         identify(*good, model=MODEL, lib=lib, cutoff=600.0)
 
 
+@pytest.mark.parametrize("kw, message", [({"cutoff": 0.0}, "the cut-off 0.0 Hz"), ({"cutoff": np.nan}, "the cut-off nan Hz"),
+                                         ({"cutoff": "20"}, "the cut-off '20' Hz"),
+                                         ({"trim": -5}, "trim -5 must be a whole number of samples >= 0"),
+                                         ({"trim": 2.5}, "trim 2.5 must be")])
+def test_a_cutoff_or_trim_of_the_wrong_kind_is_named(good, lib, kw, message):
+    with pytest.raises(IdentificationError, match=re.escape(message)):
+        identify(*good, model=MODEL, lib=lib, **kw)
+
+
 def write_csv(path, t, rho, F, drop=None):
     cols = ["t"] + [f"rho[{i}]" for i in range(1, 5)] + [f"F[{i}]" for i in range(1, 5)]
     with open(path, "w", newline="") as f:
@@ -165,7 +175,7 @@ def test_command_line_names_what_is_wrong(good, tmp_path):
     p = run_cli("no_f3.csv", cwd=tmp_path)
     assert p.returncode == 1 and "missing column(s) F[3]" in p.stderr, p.stderr
     p = run_cli("absent.csv", cwd=tmp_path)
-    assert p.returncode == 1 and "absent.csv: no such file" in p.stderr, p.stderr
+    assert p.returncode == 2 and "absent.csv: no such file" in p.stderr, p.stderr
     t, rho, F = (a.copy() for a in good)
     F[77, 0] = np.nan
     write_csv(tmp_path / "nan.csv", t, rho, F)

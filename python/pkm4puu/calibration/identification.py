@@ -19,11 +19,13 @@ model's known values for what the forces cannot separate.
 """
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import capi
+from .. import capi, extras
 from .parameters import BaseParameters, base_parameters, make_plant
 
 
@@ -90,19 +92,24 @@ def _check_data(t, rho, F, min_samples):
     return t, rho, F, h
 
 
+def _scipy(module):
+    """scipy.<module>, or extras.MissingExtra saying how to install it."""
+    return extras.import_module(f"scipy.{module}", "pkm4puu.identify")
+
+
 def filtered_derivatives(t, rho, cutoff, order=4):
     """rho low-passed without phase (Butterworth of `order`, forward and
     backward: the magnitude response squared) and its first and second
     central differences."""
-    from scipy.signal import butter, sosfiltfilt
+    signal = _scipy("signal")
 
     h = (t[-1] - t[0]) / (len(t) - 1)
     fs = 1.0 / h
     if not 0 < cutoff < 0.5 * fs:
         raise IdentificationError(f"the cut-off {cutoff} Hz must lie between 0 and half the sampling rate "
                                   f"({0.5 * fs:.6g} Hz)")
-    sos = butter(order, cutoff, fs=fs, output="sos")
-    r = sosfiltfilt(sos, rho, axis=0)
+    sos = signal.butter(order, cutoff, fs=fs, output="sos")
+    r = signal.sosfiltfilt(sos, rho, axis=0)
     rd = np.gradient(r, t, axis=0)
     rdd = np.gradient(rd, t, axis=0)
     return r, rd, rdd
@@ -134,9 +141,14 @@ def identify(t, rho, F, *, cutoff=20.0, order=4, trim=None, model=None, physical
         relative to its size under generic motions) lies within this
         relative distance of the others' span is not identifiable from the
         data: IdentificationError names it.
-    """
-    from scipy.linalg import qr
 
+    Needs scipy (the extra `calibration`): extras.MissingExtra otherwise.
+    """
+    qr = _scipy("linalg").qr
+    if not (isinstance(cutoff, numbers.Real) and math.isfinite(cutoff) and cutoff > 0):
+        raise IdentificationError(f"the cut-off {cutoff!r} Hz must be a finite number > 0")
+    if trim is not None and not (isinstance(trim, numbers.Integral) and trim >= 0):
+        raise IdentificationError(f"trim {trim!r} must be a whole number of samples >= 0")
     lib = lib or capi.load()
     model = dict(model or {})
     try:
@@ -243,7 +255,7 @@ def _constrained(Ww, yw, x, std, base):
     """The weighted least squares under the physical rows (SLSQP on the
     parameters scaled by their standard deviations); x itself when it
     satisfies them."""
-    from scipy.optimize import minimize
+    minimize = _scipy("optimize").minimize
 
     A, b, what = _physical_rows(base)
     if len(A) == 0 or np.all(A @ x >= b):
