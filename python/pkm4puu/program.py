@@ -15,7 +15,7 @@ import sys
 import time
 from pathlib import Path
 
-from . import extras
+from . import extras, plots
 from .fmu import find_fmu
 from .locate import BUILD_ENV, DEFAULT_BUILD, build_dir
 
@@ -187,10 +187,13 @@ def add_common_args(ap, files):
     add_out_arg(ap, files)
 
 
-def say_figures_skipped(log):
-    """Logs that the figures are left out, matplotlib missing, and how to
-    install it (call when plots.available() is False)."""
+def figures_available(log):
+    """True when the figures can be drawn (plots.available()); otherwise
+    logs that they are left out, matplotlib missing, and how to install it."""
+    if plots.available():
+        return True
     log(f"figures skipped: matplotlib is not installed ({extras.install_command(['matplotlib'])} draws them)")
+    return False
 
 
 def find_build(build, log):
@@ -220,6 +223,17 @@ def start(ap, argv, models=("PKM4PUU", "PKM4PUU_Inverse"), name=None):
     args = ap.parse_args(argv)
     log = Log(name or ap.prog)
     return args, log, find_fmus(args.build, log, models)
+
+
+def start_report(command, description, files, argv, models=("PKM4PUU", "PKM4PUU_Inverse")):
+    """The start of a report program of the pkm4puu command: its parser
+    (--build, and --out for `files`), argv parsed, the FMUs found:
+    (args, log, fmus, figures), fmus None when they are missing (logged),
+    figures whether they can be drawn (figures_available)."""
+    ap = ArgumentParser(prog=command_prog(command), description=description)
+    add_common_args(ap, files)
+    args, log, fmus = start(ap, argv, models, name=command)
+    return args, log, fmus, fmus is not None and figures_available(log)
 
 
 def run_program(ap, argv, compute, invalid=None, models=("PKM4PUU", "PKM4PUU_Inverse")):

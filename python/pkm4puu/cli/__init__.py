@@ -33,9 +33,9 @@ def parser():
     width = max(map(len, COMMANDS))
     listing = "\n".join(f"  {name:<{width}}  {what}" for name, (_, what) in COMMANDS.items())
     ap = ArgumentParser(prog=prog, formatter_class=argparse.RawDescriptionHelpFormatter,
-                                 description="The 4-PUU robot's reports through the FMUs and the C API.",
-                                 epilog=f"commands:\n{listing}\n\n'{prog} COMMAND --help' tells a command's "
-                                 "arguments.")
+                        description="The 4-PUU robot's reports through the FMUs and the C API.",
+                        epilog=f"commands:\n{listing}\n\n'{prog} COMMAND --help' tells a command's "
+                        "arguments.")
     ap.add_argument("--version", action="version", version=f"pkm4puu {__version__}")
     ap.add_argument("command", metavar="COMMAND", choices=list(COMMANDS), help="one of the commands below")
     ap.add_argument("args", metavar="ARGS", nargs="*", help="the command's arguments")

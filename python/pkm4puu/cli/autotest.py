@@ -44,8 +44,7 @@ from ..fmu import Fmu, inverse_forces, run
 from ..interface import ACC, F, POSE, START_P0, VEL
 from ..motions import pose_at
 from ..plots import pyplot, save_figure
-from ..program import (ArgumentParser, add_common_args, case_table, command_prog, finish, run_cases,
-                       say_figures_skipped, start)
+from ..program import case_table, finish, run_cases, start_report
 from ..spec import STEP as H, T_MOVE
 from .checks import check, finish_checks, write_checks
 
@@ -296,17 +295,12 @@ def write_results(runs, Fh, inverse_fmu, out_dir, bounds=None, figures=True):
 
 # --- command line ---------------------------------------------------------------------------
 def main(argv=None):
-    ap = ArgumentParser(prog=command_prog("autotest"),
-                                 description="The paper's auto-test (section 5.1) through the FMUs: inverse FMU "
-                                 "-> F1..F4 -> plant FMU, open loop, 1 ms communication step, 2 s.")
-    add_common_args(ap, "fmu_autotest.csv, fmu_autotest_checks.csv and, with matplotlib, fmu_autotest_errors.png, "
-                    "fmu_autotest_pose.png and fmu_autotest_forces.png")
-    args, log, fmus = start(ap, argv, name="autotest")
+    args, log, fmus, figures = start_report(
+        "autotest", "The paper's auto-test (section 5.1) through the FMUs: inverse FMU -> F1..F4 -> plant FMU, open "
+        "loop, 1 ms communication step, 2 s.", "fmu_autotest.csv, fmu_autotest_checks.csv and, with matplotlib, "
+        "fmu_autotest_errors.png, fmu_autotest_pose.png and fmu_autotest_forces.png", argv)
     if fmus is None:
         return 1
-    figures = plots.available()
-    if not figures:
-        say_figures_skipped(log)
     plant, inverse = fmus
     log(f"inverse FMU {inverse}: F1..F4 at {2 * N + 1} half-step times")
     Fh = half_step_forces(inverse)

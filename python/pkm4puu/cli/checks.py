@@ -111,9 +111,9 @@ def report(paths):
 
 def main(argv=None):
     ap = ArgumentParser(prog=command_prog("verdict"),
-                                 description="The main job's verdict: every check of the given <stage>_checks.csv "
-                                 "files (measured value, bound, PASS/FAIL); exit status 1 when any failed or a file "
-                                 "is missing.")
+                        description="The main job's verdict: every check of the given <stage>_checks.csv "
+                        "files (measured value, bound, PASS/FAIL); exit status 1 when any failed or a file "
+                        "is missing.")
     ap.add_argument("files", type=Path, nargs="+", metavar="CHECKS_CSV", help="a checks file written by a stage")
     args = ap.parse_args(argv)
     lines, ok = report(args.files)

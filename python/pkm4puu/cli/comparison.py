@@ -33,13 +33,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import plots
 from ..fmu import Fmu, run
 from ..interface import F, POSE, START_P0, indexed_names
 from ..motions import comparison_forces
 from ..plots import pyplot, save_figure
-from ..program import (ArgumentParser, add_common_args, case_table, command_prog, finish, run_cases,
-                       say_figures_skipped, start)
+from ..program import case_table, finish, run_cases, start_report
 from ..spec import CMP_AMPLITUDE, CMP_DURATION, L as L_ROD, M_PLATFORM, M_ROD, M_SLIDER, STEP
 from .checks import check, finish_checks, write_checks
 
@@ -214,17 +212,12 @@ def write_results(runs, out_dir, figures=True):
 
 # --- command line ---------------------------------------------------------------------------
 def main(argv=None):
-    ap = ArgumentParser(prog=command_prog("comparison"),
-                                 description="The paper's comparison test (section 5.2) through the plant FMU, "
-                                 "with CVODE and with RK4.")
-    add_common_args(ap, "comparison.csv, comparison_checks.csv and, with matplotlib, comparison_pose.png and "
-                    "comparison_delta_rho1.png")
-    args, log, fmus = start(ap, argv, models=("PKM4PUU",), name="comparison")
+    args, log, fmus, figures = start_report(
+        "comparison", "The paper's comparison test (section 5.2) through the plant FMU, with CVODE and with RK4.",
+        "comparison.csv, comparison_checks.csv and, with matplotlib, comparison_pose.png and "
+        "comparison_delta_rho1.png", argv, models=("PKM4PUU",))
     if fmus is None:
         return 1
-    figures = plots.available()
-    if not figures:
-        say_figures_skipped(log)
     plant = fmus[0]
     errors = {}
     runs = run_all(plant, log=log, errors=errors)

@@ -10,8 +10,7 @@ the figures the extra `plots`.
 from .. import extras
 from ..fmu import find_fmu
 from ..locate import library_path
-from ..plots import available as figures_available
-from ..program import ArgumentParser, add_build_arg, add_out_arg, command_prog, prefixed_log, say_figures_skipped
+from ..program import ArgumentParser, add_build_arg, add_out_arg, command_prog, prefixed_log, figures_available
 
 NEEDS = ("pinocchio", "mujoco", "scipy")
 
@@ -40,9 +39,7 @@ def main(argv=None):
     except FileNotFoundError as e:
         log(f"error: {e}")
         return 1
-    figures = figures_available()
-    if not figures:
-        say_figures_skipped(log)
+    figures = figures_available(log)
     print(f"engines: pinocchio {pinocchio.__version__}, mujoco {mujoco.__version__}; "
           f"{library_path(args.build)}, {plant}, {inverse}", flush=True)
     r = ec.run_all(args.build, plant, inverse, log=log)

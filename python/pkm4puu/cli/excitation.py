@@ -22,8 +22,8 @@ def parser():
     from ..calibration import Limits
     d = Limits()
     ap = ArgumentParser(prog=command_prog("excitation"),
-                                 description=__doc__.split("\n\n")[0].split(": ", 1)[1],
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+                        description=__doc__.split("\n\n")[0].split(": ", 1)[1],
+                        formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--period", type=positive, default=2.5, help="period of the series, s (default 2.5)")
     ap.add_argument("--harmonics", type=counting(1), default=5, help="harmonics per axis (default 5)")
     ap.add_argument("--seed", type=counting(0), default=0, help="seed of the random start (default 0)")

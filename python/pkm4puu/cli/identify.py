@@ -110,7 +110,7 @@ def model_parameters(ap, items, lib):
 
 def parser():
     ap = ArgumentParser(prog=command_prog("identify"), description=__doc__.split("\n\n")[0].split(": ", 1)[1],
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+                        formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("log", metavar="LOG.csv", type=existing_file, help="columns t, rho[1..4], F[1..4] (header row)")
     ap.add_argument("--cutoff", type=positive, default=20.0, metavar="HZ",
                     help="low-pass cut-off of rho, Hz (default 20)")

@@ -66,9 +66,9 @@ def plot_errors(runs, out, bound=None):
 
 def main(argv=None):
     ap = ArgumentParser(prog=command_prog("plot-autotest"),
-                                 description="Plots of the C++ auto-test (pkm_autotest --out RESULTS_DIR) from its "
-                                 "autotest_*.csv files: autotest_forces.png, autotest_pose.png and "
-                                 "autotest_errors.png, written beside them.")
+                        description="Plots of the C++ auto-test (pkm_autotest --out RESULTS_DIR) from its "
+                        "autotest_*.csv files: autotest_forces.png, autotest_pose.png and "
+                        "autotest_errors.png, written beside them.")
     ap.add_argument("results", type=lambda text: writable_dir(text, must_exist=True), metavar="RESULTS_DIR",
                     help="the directory holding autotest_*.csv, where the figures go")
     res = ap.parse_args(argv).results
