@@ -138,10 +138,12 @@ def test_cutoff_above_nyquist(good, lib):
         identify(*good, model=MODEL, lib=lib, cutoff=600.0)
 
 
-@pytest.mark.parametrize("kw, message", [({"cutoff": 0.0}, "the cut-off 0.0 Hz"), ({"cutoff": np.nan}, "the cut-off nan Hz"),
+@pytest.mark.parametrize("kw, message", [({"cutoff": 0.0}, "the cut-off 0.0 Hz"),
+                                         ({"cutoff": np.nan}, "the cut-off nan Hz"),
                                          ({"cutoff": "20"}, "the cut-off '20' Hz"),
                                          ({"trim": -5}, "trim -5 must be a whole number of samples >= 0"),
-                                         ({"trim": 2.5}, "trim 2.5 must be"), ({"block": 0}, "block 0 must be")])
+                                         ({"trim": 2.5}, "trim 2.5 must be"), ({"block": 0}, "block 0 must be")],
+                         ids=["cutoff 0", "cutoff nan", "cutoff text", "trim -5", "trim 2.5", "block 0"])
 def test_a_cutoff_or_trim_of_the_wrong_kind_is_named(good, lib, kw, message):
     with pytest.raises(IdentificationError, match=re.escape(message)):
         identify(*good, model=MODEL, lib=lib, **kw)

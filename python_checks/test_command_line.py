@@ -224,7 +224,8 @@ def test_engines_runs_on_the_packages_own_files_without_a_build(capsys, monkeypa
     from pkm4puu.cli import engine_comparison
     pkg, empty = tmp_path / "pkg", tmp_path / "empty"
     for target, source in ((pkg / "fmus" / "fmi2" / plant_fmu.name, plant_fmu),
-                           (pkg / "fmus" / "fmi2" / inverse_fmu.name, inverse_fmu), (pkg / locate.LIBRARY, pkm_library)):
+                           (pkg / "fmus" / "fmi2" / inverse_fmu.name, inverse_fmu),
+                           (pkg / locate.LIBRARY, pkm_library)):
         target.parent.mkdir(parents=True, exist_ok=True)
         target.symlink_to(source)
     empty.mkdir()

@@ -53,6 +53,19 @@ def wheel():
     return wheels[0]
 
 
+def test_the_wheel_carries_the_version_and_the_licence(wheel):
+    """Its metadata's version is pkm4puu.__version__ (one source,
+    _version.py), its licence BSD-2-Clause, and the project's LICENSE is in
+    its .dist-info."""
+    with zipfile.ZipFile(wheel) as z:
+        names = z.namelist()
+        meta = z.read(next(n for n in names if n.endswith(".dist-info/METADATA"))).decode()
+        licence = next(n for n in names if re.search(r"\.dist-info/(licenses/)?LICENSE$", n))
+        assert z.read(licence) == (REPO / "LICENSE").read_bytes()
+    assert f"\nVersion: {pkm4puu.__version__}\n" in meta
+    assert re.search(r"^License(-Expression)?: BSD-2-Clause$", meta, re.M), meta[:600]
+
+
 class User:
     """A fresh venv holding the wheel without extras, and an empty folder."""
 

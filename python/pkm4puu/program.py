@@ -34,6 +34,13 @@ def command_prog(command):
     return f"{invoked_as()} {command}"
 
 
+def description(doc):
+    """A program's --help description from its module's docstring: the first
+    paragraph without its "pkm4puu COMMAND ...: " head, capitalised."""
+    text = doc.split("\n\n")[0].split(": ", 1)[1]
+    return text[0].upper() + text[1:]
+
+
 class ArgumentParser(argparse.ArgumentParser):
     """argparse's parser whose usage errors are one line, "<prog>: error:
     <message>", with exit status 2 (--help shows the usage)."""

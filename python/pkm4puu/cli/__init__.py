@@ -33,7 +33,8 @@ def parser():
     width = max(map(len, COMMANDS))
     listing = "\n".join(f"  {name:<{width}}  {what}" for name, (_, what) in COMMANDS.items())
     ap = ArgumentParser(prog=prog, formatter_class=argparse.RawDescriptionHelpFormatter,
-                        description="The 4-PUU robot's reports through the FMUs and the C API.",
+                        description="The 4-PUU robot's programs: the paper's tests and reports through the\n"
+                        "FMUs and the C API, the identification of its dynamic parameters.",
                         epilog=f"commands:\n{listing}\n\n'{prog} COMMAND --help' tells a command's "
                         "arguments.")
     ap.add_argument("--version", action="version", version=f"pkm4puu {__version__}")

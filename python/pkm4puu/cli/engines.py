@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """pkm4puu engines: validation against Pinocchio and MuJoCo models of the
-same mechanism (engine_comparison.py): inverse dynamics along the
-auto-test, the comparison test, the machine's terms. Prints the tables,
+same mechanism: inverse dynamics along the auto-test, the comparison test,
+the machine's terms (engine_comparison.py runs them). Prints the tables,
 writes engines_comparison.csv and the figures to --out DIR, exits 1 when a
 bound is not met. Needs the extra `references` (Pinocchio, MuJoCo, SciPy);
 the figures the extra `plots`.
@@ -10,13 +10,14 @@ the figures the extra `plots`.
 from .. import extras
 from ..fmu import find_fmu
 from ..locate import library_path
-from ..program import ArgumentParser, add_build_arg, add_out_arg, command_prog, prefixed_log, figures_available
+from ..program import (ArgumentParser, add_build_arg, add_out_arg, command_prog, description, figures_available,
+                       prefixed_log)
 
 NEEDS = ("pinocchio", "mujoco", "scipy")
 
 
 def parser():
-    ap = ArgumentParser(prog=command_prog("engines"), description=__doc__.split("\n\n")[0].split(": ", 1)[1])
+    ap = ArgumentParser(prog=command_prog("engines"), description=description(__doc__))
     add_build_arg(ap, "libpkm and the FMUs")
     add_out_arg(ap, "engines_comparison.csv and, with matplotlib, engines_pose.png, engines_delta_rho1.png and "
                 "engines_differences.png")

@@ -14,7 +14,8 @@ import sys
 import numpy as np
 
 from .. import extras
-from ..program import ArgumentParser, command_prog, counting, non_negative, number, positive, writable_file
+from ..program import (ArgumentParser, command_prog, counting, description, non_negative, number, positive,
+                       writable_file)
 from .identify import add_model_arg, model_parameters
 
 
@@ -22,7 +23,7 @@ def parser():
     from ..calibration import Limits
     d = Limits()
     ap = ArgumentParser(prog=command_prog("excitation"),
-                        description=__doc__.split("\n\n")[0].split(": ", 1)[1],
+                        description=description(__doc__),
                         formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--period", type=positive, default=2.5, help="period of the series, s (default 2.5)")
     ap.add_argument("--harmonics", type=counting(1), default=5, help="harmonics per axis (default 5)")

@@ -24,7 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import extras
-from ..program import ArgumentParser, command_prog, counting, existing_file, number, positive, writable_file
+from ..program import (ArgumentParser, command_prog, counting, description, existing_file, number, positive,
+                       writable_file)
 
 COLUMNS = ["t"] + [f"rho[{i}]" for i in range(1, 5)] + [f"F[{i}]" for i in range(1, 5)]
 
@@ -109,7 +110,7 @@ def model_parameters(ap, items, lib):
 
 
 def parser():
-    ap = ArgumentParser(prog=command_prog("identify"), description=__doc__.split("\n\n")[0].split(": ", 1)[1],
+    ap = ArgumentParser(prog=command_prog("identify"), description=description(__doc__),
                         formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("log", metavar="LOG.csv", type=existing_file, help="columns t, rho[1..4], F[1..4] (header row)")
     ap.add_argument("--cutoff", type=positive, default=20.0, metavar="HZ",
