@@ -160,10 +160,14 @@ esac
 # 3. This project's Python package (python/pkm4puu), editable: the checks,
 # examples and benchmarks import it, and it follows the working tree.
 # pyproject.toml's editable override builds nothing (PKM_PYTHON_ONLY): the
-# package finds libpkm and the FMUs in build/.
-if ! .venv/bin/python -c "import pkm4puu, sys; sys.exit(pkm4puu.__file__ != '$PWD/python/pkm4puu/__init__.py')" 2>/dev/null; then
+# package finds libpkm and the FMUs in build/. Installed again when
+# pyproject.toml changed since (its metadata: dependencies, extras, command).
+pkg_stamp=.venv/.pkm4puu.stamp
+if ! .venv/bin/python -c "import pkm4puu, sys; sys.exit(pkm4puu.__file__ != '$PWD/python/pkm4puu/__init__.py')" 2>/dev/null \
+   || [ ! -f "$pkg_stamp" ] || [ pyproject.toml -nt "$pkg_stamp" ]; then
   log "installing the pkm4puu package (editable, nothing built)"
   .venv/bin/pip install --disable-pip-version-check -q --no-deps --no-build-isolation -e .
+  touch "$pkg_stamp"
 else
   log "pkm4puu package installed"
 fi
