@@ -170,7 +170,7 @@ def test_files_from_the_asked_build_else_the_package_else_cwd_build(tmp_path, mo
 
 
 def test_checks_run_the_build_trees_files(plant_fmu, plant_fmu3, pkm_library):
-    """This package is the development install (python/pyproject.toml): it
+    """This package is the development install (`pip install -e .`): it
     holds no FMUs nor libpkm of its own, so the checks test the build
     tree's ($PKM_BUILD_DIR, conftest.py), whatever is asked."""
     assert not (locate.PACKAGE_DIR / locate.PACKAGED_FMUS).exists()
