@@ -8,13 +8,19 @@ The log: a random Fourier trajectory within the workspace
 (pkm4puu.calibration.random_trajectory), the sliders' positions and the
 exact forces F = Y pi + F0 from the C API, 1 % force noise and 1 um
 encoder quantisation. The first call (scipy's modules imported, the
-library loaded) and the median of --repeat later calls are printed.
+library loaded) and the median of --repeat later calls are printed, and the
+peak memory one call allocates (tracemalloc) against the stacked regressor's
+size (n x 4 x n_pi doubles, what least squares on the stacked rows holds at
+the least): the regressor goes in blocks of calibration.identification.BLOCK
+samples, so the peak falls below it once the log is a few blocks long
+(--seconds 100 and more).
 
 usage: calibration_bench.py [--build DIR] [--seconds S] [--repeat N]
 """
 import argparse
 import sys
 import time
+import tracemalloc
 
 import numpy as np
 
@@ -63,6 +69,11 @@ def main(argv=None):
             t0 = time.perf_counter()
             p.regressor_joints(r_, rd, rdd)
             reg.append(time.perf_counter() - t0)
+    tracemalloc.start()
+    identify(t, rho, F, model=MODEL, lib=lib)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    stacked = len(t) * 4 * len(capi.regressor_params(lib)) * 8
     med, reg_med = float(np.median(warm)) if warm else first, float(np.median(reg))
     target = TARGET * args.seconds / 10.0
     print(f"identify: {len(t)} samples ({args.seconds:g} s at 1 kHz), {len(r.names)} base parameters, "
@@ -72,6 +83,8 @@ def main(argv=None):
     print(f"   {'identify, median of later calls':<48} {med * 1e3:8.1f} ms {med / reg_med:7.2f}x "
           f"{f'<= {target:g} s  ' + ('ok' if med <= target else 'OVER'):>18}")
     print(f"   {'identify, first call (imports, library)':<48} {first * 1e3:8.1f} ms {first / reg_med:7.2f}x")
+    print(f"   {'memory: the stacked regressor (baseline)':<48} {stacked / 1e6:8.1f} MB {1.0:7.2f}x")
+    print(f"   {'memory: identify, peak allocation':<48} {peak / 1e6:8.1f} MB {peak / stacked:7.2f}x")
     return 0
 
 

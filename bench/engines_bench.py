@@ -8,7 +8,7 @@ step, through
                  FMU through the C harness (build/bench/pkm_fmu_bench compare,
                  plain C: no Python in any timed loop);
   MuJoCo         mj_step, RK4, 1 ms, the stiffest connect constraints
-                 (pkm4puu.validation.references.mujoco_model), timed in
+                 (pkm4puu.references.mujoco_model), timed in
                  mujoco.rollout (MuJoCo's own C loop) and, for context, in a
                  Python loop of mj_step (its Python overhead per step is
                  printed);
@@ -60,11 +60,14 @@ import mujoco.rollout
 import pinocchio as pin
 
 from pkm4puu import motions, spec
-from pkm4puu.validation.cli import add_build_arg, find_build, machine_description, prefixed_log
-from pkm4puu.locate import BENCH_PROGRAM, FMU_BENCH_PROGRAM, build_path
-from pkm4puu.validation.references import mujoco_model
-from pkm4puu.validation.engine_comparison import deviation, pinocchio_reference
-from pkm4puu.validation.references.pinocchio_model import PinocchioPKM
+from pkm4puu.cli.engine_comparison import deviation, pinocchio_reference
+from pkm4puu.program import add_build_arg, find_build, machine_description, prefixed_log
+from pkm4puu.references import mujoco_model
+from pkm4puu.references.pinocchio_model import PinocchioPKM
+
+# This benchmark's programs, in the build directory (bench/CMakeLists.txt).
+BENCH_PROGRAM = "bench/pkm_bench"  # the C++ benchmark (bench/pkm_bench.cpp)
+FMU_BENCH_PROGRAM = "bench/pkm_fmu_bench"  # the FMU's C harness; its `compare` is run here
 
 H = 1e-3
 STEPS_TIMED = 1000  # one simulated second
@@ -80,7 +83,7 @@ def _rows_from_q(Q):
 # --- this project, through the C harness ---------------------------------------------------------------
 def run_c_harness(build, batches, log, keep_runs=True):
     """One run of the C harness: {case: {"what", "median", "min", "max_c", "run"}}, and its stdout."""
-    exe = build_path(FMU_BENCH_PROGRAM, build)
+    exe = build / FMU_BENCH_PROGRAM
     if not exe.is_file():
         raise FileNotFoundError(f"{exe} not found: build the project first (cmake --build {build})")
     with tempfile.TemporaryDirectory() as tmp:
@@ -234,7 +237,7 @@ def derivatives_comparison(build, median, bench_args=()):
     print(f"derivatives, Pinocchio: constraintDynamics {1e6 * t_cd:.1f} us, with "
           f"computeConstraintDynamicsDerivatives {1e6 * t_dd:.1f} us per call (16 coordinates, 4 constraints, "
           f"from Python): {t_dd / t_cd:.2f}x")
-    exe = build_path(BENCH_PROGRAM, build)
+    exe = build / BENCH_PROGRAM
     if not exe.exists():
         print(f"derivatives, this project: {exe} not built")
         return

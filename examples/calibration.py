@@ -42,8 +42,8 @@ from pkm4puu.calibration import identify, optimise_excitation, random_trajectory
 from pkm4puu.calibration.drive_log import DriveLog, feedforward, replay, simulate_drive_log
 from pkm4puu.calibration.identification import filtered_derivatives
 from pkm4puu.calibration.parameters import make_plant
-from pkm4puu.validation.cli import add_common_args, run_program
-from pkm4puu.validation.plots import save_figure
+from pkm4puu.program import add_common_args, run_program
+from pkm4puu.plots import save_figure
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -165,7 +165,7 @@ def plot(c: Calibration, path):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="calibration", description=__doc__.split("\n\n")[0])
-    add_common_args(ap)
+    add_common_args(ap, "calibration.png and calibration_start.json")
     ap.add_argument("--seed", type=int, default=0, help="seed of the excitation's start and the noise")
 
     def compute(args, fmus, log):

@@ -46,10 +46,10 @@ import sys
 import matplotlib
 import numpy as np
 
-from pkm4puu.validation.cli import add_common_args, run_program
+from pkm4puu.program import add_common_args, run_program
 from pkm4puu.closed_loop import run_closed_loop
-from pkm4puu.validation.plots import save_figure
-from pkm4puu.validation.drawing import write_run_csv
+from pkm4puu.plots import save_figure
+from pkm4puu.drawing import write_run_csv
 from pkm4puu.interface import RK4, START_P0
 from pkm4puu.spec import STEP as H, T_MOVE
 
@@ -231,7 +231,7 @@ def plot(runs, ratio, params, path):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="closed_loop_control", description=__doc__.split("\n\n")[0])
-    add_common_args(ap)
+    add_common_args(ap, "closed_loop.csv, closed_loop_tracking.png and closed_loop_run.csv")
     ap.add_argument("--payload", type=float, default=PAYLOAD,
                     help="payload on the platform, known to both feed-forwards (kg, default %(default)s)")
     ap.add_argument("--coulomb", type=float, default=COULOMB,

@@ -49,8 +49,8 @@ from pathlib import Path
 import numpy as np
 
 import pkm4puu
-from pkm4puu.validation.cli import add_common_args, start, write_outputs
-from pkm4puu.validation.plots import save_figure
+from pkm4puu.program import add_common_args, start, write_outputs
+from pkm4puu.plots import save_figure
 from pkm4puu.fmu import Fmu
 from pkm4puu.interface import ACC, F, POSE, RK4, START_P0, VEL
 from pkm4puu.motions import motion
@@ -365,7 +365,7 @@ def summary(results, wall, where):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="dask_sweep", description=__doc__.split("\n\n")[0])
-    add_common_args(ap)
+    add_common_args(ap, "sweep.csv and sweep_maps.png")
     ap.add_argument("--scheduler", metavar="ADDRESS",
                     help="address of a running Dask scheduler, e.g. tcp://10.0.0.5:8786 (default: start a "
                          "LocalCluster on this machine)")

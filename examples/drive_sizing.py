@@ -34,8 +34,8 @@ from dataclasses import dataclass
 import matplotlib
 import numpy as np
 
-from pkm4puu.validation.cli import add_common_args, run_program
-from pkm4puu.validation.plots import save_figure
+from pkm4puu.program import add_common_args, run_program
+from pkm4puu.plots import save_figure
 from pkm4puu.fmu import Fmu
 from pkm4puu.interface import ACC, indexed_names, DRHO, F, POSE, RHO, VEL
 from pkm4puu.motions import motion
@@ -206,7 +206,7 @@ def plot(profiles, path, motor=MOTOR, machine=None):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="drive_sizing", description=__doc__.split("\n\n")[0])
-    add_common_args(ap)
+    add_common_args(ap, "drive_sizing.csv and drive_sizing.png")
     ap.add_argument("--durations", type=float, nargs="+", default=list(DURATIONS),
                     help="move times T of the auto-test's path (s, default %(default)s)")
 

@@ -53,14 +53,14 @@ import matplotlib
 import numpy as np
 import scipy.linalg as sla
 
-from pkm4puu.validation.cli import add_common_args, run_program
-from pkm4puu.validation.plots import save_figure
+from pkm4puu.program import add_common_args, run_program
+from pkm4puu.plots import save_figure
 from pkm4puu.closed_loop import run_closed_loop
 from pkm4puu.fmu import Fmu
 from pkm4puu.interface import F, POSE, RK4, VEL, start_pose
 from pkm4puu.linearization import INPUTS, ModelExchange
 from pkm4puu.motions import autotest_motion
-from pkm4puu.validation.references.pinocchio_derivatives import PinocchioReducedDerivatives
+from pkm4puu.references.pinocchio_derivatives import PinocchioReducedDerivatives
 from pkm4puu import spec
 from pkm4puu.spec import STEP as H, T_MOVE
 
@@ -402,7 +402,7 @@ def plot(s, path):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="linearize_lqr", description=__doc__.split("\n\n")[0])
-    add_common_args(ap)
+    add_common_args(ap, "linearize_lqr.csv and linearize_lqr.png")
     ap.add_argument("--t-end", type=float, default=T_END, help="closed-loop run length (s, default %(default)s)")
     ap.add_argument("--offset", type=float, default=1e3 * OFFSET,
                     help="initial offset from the path (mm, default %(default)s)")

@@ -32,8 +32,8 @@ import matplotlib
 import numpy as np
 
 import pkm4puu
-from pkm4puu.validation.cli import add_common_args, run_program
-from pkm4puu.validation.plots import save_figure
+from pkm4puu.program import add_common_args, run_program
+from pkm4puu.plots import save_figure
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402

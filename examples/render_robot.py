@@ -5,14 +5,14 @@ run, as an animated GIF and as a still of several frames (like the paper's
 Fig. 7).
 
 Every point is computed from the CSV's joint values and pose with
-docs/model.md's formulas (pkm4puu.validation.drawing.mechanism_points): the legs from the DH
+docs/model.md's formulas (pkm4puu.drawing.mechanism_points): the legs from the DH
 chain of Table I (slider's U joint O2 at height rho + h on the prismatic axis
 through B_i, rod to O3 = O2 + l x3, offset h' along z3 to the leg's end Q_i),
 the platform from the pose (p + Rz(phi) r_Qi). The two meet where the loop
 closes, which the drawing shows and test_examples_render.py checks.
 
 The CSV has the columns t_s, x, y, z, phi, rho[1..4], theta1[1..4],
-theta2[1..4] (pkm4puu.validation.drawing.write_run_csv; closed_loop_control.py writes one
+theta2[1..4] (pkm4puu.drawing.write_run_csv; closed_loop_control.py writes one
 as closed_loop_run.csv). Without --csv, the auto-test is run through the FMUs
 first (the inverse FMU's forces, held at each 1 ms step's midpoint, drive the
 plant open loop) and written as robot_run.csv.
@@ -30,8 +30,8 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 
-from pkm4puu.validation.cli import add_common_args, find_fmus, Log
-from pkm4puu.validation.drawing import mechanism_points, read_run_csv, RUN_COLUMNS, write_run_csv
+from pkm4puu.program import add_common_args, find_fmus, Log
+from pkm4puu.drawing import mechanism_points, read_run_csv, RUN_COLUMNS, write_run_csv
 from pkm4puu.fmu import Fmu
 from pkm4puu.interface import ACC, F, POSE, RK4, START_P0, VEL
 from pkm4puu.motions import motion
@@ -219,7 +219,7 @@ def closure_error(rows):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="render_robot", description=__doc__.split("\n\n")[0])
-    add_common_args(ap)
+    add_common_args(ap, "robot_run.csv (without --csv), robot_motion.gif and robot_frames.png")
     ap.add_argument("--csv", type=Path, help="a run CSV to draw (default: run the auto-test through the FMUs)")
     ap.add_argument("--frames", type=int, default=51, help="GIF frames over the run (default %(default)s)")
     ap.add_argument("--fps", type=int, default=25, help="GIF frames per second (default %(default)s)")

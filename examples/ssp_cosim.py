@@ -29,8 +29,8 @@ plant will need: before the step from t_k, the inputs are set to the motion at
 the midpoint of the plant's next step, and the SSP's initial values (seen
 during libcosim's initialisation, which transfers them before the first step)
 are the motion at h/2. The plant then holds over every step [t_k, t_k + h] the
-force F(t_k + h/2): exactly the midpoint-held case of
-pkm4puu.validation.autotest, whose max pose error over the 2 s is O(h^2):
+force F(t_k + h/2): exactly the midpoint-held case of the auto-test through
+the FMUs (`pkm4puu autotest`), whose max pose error over the 2 s is O(h^2):
 ~1.1e-8 m with CVODE. With no lead (inputs at t_k) the plant would hold
 F(t_k - h) over [t_k, t_k + h], a lag of 3h/2: an O(h) error of ~3e-5 m.
 
@@ -52,10 +52,9 @@ from xml.sax.saxutils import quoteattr
 import matplotlib
 import numpy as np
 
-from pkm4puu.validation.autotest import BOUNDS as AUTOTEST_BOUNDS
-from pkm4puu.validation.cli import add_common_args, start, write_outputs
+from pkm4puu.program import add_common_args, start, write_outputs
 from pkm4puu.closed_loop import PoseErrors
-from pkm4puu.validation.plots import save_figure
+from pkm4puu.plots import save_figure
 from pkm4puu.interface import ACC, F, POSE, START_P0, VEL
 from pkm4puu.motions import motion, pose_at
 from pkm4puu.spec import STEP as H, T_MOVE
@@ -68,10 +67,6 @@ H_NS = 1_000_000  # libcosim counts time in integer nanoseconds: 1 ms
 N_STEPS = round(T_MOVE / H)
 LEAD = 1.5  # steps: the inverse FMU's inputs lead the plant by 3h/2 (see the module's doc)
 SOLVERS = {"cvode": 0, "rk4": 1}
-# What test_examples_ssp.py requires: the bound pkm4puu.validation.autotest
-# holds the midpoint-held case to (the libcosim run is that case), and
-# agreement with that fmpy run to rounding.
-TOL_POS, TOL_PHI = AUTOTEST_BOUNDS.position, AUTOTEST_BOUNDS.phi  # m, rad
 
 MOTION_INPUTS = POSE + VEL + ACC
 NS = {
@@ -172,7 +167,7 @@ def write_ssp(plant_fmu, inverse_fmu, path, solver="cvode", lead=LEAD):
 @dataclass
 class SspRun(PoseErrors):
     """Communication times t (s), the plant's pose (x, y, z, phi) there and
-    the prescribed pose pose_d; pos_err (m) and phi_err (rad) as in pkm4puu.validation.autotest."""
+    the prescribed pose pose_d; pos_err (m) and phi_err (rad) as in `pkm4puu autotest`."""
     t: np.ndarray
     pose: np.ndarray
     pose_d: np.ndarray
@@ -250,8 +245,7 @@ def plot(runs, path, solver):
     axes[1].set_xlabel("time (s)")
     axes[0].set_title(f"Auto-test as an SSP system in libcosim: inverse.F -> plant.F, 1 ms fixed step, "
                       f"plant {solver.upper()}", fontsize=10)
-    for ax, tol, unit in ((axes[0], TOL_POS, "m"), (axes[1], TOL_PHI, "rad")):
-        ax.axhline(tol, color="grey", lw=0.8, ls=":", label=f"test bound {tol:g} {unit}")
+    for ax in axes:
         ax.set_ylim(bottom=1e-12)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
@@ -260,7 +254,7 @@ def plot(runs, path, solver):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="ssp_cosim", description=__doc__.split("\n\n")[0])
-    add_common_args(ap)
+    add_common_args(ap, "PKM4PUU_autotest.ssp, ssp_autotest.csv and ssp_autotest_errors.png")
     ap.add_argument("--solver", choices=sorted(SOLVERS), default="cvode",
                     help="the plant's integrator (default %(default)s)")
     args, log, fmus = start(ap, argv)
@@ -287,11 +281,7 @@ def main(argv=None):
         print(f"  {name:<36} {r.pos_err.max():.3e} m  {r.phi_err.max():.3e} rad")
     write_outputs(args.out, log, {"ssp_autotest.csv": lambda p: write_csv(runs, p),
                                   "ssp_autotest_errors.png": lambda p: plot(runs, p, args.solver)})
-    good = runs[next(iter(cases))]
-    ok = good.pos_err.max() <= TOL_POS and good.phi_err.max() <= TOL_PHI
-    if not ok:
-        log(f"error: the compensated run's error exceeds {TOL_POS:g} m / {TOL_PHI:g} rad")
-    return 0 if ok else 1
+    return 0
 
 
 if __name__ == "__main__":

@@ -8,7 +8,10 @@ as PKM_BUILD_DIR for everything the checks run (pkm4puu.locate.build_dir,
 the example programs). A missing FMU is a failure, not a skip: these checks
 exist to test the built FMUs.
 """
+import contextlib
+import io
 import os
+import re
 from pathlib import Path
 
 import pytest
@@ -74,3 +77,19 @@ def dist_fmus() -> dict:
     platform and the source code (cmake/Platforms.cmake), keyed (version, id)."""
     return {(v, i): _require_fmu(str(locate.dist_fmu_path(i, v, BUILD).relative_to(BUILD)))
             for v in (2, 3) for i in ("PKM4PUU", "PKM4PUU_Inverse")}
+
+
+def promised_files(help_text: str) -> set:
+    """The file names a command's --help promises for --out."""
+    out = help_text[help_text.index("--out DIR"):]
+    return set(re.findall(r"[\w.]+\.(?:csv|png|gif|json)\b", " ".join(out.split())))
+
+
+def command_help(command: str) -> str:
+    """`pkm4puu COMMAND --help`, run in this process."""
+    from pkm4puu import cli
+    text = io.StringIO()
+    with contextlib.redirect_stdout(text), pytest.raises(SystemExit) as e:
+        cli.main([command, "--help"])
+    assert e.value.code == 0
+    return text.getvalue()

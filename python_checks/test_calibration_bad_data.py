@@ -1,13 +1,16 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""pkm4puu.identify and `python -m pkm4puu identify` refuse bad data with a
-message that says what and where (docs/calibration.md): too short,
-non-exciting (naming what is not identifiable), NaN samples, time going
-back, slider positions out of reach or beyond the travel, a CSV without
-the columns. The logs here are made with the C API's regressor, exact
-forces F = Y pi + F0 along a random Fourier trajectory (no FMU needed)."""
+"""pkm4puu.identify and `pkm4puu identify` refuse bad data with a message
+that says what and where (docs/calibration.md): too short, non-exciting
+(naming what is not identifiable), NaN samples, time going back, slider
+positions out of reach or beyond the travel, a CSV without the columns, a
+cut-off or trim that is no number of the kind. The regressor goes in
+blocks, whatever their size the same estimate as the stacked rows' least
+squares. The logs here are made with the C API's regressor, exact forces
+F = Y pi + F0 along a random Fourier trajectory (no FMU needed)."""
 import csv
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -15,7 +18,7 @@ import numpy as np
 import pytest
 
 from pkm4puu import capi, locate
-from pkm4puu.calibration import IdentificationError, identify, random_trajectory
+from pkm4puu.calibration import IdentificationError, filtered_derivatives, identify, random_trajectory
 from pkm4puu.calibration.parameters import make_plant
 
 MODEL = {"friction_velocity": 0.005}
@@ -135,6 +138,57 @@ def test_cutoff_above_nyquist(good, lib):
         identify(*good, model=MODEL, lib=lib, cutoff=600.0)
 
 
+@pytest.mark.parametrize("kw, message", [({"cutoff": 0.0}, "the cut-off 0.0 Hz"),
+                                         ({"cutoff": np.nan}, "the cut-off nan Hz"),
+                                         ({"cutoff": "20"}, "the cut-off '20' Hz"),
+                                         ({"trim": -5}, "trim -5 must be a whole number of samples >= 0"),
+                                         ({"trim": 2.5}, "trim 2.5 must be"), ({"block": 0}, "block 0 must be")],
+                         ids=["cutoff 0", "cutoff nan", "cutoff text", "trim -5", "trim 2.5", "block 0"])
+def test_a_cutoff_or_trim_of_the_wrong_kind_is_named(good, lib, kw, message):
+    with pytest.raises(IdentificationError, match=re.escape(message)):
+        identify(*good, model=MODEL, lib=lib, **kw)
+
+
+def test_the_blocks_give_the_stacked_rows_least_squares(good, lib):
+    """The regressor in blocks of 997 samples (the last one short) and in
+    one: the same estimate to rounding; and both the weighted least squares
+    of the stacked rows computed here directly (the rows [Y_i | F_i - F0_i]
+    of every leg, numpy's lstsq, each leg weighted by its OLS residuals'
+    standard deviation): values, standard deviations, condition number and
+    residual. The values' columns differ in size by 1e9 (masses against
+    rotor inertia), so the orders of the sums leave each value a rounding
+    error relative to its standard deviation, not to itself: the values are
+    compared to 1e-6 of their standard deviations."""
+    t, rho, F = (a.copy() for a in good)
+    rng = np.random.default_rng(5)
+    F += 0.01 * rng.standard_normal(F.shape)  # residuals that differ per leg: the weights matter
+    blocked = identify(t, rho, F, model=MODEL, lib=lib, physical=False, block=997)
+    whole = identify(t, rho, F, model=MODEL, lib=lib, physical=False, block=len(t))
+    assert np.all(np.abs(blocked.values - whole.values) <= 1e-6 * whole.std) and blocked.samples == whole.samples
+    trim = round(2 / (20.0 * H))  # the default: two periods of the 20 Hz cut-off
+    keep = slice(trim, len(t) - trim)
+    assert blocked.samples == keep.stop - keep.start
+    r, rd, rdd = filtered_derivatives(t, rho, 20.0)
+    with make_plant(lib, MODEL) as p:
+        Y, F0, _ = p.regressor_joints(r[keep], rd[keep], rdd[keep])
+    W = Y[:, :, blocked.base.independent]  # (n, 4, nb)
+    y = F[keep] - F0
+    x = np.linalg.lstsq(W.reshape(-1, W.shape[2]), y.reshape(-1), rcond=None)[0]
+    sigma = np.sqrt(np.sum((W @ x - y) ** 2, axis=0) / (len(y) - W.shape[2] / 4))
+    Ww, yw = (W / sigma[:, None]).reshape(-1, W.shape[2]), (y / sigma).reshape(-1)
+    xw = np.linalg.lstsq(Ww, yw, rcond=None)[0]
+    s2 = np.sum((Ww @ xw - yw) ** 2) / (len(yw) - len(xw))
+    std = np.sqrt(np.diag(s2 * np.linalg.inv(Ww.T @ Ww)))
+    Wn = W.reshape(-1, W.shape[2])
+    sv = np.linalg.svd(Wn / np.linalg.norm(Wn, axis=0), compute_uv=False)
+    for result in (blocked, whole):
+        assert np.all(np.abs(result.values - xw) <= 1e-6 * std)
+        assert np.allclose(result.leg_sigma, sigma, rtol=1e-8, atol=0)
+        assert np.allclose(result.std, std, rtol=1e-6, atol=0)
+        assert result.condition == pytest.approx(sv[0] / sv[-1], rel=1e-8)
+        assert result.residual_rms == pytest.approx(np.sqrt(np.mean((W @ xw - y) ** 2)), rel=1e-8)
+
+
 def write_csv(path, t, rho, F, drop=None):
     cols = ["t"] + [f"rho[{i}]" for i in range(1, 5)] + [f"F[{i}]" for i in range(1, 5)]
     with open(path, "w", newline="") as f:
@@ -165,7 +219,7 @@ def test_command_line_names_what_is_wrong(good, tmp_path):
     p = run_cli("no_f3.csv", cwd=tmp_path)
     assert p.returncode == 1 and "missing column(s) F[3]" in p.stderr, p.stderr
     p = run_cli("absent.csv", cwd=tmp_path)
-    assert p.returncode == 1 and "absent.csv: no such file" in p.stderr, p.stderr
+    assert p.returncode == 2 and "absent.csv: no such file" in p.stderr, p.stderr
     t, rho, F = (a.copy() for a in good)
     F[77, 0] = np.nan
     write_csv(tmp_path / "nan.csv", t, rho, F)

@@ -11,7 +11,7 @@ import pytest
 
 from pkm4puu import capi
 from pkm4puu.calibration.parameters import make_plant
-from pkm4puu.validation.excitation import main
+from pkm4puu.cli.excitation import main
 
 
 @pytest.fixture(scope="module")

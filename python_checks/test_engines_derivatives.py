@@ -39,8 +39,8 @@ import pytest
 from differences import richardson
 from pkm4puu import capi as pkm_capi, motions, spec
 from pkm4puu.linearization import ModelExchange
-from pkm4puu.validation.references.pinocchio_derivatives import PinocchioReducedDerivatives
-from pkm4puu.validation.references.pinocchio_model import PinocchioPKM
+from pkm4puu.references.pinocchio_derivatives import PinocchioReducedDerivatives
+from pkm4puu.references.pinocchio_model import PinocchioPKM
 
 TOL = 1e-6  # the bound, relative per column (see above)
 TOL_SANITY = 1e-7  # Pinocchio's assembly against differences of its own ydot

@@ -23,10 +23,11 @@
 import numpy as np
 import pytest
 
-from pkm4puu.validation.engine_comparison import (CAPI_SOLVERS, TIMES, TOL_CONSTRAINT, TOL_FMU_PHI, TOL_FMU_POS,
-                                                  TOL_PHI, TOL_POS, TOL_REF_PHI, TOL_REF_POS, capi_run, deviation,
-                                                  fmu_runs, load_capi, mujoco_run, pinocchio_reference, pinocchio_rk4,
-                                                  write_results)
+from conftest import command_help, promised_files
+from pkm4puu.cli.engine_comparison import (CAPI_SOLVERS, TIMES, TOL_CONSTRAINT, TOL_FMU_PHI, TOL_FMU_POS,
+                                           TOL_PHI, TOL_POS, TOL_REF_PHI, TOL_REF_POS, capi_run, deviation,
+                                           fmu_runs, load_capi, mujoco_run, pinocchio_reference, pinocchio_rk4,
+                                           write_results)
 
 
 @pytest.fixture(scope="module")
@@ -110,5 +111,7 @@ def test_mujoco_agreement_and_constraint_violation(mujoco_result, ref, ref_held)
 
 def test_write_results(ref, ref_held, capi, fmu, mujoco_result, results_dir):
     r = {"ref": ref, "ref_held": ref_held, "capi": capi, "fmu": fmu, "mujoco": mujoco_result}
-    for path in write_results(r, results_dir):
+    paths = write_results(r, results_dir)
+    for path in paths:
         assert path.stat().st_size > 0, f"{path} is empty"
+    assert {p.name for p in paths} == promised_files(command_help("engines"))

@@ -12,8 +12,8 @@ About 99% of each force is static weight and the dynamic part is ~0.013 N
 import numpy as np
 import pytest
 
-from pkm4puu.validation.engine_comparison import (AUTOTEST_TIMES, TOL_ID, capi_inverse, fmu_inverse, load_capi,
-                                                  pinocchio_inverse)
+from pkm4puu.cli.engine_comparison import (AUTOTEST_TIMES, TOL_ID, capi_inverse, fmu_inverse, load_capi,
+                                           pinocchio_inverse)
 
 
 @pytest.fixture(scope="module")

@@ -28,8 +28,8 @@ import pinocchio as pin
 import pytest
 
 from pkm4puu import motions, spec
-from pkm4puu.validation.references import mujoco_model
-from pkm4puu.validation.references.pinocchio_model import PinocchioPKM
+from pkm4puu.references import mujoco_model
+from pkm4puu.references.pinocchio_model import PinocchioPKM
 
 RNG = np.random.default_rng(20261121)
 

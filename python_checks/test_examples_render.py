@@ -7,7 +7,7 @@ platform (the DH chain from the FMU's joint outputs against the pose)."""
 import numpy as np
 import pytest
 
-from pkm4puu.validation.drawing import read_run_csv, RUN_COLUMNS, write_run_csv
+from pkm4puu.drawing import read_run_csv, RUN_COLUMNS, write_run_csv
 from example_scripts import load_example
 
 rr = load_example("render_robot")

@@ -7,6 +7,7 @@ import zipfile
 import numpy as np
 import pytest
 
+from pkm4puu.cli.autotest import BOUNDS
 from pkm4puu.fmu import Fmu, inverse_forces, run
 from pkm4puu.interface import F, POSE
 from example_scripts import load_example
@@ -33,7 +34,7 @@ def compensated(ssp_file):
 
 
 def fmpy_midpoint_run(plant_fmu, inverse_fmu):
-    """The midpoint-held auto-test through fmpy (pkm4puu.validation.autotest's
+    """The midpoint-held auto-test through fmpy (pkm4puu.cli.autotest's
     'midpoint' case, CVODE): the plant holds F(t_k + h/2) over [t_k, t_k + h]."""
     with Fmu(inverse_fmu) as inv:
         Fm = inverse_forces(inv, (np.arange(N) + 0.5) * H)
@@ -57,7 +58,7 @@ def test_ssp_archive_structure(ssp_file):
 def test_libcosim_reproduces_the_autotest(compensated, plant_fmu, inverse_fmu):
     """With the inverse FMU's inputs leading by 3h/2 the plant holds
     F(t_k + h/2) over every step: the midpoint-held auto-test, whose bound
-    pkm4puu.validation.autotest sets at 5e-8 m / 5e-8 rad (measured 1.1e-8 m,
+    pkm4puu.cli.autotest sets at 5e-8 m / 5e-8 rad (measured 1.1e-8 m,
     1.4e-8 rad with CVODE). It is the same computation as fmpy's, so the two
     runs agree to rounding: 6e-14 m measured, from the step times, which
     libcosim counts in integer nanoseconds, differing from fmpy's k * 1e-3 in
@@ -67,8 +68,8 @@ def test_libcosim_reproduces_the_autotest(compensated, plant_fmu, inverse_fmu):
     print(f"\nlibcosim SSP auto-test: max position error {r.pos_err.max():.3e} m, "
           f"max phi error {r.phi_err.max():.3e} rad")
     assert np.all(np.isfinite(r.pose))
-    assert r.pos_err.max() <= ssp_cosim.TOL_POS
-    assert r.phi_err.max() <= ssp_cosim.TOL_PHI
+    assert r.pos_err.max() <= BOUNDS.position
+    assert r.phi_err.max() <= BOUNDS.phi
     by_fmpy = fmpy_midpoint_run(plant_fmu, inverse_fmu)
     diff = np.abs(r.pose - by_fmpy).max()
     print(f"libcosim vs fmpy (midpoint hold): max |diff| = {diff:.3e}")

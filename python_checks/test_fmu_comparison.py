@@ -2,7 +2,7 @@
 """The paper's comparison test (section 5.2, docs/model.md "The paper's two tests")
 through the plant FMU: 1.5 s from rest at P0, gravity off, F2 = F3 = 0,
 F1(t) = 0.02 N sin(2 pi t / 1.5 s) = -F4(t), midpoint-held at a 1 ms step.
-The runner and the result writer are in pkm4puu.validation.comparison (the main job runs
+The runner and the result writer are in pkm4puu.cli.comparison (the main job runs
 the same code).
 
 Checked facts, each following from the model rather than from a past run:
@@ -18,9 +18,10 @@ The bounds are the report's (BOUNDS), which the main job's verdict uses too.
 """
 import pytest
 
-from pkm4puu.validation.comparison import (BOUNDS, checks, format_table, max_constraint_residual, max_delta_rho1,
-                                           nonfinite_outputs, run_all, solver_difference, vertical_com_drift,
-                                           write_results)
+from conftest import command_help, promised_files
+from pkm4puu.cli.comparison import (BOUNDS, checks, format_table, max_constraint_residual, max_delta_rho1,
+                                    nonfinite_outputs, run_all, solver_difference, vertical_com_drift,
+                                    write_results)
 
 TOL_POS, TOL_PHI, TOL_CONSTRAINT, MIN_DELTA_RHO1 = BOUNDS
 
@@ -77,6 +78,9 @@ def test_verdict_checks_what_the_tests_check(runs):
 
 
 def test_write_results(runs, results_dir):
-    csv_path, pose_png, rho_png = write_results(runs, results_dir)
-    for path in (csv_path, pose_png, rho_png):
+    """The files, each not empty: those `pkm4puu comparison --help` promises
+    but the checks (written beside them by the program)."""
+    paths = write_results(runs, results_dir)
+    for path in paths:
         assert path.stat().st_size > 0, f"{path} is empty"
+    assert {p.name for p in paths} | {"comparison_checks.csv"} == promised_files(command_help("comparison"))

@@ -32,7 +32,7 @@ import numpy as np
 import pytest
 from fmpy.util import add_remoting
 
-from pkm4puu.validation.autotest import BOUNDS, SOLVERS, half_step_forces, run_case
+from pkm4puu.cli.autotest import BOUNDS, SOLVERS, half_step_forces, run_case
 from pkm4puu.fmu import Fmu
 
 PLATFORMS = {2: {"linux64", "win64"}, 3: {"x86_64-linux", "x86_64-windows", "aarch64-linux"}}

@@ -18,7 +18,7 @@ import pytest
 
 from pkm4puu import capi, spec
 from pkm4puu.planning import segment
-from pkm4puu.validation import cycle as program
+from pkm4puu.cli import cycle as program
 
 # The columns of cycle.csv as docs/pick_and_place.md (and the issue) list them.
 CSV_COLUMNS = ("t x y z phi dx dy dz dphi ddx ddy ddz ddphi F[1] F[2] F[3] F[4] payload_mass").split()
@@ -117,7 +117,7 @@ def test_table_lists_every_payload_and_force_limit():
 def _one_error_line(status, stdout, stderr):
     lines = stderr.strip().splitlines()
     assert status == 2, (status, stderr)
-    assert len(lines) == 1 and lines[0].startswith(f"{program.PROG}: error: "), stderr
+    assert len(lines) == 1 and lines[0].startswith(f"{program.prog()}: error: "), stderr
     assert "Traceback" not in stderr and stdout == ""
     return lines[0]
 

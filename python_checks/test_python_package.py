@@ -2,20 +2,26 @@
 """The Python package pkm4puu (python/pkm4puu): the README's first look runs
 as written (the getting-started page's session: test_docs.py), and the wrapper opens the FMUs by name, runs them with named inputs
 and outputs, and says clearly what is wrong with a bad request; the library
-imports without matplotlib, finds the build directory from what it is given
-(not from where it is installed), and python -m pkm4puu runs the reports."""
+and the programs import without the extras, the library finds the build
+directory from what it is given (not from where it is installed), and the
+command pkm4puu runs the programs. One pyproject.toml declares the package;
+the development install is its editable install, which builds nothing."""
 import os
 import re
 import subprocess
 import sys
 
+from pathlib import Path
+
+import matplotlib
 import numpy as np
 import pytest
 
 import pkm4puu as pkm
 from conftest import REPO
 from pkm4puu import capi, locate
-from pkm4puu.__main__ import COMMANDS
+from pkm4puu import extras
+from pkm4puu.cli import COMMANDS
 
 # The README's first look, run as written.
 README_MARKER = "## A first look from Python"
@@ -71,26 +77,38 @@ def test_simulate_refuses_a_stop_time_off_the_step_grid(plant_fmu):
             plant.simulate(0.001, pkm.STEP, inputs={"F5": 1.0})
 
 
-LIBRARY_MODULES = ["spec", "interface", "motions", "locate", "fmu", "capi", "linearization", "closed_loop"]
-# The reports that run without pinocchio and mujoco import too; matplotlib
-# only comes with a figure.
-REPORT_MODULES = ["validation.autotest", "validation.comparison", "validation.plot_cpp_autotest",
-                  "validation.drawing", "validation.cli"]
+LIBRARY_MODULES = ["spec", "interface", "motions", "locate", "fmu", "capi", "linearization", "closed_loop", "drawing",
+                   "plots", "program", "extras", "calibration"]
+# The programs: the command's module and each command's (the engine
+# comparison's runners, engine_comparison, need the extra references).
+PROGRAM_MODULES = ["cli"] + [f"cli.{module}" for module, _ in COMMANDS.values()]
+EXTRA_MODULES = ["matplotlib", "scipy", "pinocchio", "mujoco"]
 
 
-def test_package_imports_without_matplotlib():
-    """matplotlib is the extra `plots`: the library and the reports' modules
-    import with it hidden (a None entry in sys.modules makes its import fail),
-    and none of them pulls in pinocchio or mujoco either."""
-    names = ["pkm4puu"] + [f"pkm4puu.{m}" for m in LIBRARY_MODULES + REPORT_MODULES]
+def test_package_imports_without_the_extras():
+    """The extras (plots: matplotlib; calibration: scipy; references:
+    pinocchio, mujoco) come when used: the library and every command's
+    module import with them hidden (a None entry in sys.modules makes an
+    import fail), so that `pkm4puu COMMAND --help` works without them."""
+    names = ["pkm4puu"] + [f"pkm4puu.{m}" for m in LIBRARY_MODULES + PROGRAM_MODULES]
     code = ("import sys\n"
-            "sys.modules['matplotlib'] = None\n"
+            f"for name in {EXTRA_MODULES!r}:\n"
+            "    sys.modules[name] = None\n"
             f"for name in {names!r}:\n"
-            "    __import__(name)\n"
-            "loaded = [m for m in ('pinocchio', 'mujoco') if m in sys.modules]\n"
-            "assert not loaded, loaded\n")
+            "    __import__(name)\n")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
+
+
+def test_star_import_holds_identify():
+    """`from pkm4puu import *` gives every name of __all__, pkm4puu.identify
+    among them: the calibration's identification."""
+    from pkm4puu.calibration import identify
+    scope = {}
+    exec("from pkm4puu import *", scope)
+    assert set(pkm.__all__) <= set(scope) and scope["identify"] is identify is pkm.identify
+    with pytest.raises(AttributeError, match="no attribute 'identity'"):
+        pkm.identity
 
 
 def test_build_directory_from_argument_environment_or_cwd(tmp_path, monkeypatch):
@@ -135,7 +153,7 @@ def test_files_from_the_asked_build_else_the_package_else_cwd_build(tmp_path, mo
 
 
 def test_checks_run_the_build_trees_files(plant_fmu, plant_fmu3, pkm_library):
-    """This package is the development install (python/pyproject.toml): it
+    """This package is the development install (`pip install -e .`): it
     holds no FMUs nor libpkm of its own, so the checks test the build
     tree's ($PKM_BUILD_DIR, conftest.py), whatever is asked."""
     assert not (locate.PACKAGE_DIR / locate.PACKAGED_FMUS).exists()
@@ -147,19 +165,29 @@ def run_cli(*args, **kwargs):
     return subprocess.run([sys.executable, "-m", "pkm4puu", *args], capture_output=True, text=True, **kwargs)
 
 
-def test_command_line_lists_and_dispatches_the_reports():
-    """python -m pkm4puu is the one command line: its help lists every
-    command, each command's help is its program's, and a wrong command
-    fails with the list."""
+def test_command_line_lists_and_dispatches_the_programs():
+    """The command pkm4puu (console command, or python -m pkm4puu): its help
+    lists every command, each command's help is its program's with the
+    usage naming the command as invoked, and a wrong command fails with the
+    list."""
     proc = run_cli("--help")
     assert proc.returncode == 0, proc.stderr
     for command in COMMANDS:
         assert command in proc.stdout
         sub = run_cli(command, "--help")
-        assert sub.returncode == 0 and f"python -m pkm4puu {command}" in sub.stdout, sub.stderr
+        assert sub.returncode == 0 and sub.stdout.startswith(f"usage: python -m pkm4puu {command} "), sub.stderr
+    console = Path(sys.executable).parent / "pkm4puu"
+    sub = subprocess.run([console, "comparison", "--help"], capture_output=True, text=True)
+    assert sub.returncode == 0 and sub.stdout.startswith("usage: pkm4puu comparison "), sub.stderr
     bad = run_cli("no-such-command")
-    assert bad.returncode == 2 and "invalid choice" in bad.stderr
+    assert bad.returncode == 2 and "invalid choice: 'no-such-command'" in bad.stderr
     assert run_cli().returncode == 2
+
+
+def test_version():
+    for proc in (run_cli("--version"), subprocess.run([Path(sys.executable).parent / "pkm4puu", "--version"],
+                                                        capture_output=True, text=True)):
+        assert proc.returncode == 0 and proc.stdout == f"pkm4puu {pkm.__version__}\n", proc.stderr
 
 
 def test_command_line_without_a_build_says_how_to_give_one(tmp_path):
@@ -170,39 +198,42 @@ def test_command_line_without_a_build_says_how_to_give_one(tmp_path):
     assert not (tmp_path / "results").exists()
 
 
-def test_wheel_carries_the_version_and_the_licence(tmp_path):
-    """The wheel built from python/ (setuptools, offline): its metadata's
-    version is pkm4puu.__version__ (one source, _version.py), its licence
-    BSD-2-Clause, and the project's LICENSE is in its .dist-info."""
-    import shutil
-    import zipfile
-    src = tmp_path / "python"  # a copy: setuptools writes build/ and *.egg-info beside pyproject.toml
-    shutil.copytree(REPO / "python", src, ignore=shutil.ignore_patterns("__pycache__", "build", "*.egg-info"))
-    proc = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q",
-                           "-w", str(tmp_path / "dist"), str(src)], capture_output=True, text=True)
-    assert proc.returncode == 0, proc.stderr
-    wheel, = (tmp_path / "dist").glob("pkm4puu-*.whl")
-    with zipfile.ZipFile(wheel) as z:
-        names = z.namelist()
-        meta = z.read(next(n for n in names if n.endswith(".dist-info/METADATA"))).decode()
-        licence = next(n for n in names if re.search(r"\.dist-info/(licenses/)?LICENSE$", n))
-        assert z.read(licence) == (REPO / "LICENSE").read_bytes()
-    assert f"\nVersion: {pkm.__version__}\n" in meta
-    assert "\nLicense: BSD-2-Clause\n" in meta
-    assert re.fullmatch(r"\d+\.\d+\.\d+", pkm.__version__)
-
-
-def test_the_wheel_and_the_development_install_declare_the_same_package():
-    """pyproject.toml (the wheel, with the binaries) and python/pyproject.toml
-    (the editable development install) declare one package: the same name,
-    Python, licence, dependencies, extras and console command, the version
-    from the same _version.py; the command is __main__'s main."""
+def test_one_pyproject_declares_the_installed_package():
+    """pyproject.toml is the one declaration: the installed package's
+    metadata (this development install's) has its version, licence,
+    dependencies, extras and console command; the extras' install commands
+    (extras.install_command) name its extras."""
     import tomllib
-    root = tomllib.loads((REPO / "pyproject.toml").read_text())
-    dev = tomllib.loads((REPO / "python" / "pyproject.toml").read_text())
-    keys = ("name", "dynamic", "requires-python", "license", "dependencies", "optional-dependencies", "scripts")
-    assert {k: root["project"].get(k) for k in keys} == {k: dev["project"].get(k) for k in keys}
-    assert root["project"]["scripts"] == {"pkm4puu": "pkm4puu.__main__:main"}
-    assert root["tool"]["scikit-build"]["metadata"]["version"]["input"] == "python/pkm4puu/_version.py"
-    assert root["tool"]["scikit-build"]["wheel"]["packages"] == ["python/pkm4puu"]
-    assert (REPO / "python" / "pkm4puu" / "py.typed").is_file()
+    from importlib.metadata import distribution
+    project = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]
+    dist = distribution("pkm4puu")
+    assert dist.version == pkm.__version__ and dist.metadata["License"] == project["license"]["text"]
+    extras_declared = project["optional-dependencies"]
+    declared = set(project["dependencies"]) | {f'{d}; extra == "{x}"' for x, ds in extras_declared.items() for d in ds}
+    assert set(dist.requires) == declared
+    assert {(e.name, e.value) for e in dist.entry_points if e.group == "console_scripts"} == \
+        set(project["scripts"].items()) == {("pkm4puu", "pkm4puu.cli:main")}
+    assert extras.install_command(["matplotlib"]) == "pip install 'pkm4puu[plots]'"
+    assert extras.install_command(["scipy"]) == "pip install 'pkm4puu[calibration]'"
+    assert extras.install_command(["pinocchio", "mujoco"]) == "pip install 'pkm4puu[references]'"
+    assert not (REPO / "python" / "pyproject.toml").exists()
+
+
+def test_the_development_install_builds_nothing(tmp_path):
+    """The package runs from the source tree (the editable install), and
+    pyproject.toml's editable override configures CMake with PKM_PYTHON_ONLY,
+    under which it enables no language and writes no build rule: `pip
+    install -e .` compiles nothing."""
+    import tomllib
+    assert Path(pkm.__file__) == REPO / "python" / "pkm4puu" / "__init__.py"
+    skbuild = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["scikit-build"]
+    editable, = (o for o in skbuild["overrides"] if o["if"] == {"state": "editable"})
+    assert editable["cmake"]["define"] == {"PKM_PYTHON_ONLY": "ON"} and editable["build"]["targets"] == []
+    assert skbuild["cmake"]["define"]["PKM_PYTHON_ONLY"] == "OFF"  # the wheel's
+    proc = subprocess.run(["cmake", "-S", REPO, "-B", tmp_path, "-G", "Ninja", "-DPKM_PYTHON_ONLY=ON"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    cache = (tmp_path / "CMakeCache.txt").read_text()
+    assert "CMAKE_CXX_COMPILER" not in cache and "CMAKE_C_COMPILER" not in cache
+    rules = re.findall(r"^build (\S+):", (tmp_path / "build.ninja").read_text(), re.M)
+    assert not [r for r in rules if r.endswith((".o", ".so", ".a", ".fmu"))], rules

@@ -14,7 +14,8 @@
 #   scripts/setup.sh --for-main-job what ./run_autotest.sh needs: the
 #                                   compiler, CMake, Ninja, Eigen, SUNDIALS and
 #                                   Python, and in .venv fmpy, numpy,
-#                                   matplotlib (and wheel) and pkm4puu; a
+#                                   matplotlib (and scikit-build-core) and
+#                                   pkm4puu; a
 #                                   later full run still installs the rest
 #                                   (its stamp file is not written here)
 set -euo pipefail
@@ -145,7 +146,7 @@ case "$mode" in
     install_docs
     log "done (for the build)"
     exit 0 ;;
-  main-job) install_pinned fmpy numpy matplotlib wheel ;;  # wheel: the editable install of pkm4puu below
+  main-job) install_pinned fmpy numpy matplotlib scikit-build-core ;;  # scikit-build-core: pkm4puu's install below
   *)
     if [ ! -f "$stamp" ] || [ "$req" -nt "$stamp" ]; then
       log "installing Python requirements from $req"
@@ -158,9 +159,15 @@ case "$mode" in
 esac
 # 3. This project's Python package (python/pkm4puu), editable: the checks,
 # examples and benchmarks import it, and it follows the working tree.
-if ! .venv/bin/python -c "import pkm4puu, sys; sys.exit(pkm4puu.__file__ != '$PWD/python/pkm4puu/__init__.py')" 2>/dev/null; then
-  log "installing the pkm4puu package (editable) from python/"
-  .venv/bin/pip install --disable-pip-version-check -q --no-deps --no-build-isolation -e python
+# pyproject.toml's editable override builds nothing (PKM_PYTHON_ONLY): the
+# package finds libpkm and the FMUs in build/. Installed again when
+# pyproject.toml changed since (its metadata: dependencies, extras, command).
+pkg_stamp=.venv/.pkm4puu.stamp
+if ! .venv/bin/python -c "import pkm4puu, sys; sys.exit(pkm4puu.__file__ != '$PWD/python/pkm4puu/__init__.py')" 2>/dev/null \
+   || [ ! -f "$pkg_stamp" ] || [ pyproject.toml -nt "$pkg_stamp" ]; then
+  log "installing the pkm4puu package (editable, nothing built)"
+  .venv/bin/pip install --disable-pip-version-check -q --no-deps --no-build-isolation -e .
+  touch "$pkg_stamp"
 else
   log "pkm4puu package installed"
 fi

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """ctest distribution_wheel: the wheel of the repository's pyproject.toml
-(scikit-build-core, the one CMake build), as a user gets and runs it.
+(scikit-build-core, the one CMake build), built and made manylinux.
 
   check_wheel.py --source REPO --work DIR --version X.Y.Z
 
@@ -10,14 +10,11 @@
    and nothing else (no headers, static library or CMake package);
 2. `auditwheel show`, then `auditwheel repair`, which must tag it
    manylinux (auditwheel in a tools venv cached in DIR/tools);
-3. a fresh venv, `pip install WHEEL[plots]` with binaries only (no
-   compiler), timed; then, from an empty folder and with no PKM_* variable
-   in the environment: the version is project()'s, find_fmu and
-   capi.load find the package's own files inside the venv, `python -m
-   pkm4puu autotest --out OUT` passes and writes its files (and nothing
-   into the current folder), the console command `pkm4puu` runs.
-Only the temporary folder it made (and DIR, its cache) are written or
-deleted. Prints the wheel's size and the install time."""
+3. the repaired wheel is left in DIR/dist (the only one there), where
+   python_checks/test_wheel.py installs it as a user does: a fresh venv,
+   no extras, an empty folder.
+Only the temporary folder it made and DIR (its cache) are written or
+deleted. Prints the wheel's size."""
 import argparse
 import os
 import re
@@ -31,8 +28,6 @@ import zipfile
 from pathlib import Path
 
 MODELS = ("PKM4PUU", "PKM4PUU_Inverse")
-AUTOTEST_FILES = ("fmu_autotest.csv", "fmu_autotest_errors.png", "fmu_autotest_pose.png", "fmu_autotest_forces.png",
-                  "fmu_autotest_checks.csv")
 
 
 def run(cmd, **kwargs):
@@ -71,7 +66,7 @@ def check_contents(wheel, version):
         entry_points = next((z.read(n).decode() for n in names if n.endswith(".dist-info/entry_points.txt")), "")
     dist_info = f"pkm4puu-{version}.dist-info/"
     wanted = {"pkm4puu/__init__.py", "pkm4puu/__main__.py", "pkm4puu/py.typed", "pkm4puu/lib/libpkm.so",
-              "pkm4puu/licenses/SUNDIALS.txt", "pkm4puu/licenses/Eigen.txt", "pkm4puu/validation/autotest.py",
+              "pkm4puu/licenses/SUNDIALS.txt", "pkm4puu/licenses/Eigen.txt", "pkm4puu/cli/autotest.py",
               dist_info + "METADATA"}
     wanted |= {f"pkm4puu/fmus/fmi{v}/{m}.fmu" for v in (2, 3) for m in MODELS}
     if wanted - names:
@@ -82,7 +77,7 @@ def check_contents(wheel, version):
                    or n.endswith((".a", ".h", ".cmake", ".pc")))
     if stray:
         fail(f"{wheel.name} holds what the wheel does not need: {stray[:10]}")
-    if not re.search(r"^pkm4puu = pkm4puu\.__main__:main$", entry_points, re.M):
+    if not re.search(r"^pkm4puu = pkm4puu\.cli:main$", entry_points, re.M):
         fail(f"{wheel.name}: no console command pkm4puu in entry_points.txt:\n{entry_points}")
 
 
@@ -95,20 +90,6 @@ def same_fmus(wheel, build):
                 if z.read(f"pkm4puu/fmus/fmi{v}/{m}.fmu") != built.read_bytes():
                     fail(f"{wheel.name}'s pkm4puu/fmus/fmi{v}/{m}.fmu differs from {built}")
     print(f"the wheel's FMU archives are {build}'s, byte for byte", flush=True)
-
-
-PROBE = """
-import ctypes, sys
-from pathlib import Path
-import pkm4puu, pkm4puu.capi as capi
-root = Path(sys.prefix).resolve()
-paths = [pkm4puu.find_fmu(m, v) for m in ("PKM4PUU", "PKM4PUU_Inverse") for v in (2, 3)] + [capi.library_path()]
-outside = [p for p in paths if root not in p.resolve().parents]
-assert not outside, f"not inside the venv {root}: {outside}"
-lib = capi.load()
-lib.pkm_version.restype = ctypes.c_char_p
-print(pkm4puu.__version__, lib.pkm_version().decode())
-"""
 
 
 def main():
@@ -148,31 +129,14 @@ def main():
         check_contents(repaired, args.version)
         print(f"wheel {repaired.name}: {repaired.stat().st_size / 1e6:.2f} MB", flush=True)
 
-        venv.create(tmp / "venv", with_pip=True)
-        py = tmp / "venv" / "bin" / "python"
-        # Binaries only: the wheel, and its dependencies from PyPI, install with no compiler.
-        _, t_install = run([py, "-m", "pip", "install", "--disable-pip-version-check", "-q", "--only-binary=:all:",
-                            f"{repaired}[plots]"], env=env)
-        print(f"pip install {repaired.name}[plots] into a fresh venv: {t_install:.1f} s", flush=True)
-
-        cwd, out = tmp / "empty", tmp / "out"
-        cwd.mkdir()
-        probe, _ = run([py, "-c", PROBE], cwd=cwd, env=env)
-        if probe.stdout.split() != [args.version, args.version]:
-            fail(f"__version__ and pkm_version(): {probe.stdout.split()}, project() {args.version}")
-        auto, t_auto = run([py, "-m", "pkm4puu", "autotest", "--out", out], cwd=cwd, env=env)
-        print(auto.stdout[-2000:], f"autotest from the wheel: {t_auto:.0f} s", sep="\n", flush=True)
-        missing = [f for f in AUTOTEST_FILES if not (out / f).is_file()]
-        if missing:
-            fail(f"python -m pkm4puu autotest wrote no {missing} into {out}")
-        if any(cwd.iterdir()):
-            fail(f"the autotest wrote into the current folder: {sorted(p.name for p in cwd.iterdir())}")
-        cmd, _ = run([tmp / "venv" / "bin" / "pkm4puu", "--help"], cwd=cwd, env=env)
-        if "autotest" not in cmd.stdout:
-            fail(f"pkm4puu --help does not list the commands:\n{cmd.stdout}")
+        dist = args.work / "dist"
+        shutil.rmtree(dist, ignore_errors=True)
+        dist.mkdir()
+        shutil.copy2(repaired, dist / repaired.name)
+        print(f"left {dist / repaired.name} for python_checks/test_wheel.py", flush=True)
     finally:
         shutil.rmtree(tmp)
-    print("wheel: built, manylinux, installed without a compiler, auto-test passed")
+    print("wheel: built, its contents checked, manylinux")
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@
  *
  * mj_inverse (built only where the MuJoCo wheel's libmujoco and headers
  * were found, PKM_HAVE_MUJOCO): the MJCF that
- * pkm4puu.validation.references.mujoco_model writes (the engines'
+ * pkm4puu.references.mujoco_model writes (the engines'
  * benchmarks' model), at the state bench/fmu/mujoco_inverse_model.py writes
  * beside it (the auto-test path at t = 1 s: qpos, qvel, qacc of its 16
  * coordinates). mj_inverse's work does not depend on the values.

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Writes what pkm_fmu_inverse_bench's mj_inverse case loads: the MJCF of
-the mechanism as pkm4puu.validation.references.mujoco_model builds it for
+the mechanism as pkm4puu.references.mujoco_model builds it for
 the engines' benchmarks (spec gravity, no machine), and a state on the
 auto-test path at t = 1 s: qpos (the spec's closed-form leg inverse
 kinematics and the pose), qvel and qacc (the legs' by central differences
@@ -13,7 +13,7 @@ import sys
 import numpy as np
 
 from pkm4puu import motions, spec
-from pkm4puu.validation.references import mujoco_model
+from pkm4puu.references import mujoco_model
 
 T = 1.0
 

@@ -7,17 +7,21 @@
 
 The library: spec (docs/model.md's numbers and geometry), motions (the test
 motions), interface (variable names), locate (the build directory and the
-paths in it), fmu (the wrapper), capi (a ctypes binding of the C API,
-pkm.h), linearization (the plant's Jacobians through Model Exchange),
-closed_loop (the sampled loop the control examples share), calibration
-(identification of the dynamic parameters from a drive log,
-pkm4puu.identify; it needs scipy), planning (the time-optimal pick-and-place
-cycle, pkm4puu.plan_cycle; it needs toppra, imported when first used). The
-rest needs numpy and fmpy only.
+paths in it), fmu (the wrapper), capi (the C API's binding, pkm.h),
+linearization (the plant's Jacobians through Model Exchange), closed_loop
+(the sampled loop the control examples share), drawing (the mechanism's
+points, a run's CSV), plots (figures; matplotlib, the extra `plots`),
+program (what command-line programs over the FMUs share), extras (the
+optional dependencies), calibration (identification of the dynamic
+parameters from a drive log, pkm4puu.identify; scipy, the extra
+`calibration`), references (independent Pinocchio and MuJoCo models of
+the mechanism; the extra `references`) and planning (the time-optimal
+pick-and-place cycle, pkm4puu.plan_cycle; toppra, the extra `planning`).
+The rest needs numpy and fmpy only.
 
-The reports (the paper's tests through the FMUs, the engine comparison
-against the independent Pinocchio and MuJoCo models, figures) are in
-pkm4puu.validation and run as `python -m pkm4puu COMMAND`.
+The programs (the paper's tests through the FMUs, the engine comparison,
+the identification, figures) are in pkm4puu.cli, behind the command
+`pkm4puu COMMAND` (or `python -m pkm4puu COMMAND`).
 """
 from ._version import __version__
 from .fmu import Fmu, Result, find_fmu, inverse_forces, run
@@ -34,7 +38,13 @@ __all__ = ["__version__", "Fmu", "Result", "build_dir", "find_fmu", "inverse_for
 
 
 def __getattr__(name):
-    # pkm4puu.plan_cycle: the planning extra (toppra) is imported when first used
+    """pkm4puu.identify, the calibration's identification
+    (calibration.identify), and pkm4puu.plan_cycle, the pick-and-place
+    planner (planning.plan_cycle), imported on first use: they load the C
+    API's binding, and scipy or toppra when called."""
+    if name == "identify":
+        from .calibration import identify
+        return identify
     if name == "plan_cycle":
         from .planning import plan_cycle
         return plan_cycle

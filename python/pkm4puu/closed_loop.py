@@ -16,7 +16,7 @@ from .spec import STEP as H, T_MOVE
 class PoseErrors:
     """For a run with the plant's `pose` and the prescribed `pose_d` (n, 4):
     ``pos_err`` = ‖(x, y, z) − prescribed‖ (m) and ``phi_err`` = abs(phi − prescribed)
-    (rad) at each time, as pkm4puu.validation.autotest measures them."""
+    (rad) at each time, as pkm4puu.cli.autotest measures them."""
 
     @property
     def pos_err(self):

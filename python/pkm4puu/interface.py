@@ -19,7 +19,7 @@ RHO = indexed_names("rho", 4)
 DRHO = indexed_names("drho", 4)
 THETA1 = indexed_names("theta1", 4)
 THETA2 = indexed_names("theta2", 4)
-# The columns of a run's CSV (pkm4puu.validation.drawing.write_run_csv).
+# The columns of a run's CSV (pkm4puu.drawing.write_run_csv).
 RUN_COLUMNS = POSE + RHO + THETA1 + THETA2
 
 

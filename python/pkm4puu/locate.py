@@ -7,8 +7,9 @@ A file is looked for in the build directory when one is asked for (a
 in the package itself (pkm4puu/fmus/fmi<v>/<model>.fmu and
 pkm4puu/lib/libpkm.so, which the wheel built from the repository's
 pyproject.toml holds), else in ./build of the current directory (the
-development install, python/pyproject.toml, holds none). Nothing outside
-the package is derived from where it is installed.
+development install, `pip install -e .`, holds none). Nothing outside the
+package is derived from where it is installed, and nothing here knows the
+build tree's programs (who runs one finds it).
 """
 import os
 from pathlib import Path
@@ -19,9 +20,6 @@ DEFAULT_BUILD = Path("build")  # relative to the current directory
 
 # Build-relative paths.
 LIBRARY = "lib/libpkm.so"  # the plain C API, pkm.h
-AUTOTEST_PROGRAM = "bin/pkm_autotest"  # the C++ auto-test, the main job's program
-BENCH_PROGRAM = "bench/pkm_bench"  # the C++ benchmark (bench/pkm_bench.cpp)
-FMU_BENCH_PROGRAM = "bench/pkm_fmu_bench"  # the FMU's C harness; `compare` feeds bench/engines_bench.py
 # Within the build directory: the FMI 2.0 archives at the top, the FMI 3.0
 # ones in FMI3_DIR, the multi-platform ones in DIST_DIR/fmi<version>.
 FMI3_DIR = "fmi3"
@@ -50,7 +48,7 @@ def build_dir(build: PathLike = None) -> Path:
 
 
 def build_path(relative: str, build: PathLike = None) -> Path:
-    """`relative` (one of the constants above) in the build directory."""
+    """`relative` in the build directory."""
     return build_dir(build) / relative
 
 

@@ -5,7 +5,7 @@
 // integrator's own stage times) must reproduce the path. Writes one CSV per
 // solver, prints the largest pose errors and checks them against the
 // bounds (kAutotestBounds): one PASS/FAIL line each, also written to
-// DIR/autotest_checks.csv in the columns of pkm4puu.validation.checks (the
+// DIR/autotest_checks.csv in the columns of pkm4puu.cli.checks (the
 // main job's verdict reads it); exit status 1 when a check fails.
 // A wrong argument (unknown option, missing value, a value that is not a
 // number or out of range, an --out that cannot be written) fails at once,
@@ -69,7 +69,7 @@ void progress(void* user, double t, double t_end) {
 }
 
 /// One line of the verdict: a measured value against its bound
-/// (pkm4puu.validation.checks's columns).
+/// (pkm4puu.cli.checks's columns).
 struct Check {
   std::string case_name, quantity;
   double measured, bound;

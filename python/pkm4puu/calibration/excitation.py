@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import capi
+from .. import capi, extras
 from .parameters import base_parameters, make_plant
 
 AXES = ("x", "y", "z", "phi")
@@ -157,7 +157,7 @@ def optimise_excitation(lib=None, *, period=2.5, harmonics=5, limits=None, model
     SLSQP from a seeded random start inside the limits; the result holds
     them also on a grid ten times finer. Raises RuntimeError if no
     trajectory within the limits was found."""
-    from scipy.optimize import minimize
+    minimize = extras.import_module("scipy.optimize", "pkm4puu.calibration").minimize
 
     lib = lib or capi.load()
     limits = limits or Limits()

@@ -16,15 +16,25 @@ legs weighted by the inverse of their residuals' standard deviations and
 solved again (weighted least squares), optionally under the parameters'
 physical bounds; the start values then from the base parameters and the
 model's known values for what the forces cannot separate.
+
+The regressor is computed in blocks of `block` samples, each leg's rows
+[W_i | y_i] reduced at once to the triangular factor R_i of their QR
+decomposition: every least-squares quantity below follows from the four
+R_i (W_i^T W_i = R_i^T R_i), so the memory grows with the log's few
+columns, not with the regressor's rows.
 """
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import capi
+from .. import capi, extras
 from .parameters import BaseParameters, base_parameters, make_plant
+
+BLOCK = 20000  # samples per block of the regressor (about 9 MB of it)
 
 
 class IdentificationError(ValueError):
@@ -90,26 +100,65 @@ def _check_data(t, rho, F, min_samples):
     return t, rho, F, h
 
 
+def _scipy(module):
+    """scipy.<module>, or extras.MissingExtra saying how to install it."""
+    return extras.import_module(f"scipy.{module}", "pkm4puu.identify")
+
+
 def filtered_derivatives(t, rho, cutoff, order=4):
     """rho low-passed without phase (Butterworth of `order`, forward and
     backward: the magnitude response squared) and its first and second
     central differences."""
-    from scipy.signal import butter, sosfiltfilt
+    signal = _scipy("signal")
 
     h = (t[-1] - t[0]) / (len(t) - 1)
     fs = 1.0 / h
     if not 0 < cutoff < 0.5 * fs:
         raise IdentificationError(f"the cut-off {cutoff} Hz must lie between 0 and half the sampling rate "
                                   f"({0.5 * fs:.6g} Hz)")
-    sos = butter(order, cutoff, fs=fs, output="sos")
-    r = sosfiltfilt(sos, rho, axis=0)
+    sos = signal.butter(order, cutoff, fs=fs, output="sos")
+    r = signal.sosfiltfilt(sos, rho, axis=0)
     rd = np.gradient(r, t, axis=0)
     rdd = np.gradient(rd, t, axis=0)
     return r, rd, rdd
 
 
+def _leg_factors(plant, r, rd, rdd, F, independent, block, guess):
+    """The triangular factors R_i ((nb + 1) x (nb + 1)) of each leg's rows
+    [W_i | y_i] over the samples, the regressor computed `block` samples at
+    a time, each block's forward kinematics starting from the previous
+    block's last pose. PkmError's `sample` counts from r's first row."""
+    nb = len(independent)
+    R = np.zeros((4, nb + 1, nb + 1))
+    for start in range(0, len(r), block):
+        part = slice(start, start + block)
+        try:
+            Y, F0, pose = plant.regressor_joints(r[part], rd[part], rdd[part], guess=guess)
+        except capi.PkmError as e:
+            e.sample = start + getattr(e, "sample", 0)
+            raise
+        guess = pose[-1]
+        rows = np.concatenate([Y[:, :, independent], (F[part] - F0)[:, :, None]], axis=2)  # (n, 4, nb + 1)
+        for i in range(4):
+            R[i] = np.linalg.qr(np.vstack([R[i], rows[:, i, :]]), mode="r")
+    return R
+
+
+def _squared_residuals(R, x):
+    """Each leg's sum of squared residuals |W_i x - y_i|^2 = |R_i (x, -1)|^2."""
+    v = np.append(x, -1.0)
+    return np.array([np.sum((Ri @ v) ** 2) for Ri in R])
+
+
+def _stacked(R, weights):
+    """(R_W, z) of the legs' rows stacked, leg i's weighted by weights[i]:
+    W^T W = R_W^T R_W and W^T y = R_W^T z."""
+    Rs = np.linalg.qr(np.vstack([w * Ri for w, Ri in zip(weights, R)]), mode="r")
+    return Rs[:-1, :-1], Rs[:-1, -1]
+
+
 def identify(t, rho, F, *, cutoff=20.0, order=4, trim=None, model=None, physical=True, weighted=True,
-             rank_tol=1e-6, lib=None, guess=None) -> IdentificationResult:
+             rank_tol=1e-6, lib=None, guess=None, block=BLOCK) -> IdentificationResult:
     """The base parameters from a log of the sliders' positions rho (m) and
     the actuator forces F (N), n x 4 each, at the times t (s, evenly spaced).
 
@@ -134,9 +183,17 @@ def identify(t, rho, F, *, cutoff=20.0, order=4, trim=None, model=None, physical
         relative to its size under generic motions) lies within this
         relative distance of the others' span is not identifiable from the
         data: IdentificationError names it.
-    """
-    from scipy.linalg import qr
+    block
+        samples per block of the regressor (the memory it takes).
 
+    Needs scipy (the extra `calibration`): extras.MissingExtra otherwise.
+    """
+    linalg = _scipy("linalg")
+    if not (isinstance(cutoff, numbers.Real) and math.isfinite(cutoff) and cutoff > 0):
+        raise IdentificationError(f"the cut-off {cutoff!r} Hz must be a finite number > 0")
+    for name, value, least in (("trim", trim, 0), ("block", block, 1)):
+        if value is not None and not (isinstance(value, numbers.Integral) and value >= least):
+            raise IdentificationError(f"{name} {value!r} must be a whole number of samples >= {least}")
     lib = lib or capi.load()
     model = dict(model or {})
     try:
@@ -163,22 +220,22 @@ def identify(t, rho, F, *, cutoff=20.0, order=4, trim=None, model=None, physical
         r, rd, rdd = filtered_derivatives(t, rho, cutoff, order)
         keep = slice(trim_n, len(t) - trim_n)
         try:
-            Y, F0, _ = plant.regressor_joints(r[keep], rd[keep], rdd[keep], guess=guess)
+            # The dependent columns equal combinations of the kept ones: W pi = W_kept pi_b.
+            R_legs = _leg_factors(plant, r[keep], rd[keep], rdd[keep], F[keep], base.independent, block, guess)
         except capi.PkmError as e:
             k = trim_n + getattr(e, "sample", 0)
             raise IdentificationError(
                 f"slider positions out of the mechanism's reach at sample {k} (t = {t[k]:.6g} s, rho = "
                 f"{np.array2string(rho[k], precision=6)} m): no platform pose joins them ({e})") from None
-    # The dependent columns equal combinations of the kept ones: W pi = W_kept pi_b.
-    W = Y[:, :, base.independent].reshape(-1, nb)
-    y = (F[keep] - F0).reshape(-1)
-    n_rows = len(y)
+    samples = keep.stop - keep.start
+    n_rows = 4 * samples
+    W, y = _stacked(R_legs, np.ones(4))  # W^T W and W^T y of the stacked rows
 
     # Identifiability: the pivoted QR of the columns, each relative to its
     # size under generic motions (BaseParameters.typical), so that a column
     # the data leave near zero counts as zero (docs/calibration.md).
     Wt = W / (base.typical * np.sqrt(n_rows))
-    R, piv = qr(Wt, mode="r", pivoting=True)
+    R, piv = linalg.qr(Wt, mode="r", pivoting=True)
     d = np.abs(np.diag(R))
     weak = [base.names[piv[j]] for j in range(nb) if not d[j] > rank_tol * d[0]]
     if weak:
@@ -190,19 +247,15 @@ def identify(t, rho, F, *, cutoff=20.0, order=4, trim=None, model=None, physical
     s = np.linalg.svd(W / norms, compute_uv=False)
     condition = float(s[0] / s[-1])
 
-    # Ordinary, then leg-weighted least squares (each leg's noise its own).
+    # Ordinary, then leg-weighted least squares (each leg's noise its own),
+    # on the triangular factors: the same normal equations as the rows'.
     x = np.linalg.lstsq(W, y, rcond=None)[0]
-    res = (y - W @ x).reshape(-1, 4)
-    dof = max(res.shape[0] - nb / 4.0, 1.0)
-    leg_sigma = np.sqrt(np.sum(res ** 2, axis=0) / dof)
-    if weighted and np.all(leg_sigma > 0):
-        w = np.tile(1.0 / leg_sigma, len(res))
-    else:
-        w = np.ones(n_rows)
-    Ww, yw = W * w[:, None], y * w
+    dof = max(samples - nb / 4.0, 1.0)
+    leg_sigma = np.sqrt(_squared_residuals(R_legs, x) / dof)
+    w = 1.0 / leg_sigma if weighted and np.all(leg_sigma > 0) else np.ones(4)
+    Ww, yw = _stacked(R_legs, w)
     x = np.linalg.lstsq(Ww, yw, rcond=None)[0]
-    rw = yw - Ww @ x
-    s2 = float(rw @ rw) / (n_rows - nb)
+    s2 = float(w ** 2 @ _squared_residuals(R_legs, x)) / (n_rows - nb)
     cov = s2 * np.linalg.inv(Ww.T @ Ww)
     std = np.sqrt(np.diag(cov))
     x_ls = x.copy()
@@ -210,12 +263,11 @@ def identify(t, rho, F, *, cutoff=20.0, order=4, trim=None, model=None, physical
     active = []
     if physical:
         x, active = _constrained(Ww, yw, x, std, base)
-    residual = (y - W @ x).reshape(-1, 4)
     start, warnings = start_values(base, x, std, model, lib)
     return IdentificationResult(base=base, values=x, std=std, values_ls=x_ls, start_values=start,
                                 condition=condition, leg_sigma=leg_sigma,
-                                residual_rms=float(np.sqrt(np.mean(residual ** 2))), samples=len(res),
-                                active_bounds=active, warnings=warnings)
+                                residual_rms=float(np.sqrt(np.sum(_squared_residuals(R_legs, x)) / n_rows)),
+                                samples=samples, active_bounds=active, warnings=warnings)
 
 
 def _physical_rows(base):
@@ -240,10 +292,11 @@ def _physical_rows(base):
 
 
 def _constrained(Ww, yw, x, std, base):
-    """The weighted least squares under the physical rows (SLSQP on the
-    parameters scaled by their standard deviations); x itself when it
-    satisfies them."""
-    from scipy.optimize import minimize
+    """The weighted least squares min |Ww x - yw| under the physical rows
+    (SLSQP on the parameters scaled by their standard deviations); x itself
+    when it satisfies them. Ww and yw may be any pair with the same normal
+    equations (the rows' triangular factor)."""
+    minimize = _scipy("optimize").minimize
 
     A, b, what = _physical_rows(base)
     if len(A) == 0 or np.all(A @ x >= b):

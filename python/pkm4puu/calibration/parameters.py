@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import capi
+from .. import capi, extras
 
 # Lower bounds of pi's entries that make a parameter set the FMUs accept
 # (src/pkm4puu/model/param_ranges.hpp): masses >= 1 mg, the rod's and the
@@ -33,25 +33,30 @@ _INDEXED = re.compile(r"^(\w+)\[(\d+)\]$")
 def make_plant(lib, values=None):
     """A capi.Plant of the spec's parameters with `values` (the FMUs'
     parameter names: "m_rod", "I_rod[2]", "payload_com[1]", "screw_lead", ...)
-    set over them. Raises capi.PkmError naming an invalid parameter."""
+    set over them. Raises KeyError naming a name that is no parameter (or an
+    index out of its vector's 1..n), capi.PkmError naming an invalid value."""
     params, machine = {}, {}
     p0, m0 = capi.Params(), capi.MachineParams()
     lib.pkm_default_params(ct.byref(p0))
     lib.pkm_default_machine_params(ct.byref(m0))
     for name, value in (values or {}).items():
         m = _INDEXED.match(name)
-        field, index = (m.group(1), int(m.group(2)) - 1) if m else (name, None)
+        field, index = (m.group(1), int(m.group(2))) if m else (name, None)
         if field in dict(capi.Params._fields_):
             target, defaults = params, p0
         elif field in dict(capi.MachineParams._fields_):
             target, defaults = machine, m0
         else:
             raise KeyError(f"{name!r} is no parameter of the model")
+        size = len(getattr(defaults, field)) if hasattr(getattr(defaults, field), "__len__") else None
+        if (index is None) != (size is None) or (index is not None and not 1 <= index <= size):
+            raise KeyError(f"{name!r} is no parameter of the model: {field} is " +
+                           (f"a vector, {field}[1] to {field}[{size}]" if size else "a number, without an index"))
         if index is None:
             target[field] = float(value)
         else:
             arr = target.setdefault(field, list(getattr(defaults, field)))
-            arr[index] = float(value)
+            arr[index - 1] = float(value)
     for k, v in list(params.items()):
         if isinstance(v, list):
             params[k] = (ct.c_double * len(v))(*v)
@@ -118,7 +123,7 @@ def base_parameters(plant, samples=120, seed=0, tol=1e-9):
     that raises the rank of those kept is kept (so the formulas fold the
     payload into the platform, not the reverse), and the others are written
     as combinations of the kept ones by least squares."""
-    from scipy.linalg import qr
+    qr = extras.import_module("scipy.linalg", "pkm4puu.calibration").qr
 
     names = [n for n, _ in capi.regressor_params(plant.lib)]
     units = [u for _, u in capi.regressor_params(plant.lib)]

@@ -18,36 +18,35 @@ the accuracy; three ways are compared:
 
 This module holds the runner, the writers and the bounds (BOUNDS) that (a)
 and (b) are held to, by the checks in test_fmu_autotest.py and by this
-program's verdict. Run as a module it is part of the main job
+program's verdict. `pkm4puu autotest` is part of the main job
 (run_autotest.sh): it runs every (input mode, solver) case, prints the table
 of max errors and the checks against BOUNDS, exits 1 when one fails, and
 writes to --out DIR:
 
   fmu_autotest.csv          position and phi error of every case over time
-  fmu_autotest_checks.csv   the checks (pkm4puu.validation.checks)
+  fmu_autotest_checks.csv   the checks (checks.py)
   fmu_autotest_errors.png   the same, plotted
   fmu_autotest_pose.png     prescribed vs FMU-simulated x, y, z, phi
                             (midpoint input, CVODE)
   fmu_autotest_forces.png   F1..F4 from the inverse FMU
 
-usage: python -m pkm4puu autotest [--build DIR] [--out DIR]
+The figures need matplotlib (the extra `plots`); without it the CSV files
+are written and a line says how to get the figures.
 """
-import argparse
 import csv
-import sys
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 
-from . import plots
-from .checks import check, finish_checks, write_checks
-from .cli import add_common_args, case_table, finish, run_cases, start
+from .. import plots
 from ..fmu import Fmu, inverse_forces, run
 from ..interface import ACC, F, POSE, START_P0, VEL
 from ..motions import pose_at
+from ..plots import pyplot, save_figure
+from ..program import case_table, finish, run_cases, start_report
 from ..spec import STEP as H, T_MOVE
-from .plots import pyplot, save_figure
+from .checks import check, finish_checks, write_checks
 
 
 N = round(T_MOVE / H)
@@ -276,16 +275,18 @@ def plot_forces(Fh, F_static, path):
                                "Auto-test: actuator forces from the inverse FMU (PKM4PUU_Inverse)", path)
 
 
-def write_results(runs, Fh, inverse_fmu, out_dir, bounds=None):
-    """Writes fmu_autotest.csv, fmu_autotest_errors.png (with `bounds`, see
-    plot_errors), fmu_autotest_pose.png and fmu_autotest_forces.png into
-    out_dir (created if missing; files are overwritten). Returns their paths
-    in that order."""
+def write_results(runs, Fh, inverse_fmu, out_dir, bounds=None, figures=True):
+    """Writes fmu_autotest.csv and, with `figures`, fmu_autotest_errors.png
+    (with `bounds`, see plot_errors), fmu_autotest_pose.png and
+    fmu_autotest_forces.png into out_dir (created if missing; files are
+    overwritten). Returns their paths in that order."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     paths = [out_dir / n for n in ("fmu_autotest.csv", "fmu_autotest_errors.png",
                                    "fmu_autotest_pose.png", "fmu_autotest_forces.png")]
     write_csv(runs, paths[0])
+    if not figures:
+        return paths[:1]
     plot_errors(runs, paths[1], bounds)
     plot_pose(runs, paths[2])
     plot_forces(Fh, static_forces(inverse_fmu, half_step_times()), paths[3])
@@ -294,11 +295,10 @@ def write_results(runs, Fh, inverse_fmu, out_dir, bounds=None):
 
 # --- command line ---------------------------------------------------------------------------
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m pkm4puu autotest",
-                                 description="The paper's auto-test (section 5.1) through the FMUs: inverse FMU "
-                                 "-> F1..F4 -> plant FMU, open loop, 1 ms communication step, 2 s.")
-    add_common_args(ap)
-    args, log, fmus = start(ap, argv, name="autotest")
+    args, log, fmus, figures = start_report(
+        "autotest", "The paper's auto-test (section 5.1) through the FMUs: inverse FMU -> F1..F4 -> plant FMU, open "
+        "loop, 1 ms communication step, 2 s.", "fmu_autotest.csv, fmu_autotest_checks.csv and, with matplotlib, "
+        "fmu_autotest_errors.png, fmu_autotest_pose.png and fmu_autotest_forces.png", argv)
     if fmus is None:
         return 1
     plant, inverse = fmus
@@ -309,10 +309,6 @@ def main(argv=None):
     bad = [f"case {m}/{s}: non-finite pose" for m, s in sorted(k for k, r in runs.items() if not r.finite())]
     results = checks(runs)
     status = finish(log, format_table(runs, errors, BOUNDS), errors, bad, len(CASES), "cases",
-                    lambda: [*write_results(runs, Fh, inverse, args.out, BOUNDS),
+                    lambda: [*write_results(runs, Fh, inverse, args.out, BOUNDS, figures),
                              write_checks(args.out / "fmu_autotest_checks.csv", results)])
     return finish_checks(status, results, log)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

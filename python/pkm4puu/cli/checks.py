@@ -1,22 +1,20 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Checks against bounds, one line each: what was measured, the value, the
-bound, PASS or FAIL. The main job's stages (pkm_autotest, `python -m
-pkm4puu autotest`, `python -m pkm4puu comparison`) each write theirs to a
-<stage>_checks.csv beside their results, in the one format below (the C++
-program writes the same columns); `python -m pkm4puu verdict FILE...` prints
-them all as one block and exits 1 when any failed or a file is missing.
+bound, PASS or FAIL. The main job's stages (pkm_autotest, `pkm4puu
+autotest`, `pkm4puu comparison`) each write theirs to a <stage>_checks.csv
+beside their results, in the one format below (the C++ program writes the
+same columns); `pkm4puu verdict FILE...` prints them all as one block and
+exits 1 when any failed or a file is missing.
 
 CSV columns: case, quantity, measured, relation ("<=" or ">"), bound, unit,
 verdict (PASS or FAIL). A measured value that is not finite fails.
-
-usage: python -m pkm4puu verdict CHECKS_CSV...
 """
-import argparse
 import csv
 import math
-import sys
 from pathlib import Path
 from typing import NamedTuple
+
+from ..program import ArgumentParser, command_prog
 
 COLUMNS = ["case", "quantity", "measured", "relation", "bound", "unit", "verdict"]
 RELATIONS = {"<=": lambda value, bound: value <= bound, ">": lambda value, bound: value > bound}
@@ -112,17 +110,13 @@ def report(paths):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m pkm4puu verdict",
-                                 description="The main job's verdict: every check of the given <stage>_checks.csv "
-                                 "files (measured value, bound, PASS/FAIL); exit status 1 when any failed or a file "
-                                 "is missing.")
+    ap = ArgumentParser(prog=command_prog("verdict"),
+                        description="The main job's verdict: every check of the given <stage>_checks.csv "
+                        "files (measured value, bound, PASS/FAIL); exit status 1 when any failed or a file "
+                        "is missing.")
     ap.add_argument("files", type=Path, nargs="+", metavar="CHECKS_CSV", help="a checks file written by a stage")
     args = ap.parse_args(argv)
     lines, ok = report(args.files)
     print("\n".join(["verdict: one line per check (measured, bound, result)", *lines,
                      f"verdict: {'PASS' if ok else 'FAIL'}"]), flush=True)
     return 0 if ok else 1
-
-
-if __name__ == "__main__":
-    sys.exit(main())

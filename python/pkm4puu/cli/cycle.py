@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""python -m pkm4puu cycle (or pkm4puu cycle): the time-optimal pick-and-place
+"""pkm4puu cycle: the time-optimal pick-and-place
 cycle (docs/pick_and_place.md). Plans the arch x = -a cos(pi s), y = 0,
 z = z0 + h sin(pi s), phi = -(theta/2) cos(pi s) from A (s = 0) to B (s = 1)
 carrying the payload and back empty, each leg the fastest rest-to-rest
@@ -22,8 +22,8 @@ a path that leaves the workspace or crosses a singularity, limits too low
 to hold the payload), one line on stderr saying which and where; 1 when
 the C API library cannot be loaded.
 
-usage: python -m pkm4puu cycle [--payload KG] [--f-max N] [--v-max M/S] [--a M] [--h M] [--z0 M]
-                               [--theta-deg DEG] [--grid N] [--dt S] [--build DIR] [--out DIR | --table]
+usage: pkm4puu cycle [--payload KG] [--f-max N] [--v-max M/S] [--a M] [--h M] [--z0 M]
+                     [--theta-deg DEG] [--grid N] [--dt S] [--build DIR] [--out DIR | --table]
 """
 import argparse
 import math
@@ -34,16 +34,23 @@ import tempfile
 import time
 from pathlib import Path
 
-PROG = "python -m pkm4puu cycle"
+from .. import extras
+from ..program import ArgumentParser, command_prog, description, writable_dir
+
 TABLE_PAYLOADS = (0.0, 0.1, 0.25, 0.5)  # kg
 TABLE_F_MAX = (5.0, 10.0, 20.0)  # N
 
 
+def prog():
+    """The usage name, as invoked."""
+    return command_prog("cycle")
+
+
 def parser():
-    from pkm4puu import spec
-    from pkm4puu.planning import DT, GRID
-    ap = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0],
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    from .. import spec
+    from ..planning import DT, GRID
+    ap = ArgumentParser(prog=prog(), description=description(__doc__),
+                        formatter_class=argparse.RawDescriptionHelpFormatter)
     for flag, kind, default, metavar, unit, what in (
             ("--payload", float, spec.CYCLE_PAYLOAD, "KG", "kg", "mass carried from A to B, at P"),
             ("--f-max", float, spec.CYCLE_F_MAX, "N", "N", "limit of each actuator force |F_i|"),
@@ -59,7 +66,7 @@ def parser():
                     help="build directory holding lib/libpkm.so (default: $PKM_BUILD_DIR, else the installed "
                          "package's own, else ./build)")
     out = ap.add_mutually_exclusive_group()
-    out.add_argument("--out", type=Path, default=None, metavar="DIR",
+    out.add_argument("--out", type=writable_dir, default=None, metavar="DIR",
                      help="write cycle.csv and cycle.png into DIR (default: write nothing)")
     out.add_argument("--table", action="store_true",
                      help="print the table of the cycle time against payload and f_max (Markdown; its own "
@@ -68,25 +75,13 @@ def parser():
 
 
 def error(message, status=2):
-    print(f"{PROG}: error: {message}", file=sys.stderr, flush=True)
+    print(f"{prog()}: error: {message}", file=sys.stderr, flush=True)
     return status
-
-
-def writable_out(path):
-    """None if `path` is (or can be made) a writable folder, else why not."""
-    probe = path
-    while not probe.exists() and probe.parent != probe:
-        probe = probe.parent
-    if not probe.is_dir():
-        return f"--out {path}: {probe} is not a directory"
-    if not os.access(probe, os.W_OK | os.X_OK):
-        return f"--out {path}: {probe} is not writable"
-    return None
 
 
 def write_csv(cycle, path):
     import numpy as np
-    from pkm4puu.planning import COLUMNS
+    from ..planning import COLUMNS
     np.savetxt(path, cycle.samples(), delimiter=",", header=",".join(COLUMNS), comments="", fmt="%.12g")
 
 
@@ -173,7 +168,7 @@ def write_outputs(cycle, out):
 
 def table(args):
     """The Markdown table of cycle time against payload and f_max."""
-    from pkm4puu.planning import Infeasible, Limits, arch, plan_segment
+    from ..planning import Infeasible, Limits, arch, plan_segment
     arch = arch(args.a, args.h, args.z0, math.radians(args.theta_deg))
     lines = [f"Cycle time on the {arch.describe()}, |drho_i/dt| <= {args.v_max:g} m/s; the payload is carried "
              "from A to B, the platform returns empty. Active: the share of each leg's time with a force or the "
@@ -198,27 +193,19 @@ def table(args):
 
 
 def main(argv=None):
-    args = parser().parse_args(argv)
-    if args.out is not None:
-        wrong = writable_out(args.out)
-        if wrong:
-            return error(wrong)
+    ap = parser()
+    args = ap.parse_args(argv)
+    extras.require(ap.prog, "toppra", *(("matplotlib",) if args.out is not None else ()))
+    from ..planning import PlanningError, plan_cycle
     try:
-        from pkm4puu.planning import PlanningError, plan_cycle
-        if args.out is not None:
-            import matplotlib  # noqa: F401
-    except ImportError as e:
-        extra = "plots" if e.name == "matplotlib" else "planning"
-        return error(f"{e.name} is missing: pip install 'pkm4puu[{extra}]'", 1)
-    try:
-        from pkm4puu.planning.capi_adapter import _library
+        from ..planning.capi_adapter import _library
         _library(args.build)
     except OSError as e:
         return error(f"cannot load the C API library: {e}", 1)
     try:
         if args.table:
-            from pkm4puu.planning import Limits, arch
-            from pkm4puu.planning.segment import check_path, grid_points
+            from ..planning import Limits, arch
+            from ..planning.segment import check_path, grid_points
             Limits(args.f_max, args.v_max)  # the values checked before the sweep
             check_path(arch(args.a, args.h, args.z0, math.radians(args.theta_deg)), grid_points(args.grid),
                        build=args.build, name="the arch")
@@ -231,11 +218,11 @@ def main(argv=None):
     except PlanningError as e:
         return error(str(e))
     print("\n".join(cycle.summary()), flush=True)
-    print(f"{PROG}: planned in {planned:.2f} s ({args.grid} grid intervals per leg, samples every {args.dt:g} s)",
+    print(f"{prog()}: planned in {planned:.2f} s ({args.grid} grid intervals per leg, samples every {args.dt:g} s)",
           file=sys.stderr, flush=True)
     if args.out is not None:
         for path in write_outputs(cycle, args.out):
-            print(f"{PROG}: wrote {path}", file=sys.stderr, flush=True)
+            print(f"{prog()}: wrote {path}", file=sys.stderr, flush=True)
     return 0
 
 

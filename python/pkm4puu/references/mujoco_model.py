@@ -41,7 +41,7 @@ import contextlib
 import numpy as np
 import mujoco
 
-from ... import motions, spec
+from .. import motions, spec
 
 # The stiffest setting (engine_comparison.py prints a sweep around it): the
 # smallest time constant MuJoCo accepts with refsafe on (2 timesteps), critical

@@ -1,19 +1,28 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""The auto-test's two standard figures, shared by the C++ core's plots
-(plot_cpp_autotest.py) and the FMU run's (autotest.py): actuator forces with
-their dynamic part (in the spirit of the paper's Fig. 5) and prescribed
-versus simulated platform motion (Fig. 6).
+"""Figures: matplotlib on demand, and the auto-test's two standard figures,
+shared by the C++ core's plots (pkm4puu plot-autotest) and the FMU run's
+(pkm4puu autotest): actuator forces with their dynamic part (in the spirit
+of the paper's Fig. 5) and prescribed versus simulated platform motion
+(Fig. 6).
 
 matplotlib is the package's optional extra `plots`: it is imported on the
-first figure (pyplot()), not with the package."""
+first figure (pyplot()), not with the package; without it pyplot() raises
+extras.MissingExtra saying how to install it."""
 import math
 
 import numpy as np
 
+from . import extras
+
+
+def available():
+    """True when matplotlib is installed (the figures can be drawn)."""
+    return not extras.missing("matplotlib")
+
 
 def pyplot():
     """matplotlib.pyplot on the non-interactive Agg backend, imported now."""
-    import matplotlib
+    matplotlib = extras.import_module("matplotlib", "the figures")
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     return plt

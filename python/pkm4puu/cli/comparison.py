@@ -5,13 +5,13 @@ F1(t) = 0.02 N sin(2 pi t / 1.5 s) = -F4(t), midpoint-held at a 1 ms step.
 
 This module holds the runner, the quantities the checks look at, their
 bounds (BOUNDS) and the result writers; the checks are in
-test_fmu_comparison.py and in this program's verdict. Run as a module it is
-part of the main job (run_autotest.sh): it runs the plant FMU with CVODE and
+test_fmu_comparison.py and in this program's verdict. `pkm4puu comparison`
+is part of the main job (run_autotest.sh): it runs the plant FMU with CVODE and
 with RK4, prints the table of the quantities below and the checks against
 BOUNDS, exits 1 when one fails, and writes to --out DIR:
 
   comparison.csv             platform pose, rho1..rho4 and delta rho1 (CVODE)
-  comparison_checks.csv      the checks (pkm4puu.validation.checks)
+  comparison_checks.csv      the checks (checks.py)
   comparison_pose.png        platform pose over time (the paper's Figs. 9-10)
   comparison_delta_rho1.png  displacement of actuator 1 (the paper's Fig. 11)
 
@@ -23,24 +23,23 @@ The quantities (each bounded, BOUNDS):
 - CVODE vs RK4: two different integrators must agree;
 - max |delta rho1|: the motion must be non-trivial.
 
-usage: python -m pkm4puu comparison [--build DIR] [--out DIR]
+The figures need matplotlib (the extra `plots`); without it the CSV files
+are written and a line says how to get the figures.
 """
-import argparse
 import csv
 import math
-import sys
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 
-from .checks import check, finish_checks, write_checks
-from .cli import add_common_args, case_table, finish, run_cases, start
 from ..fmu import Fmu, run
 from ..interface import F, POSE, START_P0, indexed_names
 from ..motions import comparison_forces
+from ..plots import pyplot, save_figure
+from ..program import case_table, finish, run_cases, start_report
 from ..spec import CMP_AMPLITUDE, CMP_DURATION, L as L_ROD, M_PLATFORM, M_ROD, M_SLIDER, STEP
-from .plots import pyplot, save_figure
+from .checks import check, finish_checks, write_checks
 
 H = STEP
 N = round(CMP_DURATION / H)
@@ -168,10 +167,10 @@ def format_table(runs, errors=None, bounds=None):
 
 
 # --- results ------------------------------------------------------------------------------------
-def write_results(runs, out_dir):
-    """Writes comparison.csv, comparison_pose.png and comparison_delta_rho1.png
-    (from the CVODE run) into out_dir (created if missing; files are
-    overwritten). Returns their paths in that order."""
+def write_results(runs, out_dir, figures=True):
+    """Writes comparison.csv and, with `figures`, comparison_pose.png and
+    comparison_delta_rho1.png (from the CVODE run) into out_dir (created if
+    missing; files are overwritten). Returns their paths in that order."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     r = runs["CVODE"]
@@ -184,6 +183,8 @@ def write_results(runs, out_dir):
         w.writerow(["t", "x", "y", "z", "phi", "rho1", "rho2", "rho3", "rho4", "delta_rho1"])
         for i in range(len(t)):
             w.writerow([f"{t[i]:.6f}"] + [f"{r[c][i]:.12e}" for c in cols] + [f"{d_rho1[i]:.12e}"])
+    if not figures:
+        return [csv_path]
 
     plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(9, 6), sharex=True)
@@ -211,11 +212,10 @@ def write_results(runs, out_dir):
 
 # --- command line ---------------------------------------------------------------------------
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m pkm4puu comparison",
-                                 description="The paper's comparison test (section 5.2) through the plant FMU, "
-                                 "with CVODE and with RK4.")
-    add_common_args(ap)
-    args, log, fmus = start(ap, argv, models=("PKM4PUU",), name="comparison")
+    args, log, fmus, figures = start_report(
+        "comparison", "The paper's comparison test (section 5.2) through the plant FMU, with CVODE and with RK4.",
+        "comparison.csv, comparison_checks.csv and, with matplotlib, comparison_pose.png and "
+        "comparison_delta_rho1.png", argv, models=("PKM4PUU",))
     if fmus is None:
         return 1
     plant = fmus[0]
@@ -224,9 +224,6 @@ def main(argv=None):
     bad = [f"{name}: non-finite outputs {nonfinite_outputs(r)}" for name, r in runs.items() if nonfinite_outputs(r)]
     results = checks(runs)
     status = finish(log, format_table(runs, errors, BOUNDS), errors, bad, len(SOLVERS), "runs",
-                    lambda: [*write_results(runs, args.out), write_checks(args.out / "comparison_checks.csv", results)])
+                    lambda: [*write_results(runs, args.out, figures),
+                             write_checks(args.out / "comparison_checks.csv", results)])
     return finish_checks(status, results, log)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

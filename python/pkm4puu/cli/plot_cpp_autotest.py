@@ -1,20 +1,18 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-2-Clause
 """Plots of the auto-test (paper section 5.1) from the CSV files written by
 pkm_autotest: actuator forces (in the spirit of the paper's Fig. 5), the
 prescribed and simulated platform motion (Fig. 6) and the round-trip error.
 
-usage: python -m pkm4puu plot-autotest RESULTS_DIR
+It needs matplotlib (the extra `plots`).
 """
-import argparse
 import sys
-from pathlib import Path
 
 import numpy as np
 
+from .. import extras
+from ..plots import plot_forces, plot_pose, pyplot, save_figure
+from ..program import ArgumentParser, command_prog, writable_dir
 from .checks import read_rows
-from .cli import writable_dir
-from .plots import plot_forces, plot_pose, pyplot, save_figure
 
 
 # The quantities of pkm_autotest's checks drawn with their bounds.
@@ -67,19 +65,21 @@ def plot_errors(runs, out, bound=None):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m pkm4puu plot-autotest",
-                                 description="Plots of the C++ auto-test (pkm_autotest --out RESULTS_DIR) from its "
-                                 "autotest_*.csv files, written beside them.")
+    ap = ArgumentParser(prog=command_prog("plot-autotest"),
+                        description="Plots of the C++ auto-test (pkm_autotest --out RESULTS_DIR) from its "
+                        "autotest_*.csv files: autotest_forces.png, autotest_pose.png and "
+                        "autotest_errors.png, written beside them.")
     ap.add_argument("results", type=lambda text: writable_dir(text, must_exist=True), metavar="RESULTS_DIR",
                     help="the directory holding autotest_*.csv, where the figures go")
     res = ap.parse_args(argv).results
+    extras.require(ap.prog, "matplotlib")
     runs = []
     for name, label in (("rk4", "RK4, h = 1 ms"), ("cvode", "CVODE Adams, rtol 1e-12")):
         path = res / f"autotest_{name}.csv"
         if path.exists():
             runs.append((label, load(path)))
     if not runs:
-        print(f"plot_autotest: no autotest_*.csv in {res}", file=sys.stderr)
+        print(f"{ap.prog}: error: no autotest_*.csv in {res}", file=sys.stderr)
         return 1
     first = runs[0][1]
     t = first["t_s"]
@@ -94,7 +94,3 @@ def main(argv=None):
     for f in ("autotest_forces.png", "autotest_pose.png", "autotest_errors.png"):
         print(f"wrote {res / f}")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..interface import RUN_COLUMNS
-from ..spec import BETA, H, H_PRIME, L, base_point, platform_point, rz
+from .interface import RUN_COLUMNS
+from .spec import BETA, H, H_PRIME, L, base_point, platform_point, rz
 
 
 # --- the mechanism's points ---------------------------------------------------------

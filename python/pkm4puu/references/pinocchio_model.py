@@ -53,7 +53,7 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from ... import spec
+from .. import spec
 
 NQ = 16
 LEG_ROWS = [3 * i for i in range(4)]  # index of rho_i in q

@@ -1,12 +1,12 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Validation against independent multibody engines (the paper's section 5.2,
 done with open tools): Pinocchio and MuJoCo models of the same mechanism,
-built from docs/model.md's numbers only (engines/), against this project's C API
-(libpkm.so) and FMUs.
+built from docs/model.md's numbers only (pkm4puu.references), against this
+project's C API (libpkm.so) and FMUs.
 
 This module holds the runners, the quantities the checks look at and the
-result writers; the checks are in test_engines_*.py. Run as a script it runs
-everything, prints the tables and writes to --out DIR:
+result writers; the checks are in test_engines_*.py. `pkm4puu engines`
+(engines.py) runs everything, prints the tables and writes to --out DIR:
 
   engines_comparison.csv    the comparison test: Pinocchio (reference), C API,
                             plant FMU and MuJoCo, pose and delta rho1 at 1 ms
@@ -44,26 +44,21 @@ What is compared:
   (pkm_inverse_dynamics_machine against Pinocchio's RNEA with armature,
   payload and friction).
 
-usage: python -m pkm4puu engines [--build DIR] [--out DIR] [--no-sweep]
+The figures need matplotlib (the extra `plots`).
 """
-import argparse
 import csv
 import math
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
-import mujoco
 import pinocchio as pin
 from scipy.integrate import solve_ivp
 
 from .. import capi as pkm_capi, motions, spec
-from ..locate import fmu_path
-from .references import mujoco_model
-from .cli import add_build_arg, add_out_arg, find_build, prefixed_log
-from .plots import pyplot, save_figure
-from .references.pinocchio_model import PinocchioPKM
+from ..plots import pyplot, save_figure
+from ..references import mujoco_model
+from ..references.pinocchio_model import PinocchioPKM
 
 H = 1e-3  # s, output grid and communication step
 N = round(spec.CMP_DURATION / H)
@@ -190,10 +185,13 @@ def pinocchio_inverse(times=AUTOTEST_TIMES):
 
 # --- this project -----------------------------------------------------------------------------------
 def load_capi(build=None):
-    """libpkm.so of the build directory (`build`, else as locate.build_dir finds it)."""
+    """libpkm.so as locate.library_path finds it: the build directory `build`
+    when given (or $PKM_BUILD_DIR), else the installed package's own, else
+    ./build's."""
     path = pkm_capi.library_path(build)
     if not path.is_file():
-        raise FileNotFoundError(f"{path} does not exist: build first (./run_tests.sh), or set PKM_BUILD_DIR")
+        raise FileNotFoundError(f"{path} does not exist: build libpkm first (./scripts/build.sh builds it into "
+                                f"build/), and pass the directory that holds it (--build DIR) or set PKM_BUILD_DIR")
     return pkm_capi.load(path)
 
 
@@ -609,9 +607,9 @@ def run_sweep(held):
 THIS_STYLE = {"linestyle": "--", "linewidth": 1.6}
 
 
-def write_results(r, out_dir):
-    """Writes engines_comparison.csv and the three PNG files into out_dir;
-    returns their paths."""
+def write_results(r, out_dir, figures=True):
+    """Writes engines_comparison.csv and (with `figures`) the three PNG files
+    into out_dir; returns their paths."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     ref, mj, capi = r["ref"], r["mujoco"], r["capi"]["CVODE"]
@@ -629,6 +627,8 @@ def write_results(r, out_dir):
         for k in range(len(t)):
             w.writerow([f"{t[k]:.6f}"] + [f"{run[n][k]:.15e}" for _, run in series for n in OUT + ["constraint"]])
     paths.append(csv_path)
+    if not figures:
+        return paths
 
     # Figs. 9-10: platform pose. Engines solid, this model dashed.
     plt = pyplot()
@@ -743,41 +743,3 @@ def check(r):
         if not d <= TOL_MACHINE_ID:
             bad.append(f"inverse dynamics with the machine: {d:.3e} N > {TOL_MACHINE_ID:g} N")
     return bad
-
-
-# --- command line ---------------------------------------------------------------------------------------------
-def main(argv=None):
-    prog = "engines"
-    ap = argparse.ArgumentParser(prog="python -m pkm4puu engines",
-                                 description="Validation against Pinocchio and MuJoCo models of the same mechanism "
-                                 "(inverse dynamics along the auto-test, the comparison test).")
-    add_build_arg(ap, "libpkm.so and the FMUs")
-    add_out_arg(ap, "CSV and PNG files")
-    ap.add_argument("--no-sweep", action="store_true", help="skip the table of MuJoCo constraint settings")
-    args = ap.parse_args(argv)
-    log = prefixed_log(prog)
-    build = find_build(args.build, log)
-    if build is None:
-        return 1
-    plant, inverse = fmu_path("PKM4PUU", 2, build), fmu_path("PKM4PUU_Inverse", 2, build)
-    for path in (plant, inverse, pkm_capi.library_path(build)):
-        if not path.is_file():
-            log(f"error: {path} not found: build first (./scripts/build.sh builds into build/) or pass --build DIR")
-            return 1
-    print(f"engines: pinocchio {pin.__version__}, mujoco {mujoco.__version__}", flush=True)
-    r = run_all(build, plant, inverse, log=log)
-    sweep = None
-    if not args.no_sweep:
-        log("MuJoCo constraint settings")
-        sweep = run_sweep(r["ref_held"])
-    print(format_tables(r, sweep), flush=True)
-    for path in write_results(r, args.out):
-        log(f"wrote {path}")
-    bad = check(r)
-    for msg in bad:
-        log(f"FAILED: {msg}")
-    return 1 if bad else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
