@@ -13,17 +13,19 @@
 namespace pkm_fmi {
 namespace pkm4puu_inverse_model {
 
-Status InverseData::make(Context& ctx, const char* function, pkm::Model& out) const {
+Status InverseData::make(Context& ctx, const char* function, pkm::Model& out) {
+  const pkm::Configuration c = parameters();
   std::string why;
-  if (pkm::make_model(params, out, &why) != pkm::Status::Ok) {
+  if (pkm::make_model(c.params, out, &why) != pkm::Status::Ok) {
     ctx.log.error("%s: %s", function, why.c_str());
     return Status::Error;
   }
-  why = pkm::validate(limits);
+  why = pkm::validate(c.solver.limits());
   if (!why.empty()) {
-    ctx.log.error("%s: parameter %s", function, why.c_str());
+    ctx.log.error("%s: %s", function, why.c_str());
     return Status::Error;
   }
+  limits = c.solver.limits();
   return Status::OK;
 }
 
@@ -36,7 +38,7 @@ Status InverseData::exit_initialization(Context& ctx) {
 }
 
 const pkm::Model* InverseData::current_model(Context& ctx, const char* function,
-                                             std::optional<pkm::Model>& temporary) const {
+                                             std::optional<pkm::Model>& temporary) {
   if (ctx.initialization_mode) return make(ctx, function, temporary.emplace()) == Status::OK ? &*temporary : nullptr;
   if (!model) ctx.log.error("%s: outputs not available (initialisation did not succeed)", function);
   return model.get();
