@@ -100,26 +100,31 @@ constexpr bool sorted_by_vr() {
   return true;
 }
 
-/// Every member of Params has exactly one row: as many Model rows as
-/// Params has doubles, and setting one row's member changes no other row's.
-constexpr bool model_rows_cover_params() {
-  std::size_t rows = 0;
+/// No two rows share a member: with every row zero, setting one row to 1
+/// changes no other row.
+constexpr bool rows_are_distinct() {
   for (const Parameter& p : kParameters) {
-    if (p.target != ParameterTarget::Model) continue;
-    ++rows;
     Configuration c{};
     for (const Parameter& q : kParameters) q.set(c, 0.0);
     p.set(c, 1.0);
     for (const Parameter& q : kParameters)
-      if (q.target == ParameterTarget::Model && &q != &p && q.get(c) != 0.0) return false;
+      if (&q != &p && q.get(c) != 0.0) return false;
   }
+  return true;
+}
+
+/// Every member of Params has a row: as many Model rows as Params has doubles.
+constexpr bool model_rows_cover_params() {
+  std::size_t rows = 0;
+  for (const Parameter& p : kParameters) rows += p.target == ParameterTarget::Model;
   return rows == sizeof(Params) / sizeof(double);
 }
 
 }  // namespace parameter_table_checks
 
 static_assert(parameter_table_checks::sorted_by_vr(), "the parameter table must be sorted by value reference");
+static_assert(parameter_table_checks::rows_are_distinct(), "two rows of the parameter table share a member");
 static_assert(parameter_table_checks::model_rows_cover_params(),
-              "every member of Params needs exactly one row in the parameter table");
+              "every member of Params needs a row in the parameter table");
 
 }  // namespace pkm
