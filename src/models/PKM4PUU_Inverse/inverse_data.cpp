@@ -90,18 +90,22 @@ Status InverseData::compute_outputs(Context& ctx, const pkm::Model& with, unsign
     pkm::GuardReport guard;
     if (pkm::check_jacobian(J, measure2, limits, &guard) == pkm::Status::Singular) return beyond_guard(guard);
   }
+  // Every group computed before any output is written: a failure writes nothing.
+  pkm::InverseDynamicsResult full;
   if (groups & kGroupMultipliers) {  // the whole reduced path, angles and lambda
-    pkm::InverseDynamicsResult full;
     const pkm::Status sf = pkm::inverse_dynamics(*m, p, pd, pdd, we, full);
     if (sf != pkm::Status::Ok) return failed(sf);
-    for (int k = 0; k < 12; ++k) lambda[k] = full.lambda[k];
   }
+  double cond = condition;
   if (groups & kGroupCondition) {  // the actuator Jacobian's SVD
     pkm::Vec16 q;
     const pkm::Status sq = pkm::closed_form_position(*m, p, q);
     if (sq != pkm::Status::Ok) return failed(sq);
-    condition = pkm::actuator_jacobian_condition(*m, q);
+    cond = pkm::actuator_jacobian_condition(*m, q);
   }
+  if (groups & kGroupMultipliers)
+    for (int k = 0; k < 12; ++k) lambda[k] = full.lambda[k];
+  condition = cond;
   if (!(groups & kGroupActuators)) return Status::OK;
   for (int i = 0; i < 4; ++i) {
     F[i] = r.F[i];
