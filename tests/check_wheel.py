@@ -71,6 +71,7 @@ def check_contents(wheel, version):
         entry_points = next((z.read(n).decode() for n in names if n.endswith(".dist-info/entry_points.txt")), "")
     dist_info = f"pkm4puu-{version}.dist-info/"
     wanted = {"pkm4puu/__init__.py", "pkm4puu/__main__.py", "pkm4puu/py.typed", "pkm4puu/lib/libpkm.so",
+              "pkm4puu/lib/pkm_cdef.h",
               "pkm4puu/licenses/SUNDIALS.txt", "pkm4puu/licenses/Eigen.txt", "pkm4puu/validation/autotest.py",
               dist_info + "METADATA"}
     wanted |= {f"pkm4puu/fmus/fmi{v}/{m}.fmu" for v in (2, 3) for m in MODELS}
@@ -98,7 +99,7 @@ def same_fmus(wheel, build):
 
 
 PROBE = """
-import ctypes, sys
+import sys
 from pathlib import Path
 import pkm4puu, pkm4puu.capi as capi
 root = Path(sys.prefix).resolve()
@@ -106,8 +107,7 @@ paths = [pkm4puu.find_fmu(m, v) for m in ("PKM4PUU", "PKM4PUU_Inverse") for v in
 outside = [p for p in paths if root not in p.resolve().parents]
 assert not outside, f"not inside the venv {root}: {outside}"
 lib = capi.load()
-lib.pkm_version.restype = ctypes.c_char_p
-print(pkm4puu.__version__, lib.pkm_version().decode())
+print(pkm4puu.__version__, lib.ffi.string(lib.pkm_version()).decode())
 """
 
 

@@ -7,7 +7,7 @@
 
 The library: spec (docs/model.md's numbers and geometry), motions (the test
 motions), interface (variable names), locate (the build directory and the
-paths in it), fmu (the wrapper), capi (a ctypes binding of the C API,
+paths in it), fmu (the wrapper), capi (the C API's binding, cffi reading
 pkm.h), linearization (the plant's Jacobians through Model Exchange),
 closed_loop (the sampled loop the control examples share), calibration
 (identification of the dynamic parameters from a drive log,

@@ -5,20 +5,24 @@ wheel holds them), or a build directory's, each path written once here.
 A file is looked for in the build directory when one is asked for (a
 `build` argument, --build on the command line, or $PKM_BUILD_DIR), else
 in the package itself (pkm4puu/fmus/fmi<v>/<model>.fmu and
-pkm4puu/lib/libpkm.so, which the wheel built from the repository's
+pkm4puu/lib/libpkm.so or its platform's name, which the wheel built from the repository's
 pyproject.toml holds), else in ./build of the current directory (the
 development install, python/pyproject.toml, holds none). Nothing outside
 the package is derived from where it is installed.
 """
 import os
+import sys
 from pathlib import Path
 from typing import Optional, Union
 
 BUILD_ENV = "PKM_BUILD_DIR"
 DEFAULT_BUILD = Path("build")  # relative to the current directory
 
+# The plain C API's shared library (pkm.h) by platform, as the build names it.
+LIBRARY_NAME = {"win32": "pkm.dll", "darwin": "libpkm.dylib"}.get(sys.platform, "libpkm.so")
 # Build-relative paths.
-LIBRARY = "lib/libpkm.so"  # the plain C API, pkm.h
+LIBRARY = f"lib/{LIBRARY_NAME}"
+CDEF = "lib/pkm_cdef.h"  # pkm.h preprocessed for cffi, beside the library (the Python binding, capi.py)
 AUTOTEST_PROGRAM = "bin/pkm_autotest"  # the C++ auto-test, the main job's program
 BENCH_PROGRAM = "bench/pkm_bench"  # the C++ benchmark (bench/pkm_bench.cpp)
 FMU_BENCH_PROGRAM = "bench/pkm_fmu_bench"  # the FMU's C harness; `compare` feeds bench/engines_bench.py
@@ -88,7 +92,7 @@ def fmu_path(model: str, fmi: int = 2, build: PathLike = None) -> Path:
 
 
 def library_path(build: PathLike = None) -> Path:
-    """libpkm.so (LIBRARY) as fmu_path finds an archive: the asked-for build
+    """libpkm (LIBRARY) as fmu_path finds an archive: the asked-for build
     directory's, else the package's, else ./build's."""
     return _find(LIBRARY, LIBRARY, build)
 

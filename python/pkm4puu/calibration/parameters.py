@@ -10,8 +10,6 @@ determine (docs/calibration.md).
 """
 from __future__ import annotations
 
-import ctypes as ct
-import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,37 +25,16 @@ LOWER = {"m_slider": 1e-6, "m_rod": 1e-6, "I_rod[1]": 1e-12, "I_rod[2]": 1e-12, 
          "payload_my": -np.inf, "payload_Izz_P": 0.0, "rotor_inertia": 0.0, "friction_viscous": 0.0,
          "friction_coulomb": 0.0}
 
-_INDEXED = re.compile(r"^(\w+)\[(\d+)\]$")
-
-
 def make_plant(lib, values=None):
     """A capi.Plant of the spec's parameters with `values` (the FMUs'
     parameter names: "m_rod", "I_rod[2]", "payload_com[1]", "screw_lead", ...)
-    set over them. Raises capi.PkmError naming an invalid parameter."""
-    params, machine = {}, {}
-    p0, m0 = capi.Params(), capi.MachineParams()
-    lib.pkm_default_params(ct.byref(p0))
-    lib.pkm_default_machine_params(ct.byref(m0))
-    for name, value in (values or {}).items():
-        m = _INDEXED.match(name)
-        field, index = (m.group(1), int(m.group(2)) - 1) if m else (name, None)
-        if field in dict(capi.Params._fields_):
-            target, defaults = params, p0
-        elif field in dict(capi.MachineParams._fields_):
-            target, defaults = machine, m0
-        else:
+    set over them. Raises KeyError for a name that is no parameter,
+    capi.PkmError naming an invalid value."""
+    values = dict(values or {})
+    for name in values:
+        if name not in lib.parameters:
             raise KeyError(f"{name!r} is no parameter of the model")
-        if index is None:
-            target[field] = float(value)
-        else:
-            arr = target.setdefault(field, list(getattr(defaults, field)))
-            arr[index] = float(value)
-    for k, v in list(params.items()):
-        if isinstance(v, list):
-            params[k] = (ct.c_double * len(v))(*v)
-    if "payload_com" in machine:
-        machine["payload_com"] = tuple(machine["payload_com"])
-    return capi.Plant(lib, machine=machine, **params)
+    return capi.Plant(lib, **{name: float(v) for name, v in values.items()})
 
 
 @dataclass
