@@ -18,7 +18,7 @@ The runners and the machine's numbers are in engine_comparison.py
 - Every term must change the motion (by 1e3 times the bound), and the motion
   must stay clear of the end stops (left at their defaults), so that they are
   not part of the test.
-- This model (C API, pkm_create_machine, CVODE rtol 1e-12 and RK4 1 ms, the
+- This model (C API, the machine parameters set by name, CVODE rtol 1e-12 and RK4 1 ms, the
   exact forces at the integrator's own times) within the ideal machine's
   bounds, 1e-10 m and 1e-9 rad, inside the issue's 1e-8 m.
 - MuJoCo (joint armature and damping, a payload body, Coulomb friction through

@@ -7,8 +7,10 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstring>
+#include <initializer_list>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "pkm4puu/pkm.h"
 #include "pkm4puu/sim/parameters.hpp"
@@ -38,6 +40,10 @@ pkm_status null_argument(const pkm_model* m, const char* function, const char* a
 /// `size` must reach it; fields appended later are written when it reaches them.
 #define PKM_CAPI_SIZE_THROUGH(type, last) (offsetof(type, last) + sizeof(static_cast<type*>(nullptr)->last))
 
+/// The first of `args` (name, pointer) that is NULL, as null_argument; PKM_OK if none is.
+pkm_status first_null(const pkm_model* m, const char* function,
+                      std::initializer_list<std::pair<const char*, const void*>> args);
+
 /// Whether out->size holds at least the ABI 1.0 struct (`first_size`).
 template <class T>
 bool size_ok(const T* out, std::size_t first_size) {
@@ -52,6 +58,13 @@ void deliver(T* out, T value) {
 /// A struct size below the ABI 1.0 struct's: recorded, PKM_ERR_INVALID_ARGUMENT.
 pkm_status bad_size(const pkm_model* m, const char* function, const char* type, std::size_t size,
                     std::size_t first_size);
+/// A struct argument `name` of type `type`: not NULL, its size at least `first_size`.
+template <class T>
+pkm_status struct_argument(const pkm_model* m, const char* function, const char* name, const char* type, const T* p,
+                           std::size_t first_size) {
+  if (!p) return null_argument(m, function, name);
+  return size_ok(p, first_size) ? PKM_OK : bad_size(m, function, type, p->size, first_size);
+}
 
 inline pkm::Vec4 vec4(const double* a) { return a ? pkm::Vec4(a[0], a[1], a[2], a[3]) : pkm::Vec4::Zero(); }
 template <int N>

@@ -49,6 +49,10 @@ struct CallbackInputs {
   }
 };
 
+// The ABI 1.0 structs' sizes (fields appended later are written when a caller's size reaches them).
+constexpr std::size_t kOutputsSize = PKM_CAPI_SIZE_THROUGH(pkm_outputs, stop_indicators);
+constexpr std::size_t kStateSize = PKM_CAPI_SIZE_THROUGH(pkm_state, stops);
+
 /// Forward dynamics needs a run: NOT_INITIALIZED, with why there is none.
 pkm_status no_run(const pkm_model* m, const char* fn) {
   return fail(m, PKM_ERR_NOT_INITIALIZED, fn,
@@ -96,9 +100,8 @@ pkm_status pkm_advance_fn(pkm_model* m, double t_end, pkm_input_fn inputs, void*
 pkm_status pkm_get_outputs(pkm_model* m, const double u[PKM_PLANT_INPUTS], pkm_outputs* out) {
   const char* fn = "pkm_get_outputs";
   if (!m) return PKM_ERR_INVALID_ARGUMENT;
-  if (!out) return null_argument(m, fn, "out");
-  const std::size_t first = PKM_CAPI_SIZE_THROUGH(pkm_outputs, stop_indicators);
-  if (!size_ok(out, first)) return bad_size(m, fn, "pkm_outputs", out->size, first);
+  const pkm_status a = struct_argument(m, fn, "out", "pkm_outputs", out, kOutputsSize);
+  if (a != PKM_OK) return a;
   if (!m->plant->initialized()) return no_run(m, fn);
   pkm::LinearInputs in = constant_inputs(u);
   const pkm::Plant& plant = *m->plant;
@@ -141,9 +144,8 @@ pkm_status pkm_get_outputs(pkm_model* m, const double u[PKM_PLANT_INPUTS], pkm_o
 pkm_status pkm_get_state(const pkm_model* m, pkm_state* state) {
   const char* fn = "pkm_get_state";
   if (!m) return PKM_ERR_INVALID_ARGUMENT;
-  if (!state) return null_argument(m, fn, "state");
-  const std::size_t first = PKM_CAPI_SIZE_THROUGH(pkm_state, stops);
-  if (!size_ok(state, first)) return bad_size(m, fn, "pkm_state", state->size, first);
+  const pkm_status a = struct_argument(m, fn, "state", "pkm_state", state, kStateSize);
+  if (a != PKM_OK) return a;
   if (!m->plant->initialized()) return no_run(m, fn);
   const pkm::Plant& plant = *m->plant;
   pkm_state r{};
@@ -160,9 +162,8 @@ pkm_status pkm_get_state(const pkm_model* m, pkm_state* state) {
 pkm_status pkm_set_state(pkm_model* m, const pkm_state* state) {
   const char* fn = "pkm_set_state";
   if (!m) return PKM_ERR_INVALID_ARGUMENT;
-  if (!state) return null_argument(m, fn, "state");
-  const std::size_t first = PKM_CAPI_SIZE_THROUGH(pkm_state, stops);
-  if (!size_ok(state, first)) return bad_size(m, fn, "pkm_state", state->size, first);
+  const pkm_status a = struct_argument(m, fn, "state", "pkm_state", state, kStateSize);
+  if (a != PKM_OK) return a;
   const pkm::Vec8 y = Eigen::Map<const pkm::Vec8>(state->y);
   const pkm::EnergyIntegrals e{state->actuator_work, state->dissipated_energy};
   const pkm::Status s = m->plant->restore(state->t, y, vec4(state->theta1_ref), e, state->stops);
@@ -175,9 +176,8 @@ pkm_status pkm_forward_derivatives(pkm_model* m, const double state[8], const do
                                    double ydot[8], double A[64], double B[8 * PKM_PLANT_INPUTS]) {
   const char* fn = "pkm_forward_derivatives";
   if (!m) return PKM_ERR_INVALID_ARGUMENT;
-  if (!state) return null_argument(m, fn, "state");
-  if (!A) return null_argument(m, fn, "A");
-  if (!B) return null_argument(m, fn, "B");
+  const pkm_status a = first_null(m, fn, {{"state", state}, {"A", A}, {"B", B}});
+  if (a != PKM_OK) return a;
   const pkm::Vec8 y = Eigen::Map<const pkm::Vec8>(state);
   const double zero[PKM_PLANT_INPUTS] = {};
   const double* in = u ? u : zero;

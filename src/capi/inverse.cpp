@@ -23,10 +23,22 @@ pkm::Status within_guards(const pkm_model* m, const pkm::Pose& pose, std::string
   return s;
 }
 
-/// The failure of `what` at a pose: the core's status, or the guard's.
+/// The failure of `what`: the core's status, with the guard's sentence if it was the guard's.
 pkm_status refused(const pkm_model* m, pkm::Status s, const std::string& what, const std::string& why) {
   return fail(m, to_c(s), what, why.empty() ? pkm::status_name(s) : std::string(pkm::status_name(s)) + ": " + why);
 }
+
+/// PKM_OK if the core answered fn (its status s) and the pose lies within
+/// the guards; else fn's failure at the pose, recorded (the core's status
+/// first).
+pkm_status answered(const pkm_model* m, pkm::Status s, const char* fn, const double* pose) {
+  std::string why;
+  if (s == pkm::Status::Ok) s = within_guards(m, vec4(pose), &why);
+  return s == pkm::Status::Ok ? PKM_OK : refused(m, s, at_pose(fn, pose), why);
+}
+
+// The ABI 1.0 struct's size (fields appended later are written when a caller's size reaches them).
+constexpr std::size_t kInverseResultSize = PKM_CAPI_SIZE_THROUGH(pkm_inverse_result, beyond_stops);
 
 using RowRegressor = Eigen::Matrix<double, 4, pkm::kParams, Eigen::RowMajor>;
 
@@ -51,18 +63,14 @@ pkm_status pkm_inverse_dynamics(pkm_model* m, const double pose[4], const double
                                 const double acceleration[4], const double wrench[4], pkm_inverse_result* out) {
   const char* fn = "pkm_inverse_dynamics";
   if (!m) return PKM_ERR_INVALID_ARGUMENT;
-  if (!pose) return null_argument(m, fn, "pose");
-  if (!velocity) return null_argument(m, fn, "velocity");
-  if (!acceleration) return null_argument(m, fn, "acceleration");
-  if (!out) return null_argument(m, fn, "out");
-  const std::size_t first = PKM_CAPI_SIZE_THROUGH(pkm_inverse_result, beyond_stops);
-  if (!size_ok(out, first)) return bad_size(m, fn, "pkm_inverse_result", out->size, first);
+  pkm_status a = first_null(m, fn, {{"pose", pose}, {"velocity", velocity}, {"acceleration", acceleration}});
+  if (a == PKM_OK) a = struct_argument(m, fn, "out", "pkm_inverse_result", out, kInverseResultSize);
+  if (a != PKM_OK) return a;
   pkm::InverseDynamicsResult r;
-  std::string why;
-  pkm::Status s = pkm::inverse_dynamics(m->plant->model(), vec4(pose), vec4(velocity), vec4(acceleration),
-                                        vec4(wrench), r);
-  if (s == pkm::Status::Ok) s = within_guards(m, vec4(pose), &why);
-  if (s != pkm::Status::Ok) return refused(m, s, at_pose(fn, pose), why);
+  const pkm::Status s = pkm::inverse_dynamics(m->plant->model(), vec4(pose), vec4(velocity), vec4(acceleration),
+                                              vec4(wrench), r);
+  const pkm_status v = answered(m, s, fn, pose);
+  if (v != PKM_OK) return v;
   pkm_inverse_result o{};
   copy<4>(r.F, o.F);
   copy<4>(r.tau, o.tau);
@@ -79,17 +87,14 @@ pkm_status pkm_inverse_derivatives(pkm_model* m, const double pose[4], const dou
                                    const double acceleration[4], const double wrench[4], double F[4], double dF[64]) {
   const char* fn = "pkm_inverse_derivatives";
   if (!m) return PKM_ERR_INVALID_ARGUMENT;
-  if (!pose) return null_argument(m, fn, "pose");
-  if (!velocity) return null_argument(m, fn, "velocity");
-  if (!acceleration) return null_argument(m, fn, "acceleration");
-  if (!F) return null_argument(m, fn, "F");
-  if (!dF) return null_argument(m, fn, "dF");
+  const pkm_status a = first_null(
+      m, fn, {{"pose", pose}, {"velocity", velocity}, {"acceleration", acceleration}, {"F", F}, {"dF", dF}});
+  if (a != PKM_OK) return a;
   pkm::InverseDynamicsPartials d;
-  std::string why;
-  pkm::Status s = pkm::inverse_dynamics_derivatives(m->plant->model(), vec4(pose), vec4(velocity),
-                                                    vec4(acceleration), vec4(wrench), d);
-  if (s == pkm::Status::Ok) s = within_guards(m, vec4(pose), &why);
-  if (s != pkm::Status::Ok) return refused(m, s, at_pose(fn, pose), why);
+  const pkm::Status s = pkm::inverse_dynamics_derivatives(m->plant->model(), vec4(pose), vec4(velocity),
+                                                          vec4(acceleration), vec4(wrench), d);
+  const pkm_status v = answered(m, s, fn, pose);
+  if (v != PKM_OK) return v;
   copy<4>(d.F, F);
   Eigen::Map<Eigen::Matrix<double, 4, 16, Eigen::RowMajor>> J(dF);
   J << d.dp, d.dpd, d.dpdd, d.dwe;
@@ -111,16 +116,14 @@ pkm_status pkm_regressor(pkm_model* m, const double pose[4], const double veloci
                          const double wrench[4], double* Y, double F0[4]) {
   const char* fn = "pkm_regressor";
   if (!m) return PKM_ERR_INVALID_ARGUMENT;
-  if (!pose) return null_argument(m, fn, "pose");
-  if (!velocity) return null_argument(m, fn, "velocity");
-  if (!acceleration) return null_argument(m, fn, "acceleration");
-  if (!Y) return null_argument(m, fn, "Y");
+  const pkm_status a =
+      first_null(m, fn, {{"pose", pose}, {"velocity", velocity}, {"acceleration", acceleration}, {"Y", Y}});
+  if (a != PKM_OK) return a;
   pkm::RegressorSample r;
-  std::string why;
-  pkm::Status s =
+  const pkm::Status s =
       pkm::regressor(m->plant->model(), vec4(pose), vec4(velocity), vec4(acceleration), vec4(wrench), r);
-  if (s == pkm::Status::Ok) s = within_guards(m, vec4(pose), &why);
-  if (s != pkm::Status::Ok) return refused(m, s, at_pose(fn, pose), why);
+  const pkm_status v = answered(m, s, fn, pose);
+  if (v != PKM_OK) return v;
   Eigen::Map<RowRegressor> Y_out(Y);
   Y_out = r.Y;
   if (F0) copy<4>(r.F0, F0);
@@ -133,10 +136,11 @@ pkm_status pkm_regressor_poses(pkm_model* m, size_t n, const double* pose, const
   const char* fn = "pkm_regressor_poses";
   if (done) *done = 0;
   if (!m) return PKM_ERR_INVALID_ARGUMENT;
-  if (n > 0 && !pose) return null_argument(m, fn, "pose");
-  if (n > 0 && !velocity) return null_argument(m, fn, "velocity");
-  if (n > 0 && !acceleration) return null_argument(m, fn, "acceleration");
-  if (n > 0 && !Y) return null_argument(m, fn, "Y");
+  if (n > 0) {
+    const pkm_status a =
+        first_null(m, fn, {{"pose", pose}, {"velocity", velocity}, {"acceleration", acceleration}, {"Y", Y}});
+    if (a != PKM_OK) return a;
+  }
   pkm::RegressorSample r;
   for (size_t k = 0; k < n; ++k) {
     const pkm::Pose p = vec4(pose + 4 * k);
@@ -160,10 +164,10 @@ pkm_status pkm_regressor_joints(pkm_model* m, size_t n, const double* rho, const
   const char* fn = "pkm_regressor_joints";
   if (done) *done = 0;
   if (!m) return PKM_ERR_INVALID_ARGUMENT;
-  if (n > 0 && !rho) return null_argument(m, fn, "rho");
-  if (n > 0 && !drho) return null_argument(m, fn, "drho");
-  if (n > 0 && !ddrho) return null_argument(m, fn, "ddrho");
-  if (n > 0 && !Y) return null_argument(m, fn, "Y");
+  if (n > 0) {
+    const pkm_status a = first_null(m, fn, {{"rho", rho}, {"drho", drho}, {"ddrho", ddrho}, {"Y", Y}});
+    if (a != PKM_OK) return a;
+  }
   pkm::RegressorSample r;
   r.pose = guess ? vec4(guess) : pkm::Pose(0.0, 0.0, 0.05, 0.0);
   for (size_t k = 0; k < n; ++k) {

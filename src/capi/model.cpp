@@ -24,6 +24,13 @@ pkm_status null_argument(const pkm_model* m, const char* function, const char* a
   return fail(m, PKM_ERR_INVALID_ARGUMENT, function, std::string(argument) + " is NULL");
 }
 
+pkm_status first_null(const pkm_model* m, const char* function,
+                      std::initializer_list<std::pair<const char*, const void*>> args) {
+  for (const auto& [name, pointer] : args)
+    if (!pointer) return null_argument(m, function, name);
+  return PKM_OK;
+}
+
 pkm_status bad_size(const pkm_model* m, const char* function, const char* type, std::size_t size,
                     std::size_t first_size) {
   char buf[160];

@@ -38,10 +38,10 @@ What is compared:
   inertia, viscous and Coulomb friction, an off-centre payload (with g = 0
   and with gravity on, then from the holding forces plus the sine) and all
   terms together (the C API driven by motor torques), each built into
-  Pinocchio and MuJoCo independently; the C API by pkm_create_machine. The
+  Pinocchio and MuJoCo independently; the C API by its parameters. The
   same reference, the C API as above, MuJoCo at 0.125 ms; and inverse
   dynamics with every term along the auto-test
-  (pkm_inverse_dynamics_machine against Pinocchio's RNEA with armature,
+  (pkm_inverse_dynamics against Pinocchio's RNEA with armature,
   payload and friction).
 
 usage: python -m pkm4puu engines [--build DIR] [--out DIR] [--no-sweep]
@@ -299,8 +299,8 @@ def mujoco_sweep():
 # Pinocchio integrator, MuJoCo's joint damping), Coulomb friction with the
 # spec's tanh law (a joint force in both: MuJoCo through its passive-force
 # callback) and an off-centre payload (a second body rigidly attached to the
-# platform in both). The C API gets the same numbers through
-# pkm_create_machine, its end stops at their defaults.
+# platform in both). The C API gets the same numbers as parameters, its end
+# stops at their defaults.
 #
 # Bounds: the 1e-8 m for x, y, z and delta rho1; for phi 1e-7 rad,
 # 1e-8 m over the spec's 0.1 m lever for phi (the actuator Jacobian's
