@@ -81,7 +81,9 @@ class Library:
 
     def __getattr__(self, name):
         # lib.PKM_SOLVER_RK4, lib.pkm_version(): the library's own names.
-        return getattr(self.c, name)
+        if name.startswith(("pkm_", "PKM_")) and "c" in self.__dict__:
+            return getattr(self.c, name)
+        raise AttributeError(name)
 
 
 def load(path=None):
@@ -141,7 +143,7 @@ class Plant:
         s = self.c.pkm_create(handle)
         if s != self.c.PKM_OK:
             raise PkmError(f"pkm_create: {self._status(s)}", s)
-        self.handle = handle[0]
+        self.handle = self.ffi.gc(handle[0], self.c.pkm_destroy)  # destroyed with the object, or by close()
         self._callback = None
         try:
             self.set(**params)
@@ -151,7 +153,7 @@ class Plant:
 
     def close(self):
         if self.handle is not None:
-            self.c.pkm_destroy(self.handle)
+            self.ffi.release(self.handle)
             self.handle = None
 
     def __enter__(self):
