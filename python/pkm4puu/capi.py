@@ -5,14 +5,14 @@ The build preprocesses include/pkm4puu/pkm.h into lib/pkm_cdef.h beside the
 library (locate.CDEF; a wheel ships both): cffi declares every function, enum
 and struct from it, so no field can go missing, and a struct's fields are read
 by name. The parameters are the FMUs' (same names, ranges and defaults), which
-the library lists (pkm_parameter_info); nothing here spells them out.
+the library lists (pkm_parameter_info); nothing here spells them out::
 
     lib = load()                      # or load(path): libpkm of the build or the package (locate)
     with Plant(lib, g=0.0, payload_mass=0.25) as m:   # the FMUs' parameter names
         m.set_solver(solver=lib.PKM_SOLVER_CVODE, rtol=1e-12, atol=1e-14)
         m.init_pose(0.0, [0, 0, 0.05, 0])
         m.advance_fn(1.0, lambda t: (F, wrench))
-        out = m.outputs(F)            # every field of pkm_outputs: out.pose, out.lambda_, out.F_hold, ...
+        out = m.outputs(F)            # every field of pkm_outputs: out.pose, out.F_hold, ...
 
 An unknown keyword raises TypeError naming it and the known ones; a value
 the library refuses raises PkmError with its message.
@@ -133,9 +133,9 @@ class PkmError(RuntimeError):
 
 class Plant:
     """One pkm_model handle. Keyword arguments set parameters by the FMUs'
-    names (Plant(lib, g=0.0, payload_mass=0.25)); an array parameter takes
-    all its values (beta=[...], payload_com=(x, y)) or one ("beta[2]" through
-    **{"beta[2]": 0.1})."""
+    names (``Plant(lib, g=0.0, payload_mass=0.25)``); an array parameter
+    takes all its values (``beta=[...]``, ``payload_com=(x, y)``) or one
+    (``**{"beta[2]": 0.1}``)."""
 
     def __init__(self, lib, **params):
         self.lib, self.c, self.ffi = lib, lib.c, lib.ffi
@@ -283,7 +283,7 @@ class Plant:
 
     # ---- inverse dynamics
     def inverse_dynamics(self, pose, velocity, acceleration, wrench=None):
-        """Every field of pkm_inverse_result: F, tau, lambda_, q, qd, qdd, beyond_stops."""
+        """Every field of pkm_inverse_result: F, tau, ``lambda_``, q, qd, qdd, beyond_stops."""
         r = self.lib.new("pkm_inverse_result")
         self._check(self.c.pkm_inverse_dynamics(self.handle, self._d4(pose), self._d4(velocity),
                                                 self._d4(acceleration), self._d4(wrench), r), "pkm_inverse_dynamics")

@@ -146,7 +146,7 @@ class Machine:
 
     def parameters(self):
         """The parameters this machine sets, by the FMUs' names (end stops:
-        the defaults), for the C API (capi.Plant(lib, **machine.parameters()))."""
+        the defaults), for the C API: ``capi.Plant(lib, **machine.parameters())``."""
         return {"screw_lead": self.screw_lead, "rotor_inertia": self.rotor_inertia,
                 "friction_viscous": self.friction_viscous, "friction_coulomb": self.friction_coulomb,
                 "friction_velocity": self.friction_velocity, "payload_mass": self.payload_mass,
