@@ -5,9 +5,10 @@
   check_wheel.py --source REPO --work DIR --version X.Y.Z
 
 1. `pip wheel REPO --no-deps`, CMake's build tree cached in DIR/cmake (a
-   second run is incremental); the wheel holds the package, libpkm, the
-   FMI 2.0 and 3.0 archives, the notices, py.typed, the console command,
-   and nothing else (no headers, static library or CMake package);
+   second run is incremental); the wheel holds the package, libpkm with
+   pkm_cdef.h (pkm.h as the binding reads it), the FMI 2.0 and 3.0
+   archives, the notices, py.typed, the console command, and nothing else
+   (no other header, static library or CMake package);
 2. `auditwheel show`, then `auditwheel repair`, which must tag it
    manylinux (auditwheel in a tools venv cached in DIR/tools);
 3. a fresh venv, `pip install WHEEL[plots]` with binaries only (no
@@ -80,7 +81,7 @@ def check_contents(wheel, version):
     if not any(re.fullmatch(re.escape(dist_info) + r"(licenses/)?LICENSE", n) for n in names):
         fail(f"{wheel.name}: no LICENSE in {dist_info}")
     stray = sorted(n for n in names if not n.startswith(("pkm4puu/", dist_info)) or "__pycache__" in n
-                   or n.endswith((".a", ".h", ".cmake", ".pc")))
+                   or (n.endswith((".a", ".h", ".cmake", ".pc")) and n != "pkm4puu/lib/pkm_cdef.h"))
     if stray:
         fail(f"{wheel.name} holds what the wheel does not need: {stray[:10]}")
     if not re.search(r"^pkm4puu = pkm4puu\.__main__:main$", entry_points, re.M):

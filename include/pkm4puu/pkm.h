@@ -194,13 +194,16 @@ typedef struct {
   double theta1_ref[4];     /**< theta1's unwrapping reference (rad) */
   double actuator_work;     /**< J, the energy audit's integrals */
   double dissipated_energy; /**< J */
-  unsigned stops;           /**< the end stops in contact: bit i (i = 0..3) leg i+1's lower, bit 4+i its upper */
+  unsigned stops;           /**< the contact mode: bit i (i = 0..3) leg i+1's lower stop held, bit 4+i its upper,
+                                 bit 8+i its stop clamped (pushing no more) */
 } pkm_state;
 
 PKM_API pkm_status pkm_get_state(const pkm_model* m, pkm_state* state);
 /** Restores a state taken by pkm_get_state (of a model with the same
- * parameters); refused, nothing changed, beyond the guards or the speed
- * limit, or with a contact the pose does not have. */
+ * parameters), in this handle or another; a run continues from it bit for
+ * bit. Refused, nothing changed, beyond the guards or the speed limit, with
+ * a theta1 reference that is not the pose's, or a contact mode that names no
+ * stop. */
 PKM_API pkm_status pkm_set_state(pkm_model* m, const pkm_state* state);
 
 /* ---- Inverse dynamics ---- */
