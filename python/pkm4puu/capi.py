@@ -96,17 +96,34 @@ def to_python(lib, struct):
     as numpy arrays (copies), numbers as float or int."""
     ffi = lib.ffi
     out = {}
-    for name, field in ffi.typeof(struct[0]).fields:
-        if name == "size":
-            continue
-        value = getattr(struct, name)
-        if field.type.kind == "array":
-            out[name] = np.array(list(value), dtype=float if field.type.item.cname == "double" else np.int64)
-        elif field.type.kind == "pointer" and field.type.item.cname == "char":
+    for name, kind in _fields(ffi, ffi.typeof(struct[0])):
+        if kind == "double[]":
+            out[name] = np.frombuffer(ffi.buffer(getattr(struct, name)), dtype=float).copy()
+        elif kind == "array":
+            out[name] = np.array(list(getattr(struct, name)), dtype=np.int64)
+        elif kind == "string":
+            value = getattr(struct, name)
             out[name] = ffi.string(value).decode() if value != ffi.NULL else None
         else:
-            out[name] = value
+            out[name] = getattr(struct, name)
     return out
+
+
+@lru_cache(maxsize=None)
+def _fields(ffi, ctype):
+    """[(field, kind)] of a struct type but its size field: how to_python reads each."""
+    kinds = []
+    for name, field in ctype.fields:
+        t = field.type
+        if name == "size":
+            continue
+        if t.kind == "array":
+            kinds.append((name, "double[]" if t.item.cname == "double" else "array"))
+        elif t.kind == "pointer" and t.item.cname == "char":
+            kinds.append((name, "string"))
+        else:
+            kinds.append((name, "number"))
+    return kinds
 
 
 def _namespace(fields):
