@@ -14,7 +14,7 @@ install(TARGETS pkm pkm_static EXPORT pkm4puuTargets
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} NAMELINK_COMPONENT Development
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT Development)
-install(FILES "${PROJECT_SOURCE_DIR}/src/pkm4puu/pkm.h" "${PROJECT_BINARY_DIR}/include/pkm4puu/version.h"
+install(FILES "${PROJECT_SOURCE_DIR}/include/pkm4puu/pkm.h" "${PROJECT_BINARY_DIR}/include/pkm4puu/version.h"
         DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/pkm4puu" COMPONENT Development)
 install(EXPORT pkm4puuTargets NAMESPACE pkm4puu:: DESTINATION "${PKM_INSTALL_CMAKEDIR}" COMPONENT Development)
 configure_package_config_file("${CMAKE_CURRENT_LIST_DIR}/pkm4puuConfig.cmake.in"
@@ -58,13 +58,19 @@ install(FILES "${PKM_LICENSES_DIR}/SUNDIALS.txt" "${PKM_LICENSES_DIR}/Eigen.txt"
 # The Python wheel (PKM_WHEEL, set by pyproject.toml): component Wheel, with
 # destinations relative to the wheel's platlib, inside the package pkm4puu
 # that scikit-build-core copies there from python/: libpkm as
-# pkm4puu/lib/libpkm.so (one file, the name pkm4puu.locate.LIBRARY; ctypes
-# opens it by path), the host's FMU archives as pkm4puu/fmus/fmi2|fmi3/, and
+# pkm4puu/lib/libpkm.so (pkm.dll, libpkm.dylib: one file, the name
+# pkm4puu.locate.LIBRARY; cffi opens it by path) with pkm_cdef.h beside it
+# (pkm.h as the binding reads it), the host's FMU archives as pkm4puu/fmus/fmi2|fmi3/, and
 # the notices of what libpkm links as pkm4puu/licenses/ (the project's
 # LICENSE goes into the wheel's .dist-info; each FMU carries its own). The
 # target pkm_wheel builds only these (pyproject.toml's build.targets).
 if(PKM_WHEEL)
-  install(FILES "$<TARGET_FILE:pkm>" DESTINATION pkm4puu/lib RENAME libpkm.so COMPONENT Wheel)
+  set(_pkm_wheel_library "${CMAKE_SHARED_LIBRARY_PREFIX}pkm${CMAKE_SHARED_LIBRARY_SUFFIX}")
+  if(WIN32)
+    set(_pkm_wheel_library pkm.dll)
+  endif()
+  install(FILES "$<TARGET_FILE:pkm>" DESTINATION pkm4puu/lib RENAME "${_pkm_wheel_library}" COMPONENT Wheel)
+  install(FILES "${PROJECT_BINARY_DIR}/lib/pkm_cdef.h" DESTINATION pkm4puu/lib COMPONENT Wheel)
   install(FILES "${PKM_LICENSES_DIR}/SUNDIALS.txt" "${PKM_LICENSES_DIR}/Eigen.txt"
           DESTINATION pkm4puu/licenses COMPONENT Wheel)
   add_custom_target(pkm_wheel DEPENDS pkm)

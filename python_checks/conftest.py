@@ -28,7 +28,7 @@ def pytest_configure(config):
 os.environ[locate.BUILD_ENV] = str(Path(os.environ.get(locate.BUILD_ENV) or REPO / "build").resolve())
 BUILD = locate.build_dir()
 # The C API's header, whose structs capi's binding must match.
-PKM_HEADER = REPO / "src" / "pkm4puu" / "pkm.h"
+PKM_HEADER = REPO / "include" / "pkm4puu" / "pkm.h"
 
 
 def _require_fmu(name: str) -> Path:

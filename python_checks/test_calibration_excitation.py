@@ -41,7 +41,7 @@ def test_the_trajectory_holds_its_limits_at_every_sample(run, pkm_library):
             pose, vel, acc = ([run[n][k] for n in names] for names in (("x", "y", "z", "phi"),
                                                                         ("dx", "dy", "dz", "dphi"),
                                                                         ("ddx", "ddy", "ddz", "ddphi")))
-            F = np.array(p.inverse_dynamics_machine(pose, vel, acc).F)
+            F = p.inverse_dynamics(pose, vel, acc).F
             assert np.abs(F).max() <= 20.0, (k, F)
 
 

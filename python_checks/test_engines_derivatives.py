@@ -111,7 +111,7 @@ def capi_derivatives(pkm_library):
     lib = pkm_capi.load(pkm_library)
     out = {}
     for case, machine in CASES.items():
-        with pkm_capi.Plant(lib, machine=machine) as m:
+        with pkm_capi.Plant(lib, **(machine or {})) as m:
             out[case] = {name: m.forward_derivatives(y_of(s), U) for name, s in STATES.items()}
     return out
 
@@ -214,7 +214,7 @@ def test_inverse_derivatives_invert_pinocchio_forward_ones(pkm_library, pinocchi
     lib = pkm_capi.load(pkm_library)
     g = gear(CASES[case])
     worst = 0.0
-    with pkm_capi.Plant(lib, machine=CASES[case]) as m:
+    with pkm_capi.Plant(lib, **(CASES[case] or {})) as m:
         for name, (pose, rate) in STATES.items():
             ydot, A, B = ref[name]
             F, dF = m.inverse_derivatives(pose, rate, ydot[4:], U[4:8])

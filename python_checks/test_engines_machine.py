@@ -14,11 +14,11 @@ The runners and the machine's numbers are in engine_comparison.py
 - Gravity is off (the comparison test) except where a payload's weight is to
   be tested: then the forces are Pinocchio's holding forces at P0 plus the
   sine, and in the all-terms case the C API gets the sine as motor torques
-  (2 pi / p) tau (pkm_advance_fn_drives).
+  (2 pi / p) tau (pkm_advance_fn's inputs).
 - Every term must change the motion (by 1e3 times the bound), and the motion
   must stay clear of the end stops (left at their defaults), so that they are
   not part of the test.
-- This model (C API, pkm_create_machine, CVODE rtol 1e-12 and RK4 1 ms, the
+- This model (C API, the machine parameters set by name, CVODE rtol 1e-12 and RK4 1 ms, the
   exact forces at the integrator's own times) within the ideal machine's
   bounds, 1e-10 m and 1e-9 rad, inside the issue's 1e-8 m.
 - MuJoCo (joint armature and damping, a payload body, Coulomb friction through
@@ -26,7 +26,7 @@ The runners and the machine's numbers are in engine_comparison.py
   1e-8 m and 1e-7 rad (1e-8 m over the spec's 0.1 m lever for phi), its own
   ||C(q)|| within 1e-9 m as in the ideal run.
 - Inverse dynamics with every term along the auto-test (gravity on):
-  pkm_inverse_dynamics_machine's F, tau and lambda against Pinocchio's RNEA
+  pkm_inverse_dynamics's F, tau and lambda against Pinocchio's RNEA
   (armature and payload in the model) with the friction forces, within
   1e-9 N (1e-9 N * p / (2 pi) for tau); the holding forces F_hold likewise.
 """
@@ -189,7 +189,7 @@ def test_inverse_machine_matches_pinocchio(inverse_capi, inverse_pinocchio):
     dF = np.abs(inverse_capi["F"] - F_pin)
     k = np.unravel_index(dF.argmax(), dF.shape)
     dlam = np.abs(inverse_capi["lambda"] - lam_pin).max()
-    print(f"\npkm_inverse_dynamics_machine vs Pinocchio: max |dF| {dF.max():.3e} N (t = {AUTOTEST_TIMES[k[0]]:.3f} s, "
+    print(f"\npkm_inverse_dynamics vs Pinocchio: max |dF| {dF.max():.3e} N (t = {AUTOTEST_TIMES[k[0]]:.3f} s, "
           f"F{k[1] + 1}), max |d lambda| {dlam:.3e} N")
     assert dF.max() <= TOL_MACHINE_ID
     assert dlam <= TOL_MACHINE_ID
@@ -206,11 +206,11 @@ def test_inverse_machine_motor_torques(inverse_capi, inverse_pinocchio):
 
 @pytest.mark.parametrize("pose", [spec.P0, spec.P1], ids=["P0", "P1"])
 def test_holding_forces_match_pinocchio(lib, pose):
-    """F_hold (pkm_get_machine_outputs) at rest against Pinocchio's static inverse dynamics with the payload."""
+    """F_hold (pkm_get_outputs) at rest against Pinocchio's static inverse dynamics with the payload."""
     F_pin = PinocchioPKM(g=spec.G, machine=FULL).inverse_dynamics(pose, np.zeros(4), np.zeros(4))[0]
-    with pkm_capi.Plant(lib, machine=FULL.capi_params()) as m:
+    with pkm_capi.Plant(lib, **FULL.parameters()) as m:
         m.init_pose(0.0, pose)
-        F_hold = np.array(m.machine_outputs().F_hold)
+        F_hold = m.outputs().F_hold
     d = np.abs(F_hold - F_pin).max()
     print(f"\nF_hold vs Pinocchio: {d:.3e} N")
     assert d <= TOL_MACHINE_ID

@@ -16,9 +16,7 @@ a trustworthy second implementation:
 - MuJoCo's model is the same mechanism: the same sites, mass matrix and bias
   forces as Pinocchio's tree;
 - Pinocchio's own constraintDynamics gives the same accelerations as the
-  KKT solve used for the reference;
-- and the ctypes binding of this project's C API (engines/pkm_capi.py) has
-  pkm.h's struct layouts.
+  KKT solve used for the reference.
 """
 import math
 
@@ -160,15 +158,6 @@ def test_kkt_equals_pinocchio_constraint_dynamics():
         assert np.abs(a_kkt - a_pin).max() <= 1e-10 * np.abs(a_kkt).max()
         # the accelerations keep the constraints: J a + gamma = 0
         assert np.abs(pm.jacobian(q) @ a_kkt + pm.bias(q, v)).max() < 1e-12
-
-
-def test_capi_binding_matches_pkm_h(pkm_header):
-    """pkm4puu.capi's ctypes structs against the C API's header pkm.h: the
-    same fields at the same offsets (fields appended to pkm.h later must fit
-    in the binding's reserve)."""
-    from pkm4puu import capi as pkm_capi
-    bad = pkm_capi.binding_mismatches(pkm_header)
-    assert not bad, "\n".join(bad)
 
 
 # --- the machine around the mechanism in the engine models (docs/model.md) --------------------------------------

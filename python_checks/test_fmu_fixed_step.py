@@ -149,31 +149,32 @@ def test_sweep_over_the_declared_ranges(plant_fmu, capfd):
 
 
 def test_c_api_has_the_rosenbrock_solver_and_the_step_checks(pkm_library):
-    """Through the C API (ctypes): solver = 2 with friction_viscous = 1000
+    """Through the C API: solver = 2 with friction_viscous = 1000
     agrees with CVODE within the ROS2 bound at every 1 ms step, and the step
     checks are set, read back and range-checked."""
     from pkm4puu import capi
 
     lib = capi.load(pkm_library)
     dz = {}
-    for solver, settings in ((capi.PKM_SOLVER_CVODE, {"rtol": 1e-10, "atol": 1e-12, "cvode_method": 1}),
-                             (capi.PKM_SOLVER_ROSENBROCK, {})):
-        with capi.Plant(lib, machine={"friction_viscous": 1000.0}) as m:
+    for solver, settings in ((lib.PKM_SOLVER_CVODE, {"rtol": 1e-10, "atol": 1e-12, "cvode_method": 1}),
+                             (lib.PKM_SOLVER_ROSENBROCK, {})):
+        with capi.Plant(lib, friction_viscous=1000.0) as m:
             m.set_solver(solver=solver, **settings)
             m.init_pose(0.0, [0.0, 0.0, 0.05, 0.0])
             rows = []
             for k in range(1, 41):
-                m.advance(k * H, [0.0] * 4)
-                rows.append(m.outputs([0.0] * 4).velocity[2])
+                m.advance(k * H)
+                rows.append(m.outputs().velocity[2])
             dz[solver] = np.array(rows)
-    ref = dz[capi.PKM_SOLVER_CVODE]
-    worst = np.abs(dz[capi.PKM_SOLVER_ROSENBROCK] - ref).max() / np.abs(ref).max()
+    ref = dz[lib.PKM_SOLVER_CVODE]
+    worst = np.abs(dz[lib.PKM_SOLVER_ROSENBROCK] - ref).max() / np.abs(ref).max()
     print(f"\nC API, friction_viscous 1000: ROS2 within {worst:.2g} of max |dz| of CVODE")
     assert worst <= BOUND[2]
     with capi.Plant(lib) as m:
-        assert m.step_checks() == (1000.0, 0.0)
-        m.set_step_checks(50.0, 1e-6)
-        assert m.step_checks() == (50.0, 1e-6)
+        checks = ("work_budget", "energy_tolerance")
+        assert [m.get(n) for n in checks] == [1000.0, 0.0]
+        m.set_solver(work_budget=50.0, energy_tolerance=1e-6)
+        assert [m.get(n) for n in checks] == [50.0, 1e-6]
         with pytest.raises(capi.PkmError, match="work_budget"):
-            m.set_step_checks(0.0, 0.0)
-        assert m.step_checks() == (50.0, 1e-6), "a refused setting changes nothing"
+            m.set_solver(work_budget=0.0, energy_tolerance=0.0)
+        assert [m.get(n) for n in checks] == [50.0, 1e-6], "a refused setting changes nothing"

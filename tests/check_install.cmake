@@ -43,7 +43,7 @@ foreach(f IN LISTS expected)
 endforeach()
 file(GLOB sonames "${prefix}/lib/libpkm.so.*")
 list(LENGTH sonames n)
-if(n LESS 2)  # libpkm.so.0 -> libpkm.so.X.Y.Z
+if(n LESS 2)  # libpkm.so.<ABI> -> libpkm.so.<ABI>.0.0 (pkm.h's PKM_ABI_VERSION)
   message(FATAL_ERROR "libpkm without its SOVERSION link: ${sonames}")
 endif()
 set(variants shared "-DUSE_STATIC=OFF" static "-DUSE_STATIC=ON")

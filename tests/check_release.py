@@ -7,7 +7,8 @@ program) writes a release folder, and this checks it:
    and the check catches a changed byte and a missing file;
 2. the contents: the four FMUs (this build's archives byte for byte, their
    model descriptions at the project's version), the installed C package
-   (pkm.h, libpkm shared with its SOVERSION links and static, the CMake and
+   (pkm.h, libpkm shared with its SOVERSION link (pkm.h's PKM_ABI_VERSION)
+   and static, the CMake and
    pkg-config packages, the FMUs, the licences), the sdist (PKG-INFO at the
    version, the sources, no build tree), LICENSE, CHANGELOG.md, the manifest
    (saying whether the FMUs are merged or the host's);
@@ -104,16 +105,18 @@ def check_contents(folder, args):
     top = c_pkgs[0].name[: -len(".tar.gz")]
     with tarfile.open(c_pkgs[0]) as t:
         members = {m.name: m for m in t.getmembers()}
-        need = ["include/pkm4puu/pkm.h", "include/pkm4puu/version.h", "lib/libpkm.a", f"lib/libpkm.so.{v}",
+        header = (Path(args.source) / "include" / "pkm4puu" / "pkm.h").read_text()
+        abi = re.search(r"^#define PKM_ABI_VERSION (\d+)$", header, re.M).group(1)
+        need = ["include/pkm4puu/pkm.h", "include/pkm4puu/version.h", "lib/libpkm.a", f"lib/libpkm.so.{abi}.0.0",
                 "lib/cmake/pkm4puu/pkm4puuConfig.cmake", "lib/cmake/pkm4puu/pkm4puuConfigVersion.cmake",
                 "lib/pkgconfig/pkm4puu.pc", "share/doc/pkm4puu/LICENSE"]
         need += [f"share/pkm4puu/fmi{fmi}/{m}.fmu" for fmi in (2, 3) for m in MODELS]
         missing = [n for n in need if f"{top}/{n}" not in members]
         if missing:
             fail(f"{c_pkgs[0].name} lacks {missing}")
-        so0 = members.get(f"{top}/lib/libpkm.so.0")
-        if so0 is None or not so0.issym() or so0.linkname != f"libpkm.so.{v}":
-            fail(f"{c_pkgs[0].name}: lib/libpkm.so.0 is not the SOVERSION link to libpkm.so.{v}")
+        so = members.get(f"{top}/lib/libpkm.so.{abi}")
+        if so is None or not so.issym() or so.linkname != f"libpkm.so.{abi}.0.0":
+            fail(f"{c_pkgs[0].name}: lib/libpkm.so.{abi} is not the SOVERSION link to libpkm.so.{abi}.0.0")
         for fmi in (2, 3):
             for m in MODELS:
                 data = t.extractfile(members[f"{top}/share/pkm4puu/fmi{fmi}/{m}.fmu"]).read()
@@ -130,7 +133,7 @@ def check_contents(folder, args):
         pkg_info = t.extractfile(f"pkm4puu-{v}/PKG-INFO").read().decode()
     if not re.search(rf"^Version: {re.escape(v)}$", pkg_info, re.M):
         fail(f"the sdist's PKG-INFO is not at version {v}")
-    for n in ("pyproject.toml", "CMakeLists.txt", "src/pkm4puu/pkm.h", "python/pkm4puu/__init__.py", "LICENSE"):
+    for n in ("pyproject.toml", "CMakeLists.txt", "include/pkm4puu/pkm.h", "python/pkm4puu/__init__.py", "LICENSE"):
         if f"pkm4puu-{v}/{n}" not in names:
             fail(f"the sdist lacks {n}")
     stray = sorted(n for n in names if re.match(rf"pkm4puu-{re.escape(v)}/(build|\.venv|results)(/|$)", n))

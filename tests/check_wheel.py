@@ -5,9 +5,10 @@
   check_wheel.py --source REPO --work DIR --version X.Y.Z
 
 1. `pip wheel REPO --no-deps`, CMake's build tree cached in DIR/cmake (a
-   second run is incremental); the wheel holds the package, libpkm, the
-   FMI 2.0 and 3.0 archives, the notices, py.typed, the console command,
-   and nothing else (no headers, static library or CMake package);
+   second run is incremental); the wheel holds the package, libpkm with
+   pkm_cdef.h (pkm.h as the binding reads it), the FMI 2.0 and 3.0
+   archives, the notices, py.typed, the console command, and nothing else
+   (no other header, static library or CMake package);
 2. `auditwheel show`, then `auditwheel repair`, which must tag it
    manylinux (auditwheel in a tools venv cached in DIR/tools);
 3. the repaired wheel is left in DIR/dist (the only one there), where
@@ -66,6 +67,7 @@ def check_contents(wheel, version):
         entry_points = next((z.read(n).decode() for n in names if n.endswith(".dist-info/entry_points.txt")), "")
     dist_info = f"pkm4puu-{version}.dist-info/"
     wanted = {"pkm4puu/__init__.py", "pkm4puu/__main__.py", "pkm4puu/py.typed", "pkm4puu/lib/libpkm.so",
+              "pkm4puu/lib/pkm_cdef.h",
               "pkm4puu/licenses/SUNDIALS.txt", "pkm4puu/licenses/Eigen.txt", "pkm4puu/cli/autotest.py",
               dist_info + "METADATA"}
     wanted |= {f"pkm4puu/fmus/fmi{v}/{m}.fmu" for v in (2, 3) for m in MODELS}
@@ -74,7 +76,7 @@ def check_contents(wheel, version):
     if not any(re.fullmatch(re.escape(dist_info) + r"(licenses/)?LICENSE", n) for n in names):
         fail(f"{wheel.name}: no LICENSE in {dist_info}")
     stray = sorted(n for n in names if not n.startswith(("pkm4puu/", dist_info)) or "__pycache__" in n
-                   or n.endswith((".a", ".h", ".cmake", ".pc")))
+                   or (n.endswith((".a", ".h", ".cmake", ".pc")) and n != "pkm4puu/lib/pkm_cdef.h"))
     if stray:
         fail(f"{wheel.name} holds what the wheel does not need: {stray[:10]}")
     if not re.search(r"^pkm4puu = pkm4puu\.cli:main$", entry_points, re.M):

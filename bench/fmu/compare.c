@@ -123,19 +123,16 @@ static void fill_force_table(void) {
   }
 }
 
-static void input_callback(void* user, double t, double F[4], double wrench[4]) {
+static void input_callback(void* user, double t, double F[PKM_PLANT_INPUTS]) {
   const double u = t / (0.5 * STEP);
   const long j = lround(u);
   (void)user;
   if (j >= 0 && j < TABLE_SIZE && fabs(u - (double)j) < 1e-9) {
     F[0] = force_table[j];
-    F[1] = 0.0;
-    F[2] = 0.0;
     F[3] = -force_table[j];
   } else {
     forces(t, F);
   }
-  wrench[0] = wrench[1] = wrench[2] = wrench[3] = 0.0;
 }
 
 #define PKM_CHECK(call)                                                                              \
@@ -149,34 +146,37 @@ static void input_callback(void* user, double t, double F[4], double wrench[4]) 
     }                                                                                                \
   } while (0)
 
+/* The solver settings of a run, as parameters (pkm_set_parameters). */
+typedef struct {
+  double solver, rk4_step, rtol, atol;
+} Settings;
+
 /* one_call: the timed second is a single pkm_advance_fn(t_end = 1 s) (the
  * integrator's own steps, no stop at every millisecond) instead of 1000 calls. */
-static int run_capi(const pkm_solver_settings* settings, int one_call, int batches, const char* out_dir,
-                    Result* res) {
-  pkm_params p;
+static int run_capi(const Settings* settings, int one_call, int batches, const char* out_dir, Result* res) {
+  static const char* const names[] = {"g", "solver", "rk4_step", "rtol", "atol"};
+  const double values[] = {0.0, settings->solver, settings->rk4_step, settings->rtol, settings->atol};
   pkm_model* m = NULL;
-  char err[256];
-  double per[MAX_BATCHES], y[8], t, F[4];
-  pkm_outputs o;
+  double per[MAX_BATCHES], u[PKM_PLANT_INPUTS] = {0.0};
+  pkm_outputs o = {.size = sizeof(pkm_outputs)};
+  pkm_state s = {.size = sizeof(pkm_state)};
   int b, k;
-  pkm_default_params(&p);
-  p.g = 0.0;
-  if (pkm_create(&p, &m, err, sizeof err) != PKM_OK) {
-    fprintf(stderr, NAME ": pkm_create: %s\n", err);
+  if (pkm_create(&m) != PKM_OK) {
+    fprintf(stderr, NAME ": pkm_create failed\n");
     return 0;
   }
-  PKM_CHECK(pkm_set_solver(m, settings));
+  PKM_CHECK(pkm_set_parameters(m, 5, names, values));
   for (b = -1; b < batches; ++b) {
     double t0;
     PKM_CHECK(pkm_init_pose(m, 0.0, P0, NULL));
     t0 = now_seconds();
     if (one_call) {
       PKM_CHECK(pkm_advance_fn(m, (double)STEPS_TIMED * STEP, input_callback, NULL, 1));
-      PKM_CHECK(pkm_get_state(m, &t, y, NULL));
+      PKM_CHECK(pkm_get_state(m, &s));
     } else {
       for (k = 0; k < STEPS_TIMED; ++k) {
         PKM_CHECK(pkm_advance_fn(m, (double)(k + 1) * STEP, input_callback, NULL, 1));
-        PKM_CHECK(pkm_get_state(m, &t, y, NULL));
+        PKM_CHECK(pkm_get_state(m, &s));
       }
     }
     if (b >= 0) per[b] = now_seconds() - t0;
@@ -191,8 +191,8 @@ static int run_capi(const pkm_solver_settings* settings, int one_call, int batch
     int n_rows = 0;
     for (k = 0; k <= STEPS_TEST; k += stride, ++n_rows) {
       if (k > 0) PKM_CHECK(pkm_advance_fn(m, (double)k * STEP, input_callback, NULL, 1));
-      forces((double)k * STEP, F);
-      PKM_CHECK(pkm_get_outputs(m, F, NULL, &o));
+      forces((double)k * STEP, u);
+      PKM_CHECK(pkm_get_outputs(m, u, &o));
       rows[n_rows].v[0] = (double)k * STEP;
       memcpy(&rows[n_rows].v[1], o.pose, sizeof o.pose);
       rows[n_rows].v[5] = o.rho[0];
@@ -295,20 +295,15 @@ static int compare_run(const Plant* plant, const Options* o) {
   int i, ok, n = 0;
   Result results[9];
   Fmi md;
-  pkm_solver_settings rk4, cvode, cvode_tight;
+  /* RK4 at the 1 ms step; CVODE Adams at the default rtol 1e-8, atol 1e-10, and tight */
+  const Settings rk4 = {PKM_SOLVER_RK4, STEP, 1e-8, 1e-10}, cvode = {PKM_SOLVER_CVODE, STEP, 1e-8, 1e-10},
+                 cvode_tight = {PKM_SOLVER_CVODE, STEP, 1e-12, 1e-14};
 
   ok = lookup_value_reference(plant->text, "rho[1]", &md.rho1) &&
        lookup_value_reference(plant->text, "constraint_residual", &md.residual) &&
        lookup_value_references(plant, setting_names, 3, md.settings);
   if (!ok) return 0;
 
-  pkm_default_solver_settings(&rk4);
-  rk4.solver = PKM_SOLVER_RK4;
-  rk4.rk4_step = STEP;
-  pkm_default_solver_settings(&cvode); /* CVODE Adams, rtol 1e-8, atol 1e-10 */
-  cvode_tight = cvode;
-  cvode_tight.rtol = 1e-12;
-  cvode_tight.atol = 1e-14;
 
   printf("pkm_fmu_bench compare: one simulated second of the comparison test (docs/model.md; g = 0,\n"
          "F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s)) at a 1 ms step; median of %d batches after 1 warm-up\n",

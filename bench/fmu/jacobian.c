@@ -126,7 +126,6 @@ static int jacobian_run(const Plant* plant, const Options* o) {
   const Fmu* f = &plant->fmu;
   double per[N_CASES][BATCHES], med[N_CASES], mn[N_CASES], J[N_CASES][N_UNKNOWNS * N_KNOWNS], diff = 0.0,
          scale = 0.0, seconds = 0.0;
-  pkm_params params;
   pkm_model* m = NULL;
   fmi2Component c;
   int kind, b, i, ok = 1;
@@ -134,8 +133,7 @@ static int jacobian_run(const Plant* plant, const Options* o) {
   if (!lookup_value_references(plant, unknowns, N_UNKNOWNS, r.unknowns) ||
       !lookup_value_references(plant, knowns, N_KNOWNS, r.knowns))
     return 0;
-  pkm_default_params(&params);
-  if (pkm_create(&params, &m, NULL, 0) != PKM_OK) {
+  if (pkm_create(&m) != PKM_OK) {
     fprintf(stderr, PKM_HARNESS_NAME ": pkm_create failed\n");
     return 0;
   }

@@ -7,8 +7,8 @@
 
 The library: spec (docs/model.md's numbers and geometry), motions (the test
 motions), interface (variable names), locate (the build directory and the
-paths in it), fmu (the wrapper), capi (the C API's binding, pkm.h),
-linearization (the plant's Jacobians through Model Exchange), closed_loop
+paths in it), fmu (the wrapper), capi (the C API's binding, cffi reading
+pkm.h), linearization (the plant's Jacobians through Model Exchange), closed_loop
 (the sampled loop the control examples share), drawing (the mechanism's
 points, a run's CSV), plots (figures; matplotlib, the extra `plots`),
 program (what command-line programs over the FMUs share), extras (the

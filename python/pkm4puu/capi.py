@@ -1,218 +1,177 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""ctypes binding of this project's C API (pkm.h), for the engine
-comparisons. The library is locate.LIBRARY of the build directory when one
-is asked for (the `build` argument, else $PKM_BUILD_DIR), else the
-installed package's own (a wheel's), else ./build's: see locate::
+"""cffi binding of this project's C API (pkm.h), read from the header itself.
 
-    lib = load()                      # or load(path)
-    with Plant(lib) as m:             # spec defaults; Plant(lib, g=0.0) etc.
-        m.set_solver(solver=PKM_SOLVER_CVODE, rtol=1e-12, atol=1e-14)
+The build preprocesses include/pkm4puu/pkm.h into lib/pkm_cdef.h beside the
+library (locate.CDEF; a wheel ships both): cffi declares every function, enum
+and struct from it, so no field can go missing, and a struct's fields are read
+by name. The parameters are the FMUs' (same names, ranges and defaults), which
+the library lists (pkm_parameter_info); nothing here spells them out::
+
+    lib = load()                      # or load(path): libpkm of the build or the package (locate)
+    with Plant(lib, g=0.0, payload_mass=0.25) as m:   # the FMUs' parameter names
+        m.set_solver(solver=lib.PKM_SOLVER_CVODE, rtol=1e-12, atol=1e-14)
         m.init_pose(0.0, [0, 0, 0.05, 0])
         m.advance_fn(1.0, lambda t: (F, wrench))
-        out = m.outputs(F)
+        out = m.outputs(F)            # every field of pkm_outputs: out.pose, out.F_hold, ...
+
+An unknown keyword raises TypeError naming it and the known ones; a value
+the library refuses raises PkmError with its message.
 """
-import ctypes as ct
+from collections import namedtuple
+from functools import lru_cache
+from keyword import iskeyword
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
 from . import locate
 
-PKM_OK = 0
-PKM_SOLVER_CVODE, PKM_SOLVER_RK4, PKM_SOLVER_ROSENBROCK = 0, 1, 2
-PKM_CVODE_ADAMS, PKM_CVODE_BDF = 0, 1
-PKM_FORM_AUGMENTED, PKM_FORM_NULLSPACE_QR, PKM_FORM_LEG_PARTITIONED = 0, 1, 2
-# pkm_forward_derivatives: the state (x, y, z, phi, dx, dy, dz, dphi) and the
-# plant's inputs, in pkm.h's order (PKM_PLANT_INPUTS)
-PLANT_STATES = 8
-PLANT_INPUTS = 12  # F[1..4] (N), Fe[1..3] (N), Me_z (N m), tau[1..4] (N m)
-
-D4 = ct.c_double * 4
-# Every struct the library writes into ends in this reserve, so that fields
-# appended to a pkm.h struct later (filled by the library's own defaults:
-# pkm_default_params, pkm_default_solver_settings) cannot overrun the buffer;
-# the fields before it must be pkm.h's, in order (test_engines_models.py
-# checks them against the header).
-RESERVE = ("_reserved", ct.c_double * 64)
-
-
-class Params(ct.Structure):
-    _fields_ = [("h", ct.c_double), ("l", ct.c_double), ("h_prime", ct.c_double), ("r_b", ct.c_double),
-                ("r_Q", ct.c_double), ("beta", ct.c_double * 4), ("gamma", ct.c_double * 4),
-                ("m_slider", ct.c_double), ("m_rod", ct.c_double), ("I_rod", ct.c_double * 3),
-                ("m_platform", ct.c_double), ("Izz_platform", ct.c_double), ("g", ct.c_double), RESERVE]
-
-
-class SolverSettings(ct.Structure):
-    _fields_ = [("solver", ct.c_int), ("rk4_step", ct.c_double), ("rtol", ct.c_double), ("atol", ct.c_double),
-                ("cvode_method", ct.c_int), ("formulation", ct.c_int), RESERVE]
-
-
-class Outputs(ct.Structure):
-    _fields_ = [("t", ct.c_double), ("pose", ct.c_double * 4), ("velocity", ct.c_double * 4),
-                ("acceleration", ct.c_double * 4), ("rho", ct.c_double * 4), ("drho", ct.c_double * 4),
-                ("theta1", ct.c_double * 4), ("theta2", ct.c_double * 4), ("q", ct.c_double * 16),
-                ("qd", ct.c_double * 16), ("qdd", ct.c_double * 16), ("lambda_", ct.c_double * 12),
-                ("constraint_residual", ct.c_double), ("jacobian_condition", ct.c_double), RESERVE]
-
-
-class InverseResult(ct.Structure):
-    _fields_ = [("F", ct.c_double * 4), ("lambda_", ct.c_double * 12), ("q", ct.c_double * 16),
-                ("qd", ct.c_double * 16), ("qdd", ct.c_double * 16), RESERVE]
-
-
-class MachineParams(ct.Structure):
-    _fields_ = [("screw_lead", ct.c_double), ("rotor_inertia", ct.c_double), ("friction_viscous", ct.c_double),
-                ("friction_coulomb", ct.c_double), ("friction_velocity", ct.c_double), ("rho_min", ct.c_double),
-                ("rho_max", ct.c_double), ("stop_stiffness", ct.c_double), ("stop_damping", ct.c_double),
-                ("payload_mass", ct.c_double), ("payload_com", ct.c_double * 2), ("payload_Izz", ct.c_double),
-                RESERVE]
-
-
-class MachineOutputs(ct.Structure):
-    _fields_ = [("stop_force", ct.c_double * 4), ("friction_force", ct.c_double * 4), ("F_hold", ct.c_double * 4),
-                ("kinetic_energy", ct.c_double), ("potential_energy", ct.c_double), ("actuator_work", ct.c_double),
-                ("dissipated_energy", ct.c_double), ("stop_indicators", ct.c_double * 8), RESERVE]
-
-
-class InverseMachineResult(ct.Structure):
-    _fields_ = [("F", ct.c_double * 4), ("tau", ct.c_double * 4), ("lambda_", ct.c_double * 12),
-                ("beyond_stops", ct.c_uint), RESERVE]
-
-
-INPUT_FN = ct.CFUNCTYPE(None, ct.c_void_p, ct.c_double, ct.POINTER(ct.c_double), ct.POINTER(ct.c_double))
-TORQUE_FN = ct.CFUNCTYPE(None, ct.c_void_p, ct.c_double, ct.POINTER(ct.c_double))
-
 
 def library_path(build=None):
-    """libpkm.so: the asked-for build directory's, else the package's, else
+    """libpkm: the asked-for build directory's, else the package's, else
     ./build's (locate.library_path)."""
     return locate.library_path(build)
 
 
+def cdef_path(library):
+    """pkm.h as cffi reads it (lib/pkm_cdef.h), beside the library."""
+    return Path(library).with_name(Path(locate.CDEF).name)
+
+
+@lru_cache(maxsize=None)
+def _ffi(cdef):
+    import cffi
+    ffi = cffi.FFI()
+    ffi.cdef(Path(cdef).read_text())
+    return ffi
+
+
+# What pkm_parameter_info says of a parameter (its fields but the size).
+ParameterInfo = namedtuple("ParameterInfo", "name unit description start min max is_integer is_solver_setting "
+                                            "is_tunable fmus value_reference")
+
+
+class Library:
+    """libpkm loaded with its declarations: `c` holds the functions and enum
+    constants (lib.c.PKM_OK), `ffi` the types; `parameters` maps each
+    parameter's name to its ParameterInfo, in the library's order."""
+
+    def __init__(self, path):
+        self.path = Path(path)
+        cdef = cdef_path(self.path)
+        if not cdef.is_file():
+            raise FileNotFoundError(f"{cdef} does not exist: the build writes it beside {self.path.name} "
+                                    f"(target pkm)")
+        self.ffi = _ffi(str(cdef))
+        self.c = self.ffi.dlopen(str(self.path))
+        self.parameters = {}
+        info = self.new("pkm_parameter")
+        for i in range(self.c.pkm_parameter_count()):
+            if self.c.pkm_parameter_info(i, info) != self.c.PKM_OK:
+                raise PkmError(f"pkm_parameter_info({i}) failed")
+            fields = to_python(self, info)
+            self.parameters[fields["name"]] = ParameterInfo(**fields)
+
+    def new(self, struct):
+        """A zeroed pkm.h struct with its size field set."""
+        p = self.ffi.new(f"{struct}*")
+        p.size = self.ffi.sizeof(struct)
+        return p
+
+    def __getattr__(self, name):
+        # lib.PKM_SOLVER_RK4, lib.pkm_version(): the library's own names.
+        if name.startswith(("pkm_", "PKM_")) and "c" in self.__dict__:
+            return getattr(self.c, name)
+        raise AttributeError(name)
+
+
 def load(path=None):
-    """Loads libpkm.so and declares the signatures of pkm.h."""
-    lib = ct.CDLL(str(path or library_path()))
-    P, vp, dp, i = ct.POINTER, ct.c_void_p, ct.POINTER(ct.c_double), ct.c_int
-    lib.pkm_default_params.argtypes = [P(Params)]
-    lib.pkm_default_params.restype = None
-    lib.pkm_default_solver_settings.argtypes = [P(SolverSettings)]
-    lib.pkm_default_solver_settings.restype = None
-    lib.pkm_create.argtypes = [P(Params), P(vp), ct.c_char_p, ct.c_size_t]
-    lib.pkm_create.restype = i
-    lib.pkm_destroy.argtypes = [vp]
-    lib.pkm_destroy.restype = None
-    lib.pkm_last_error.argtypes = [vp]
-    lib.pkm_last_error.restype = ct.c_char_p
-    lib.pkm_set_solver.argtypes = [vp, P(SolverSettings)]
-    lib.pkm_set_solver.restype = i
-    lib.pkm_set_step_checks.argtypes = [vp, ct.c_double, ct.c_double]
-    lib.pkm_set_step_checks.restype = i
-    lib.pkm_get_step_checks.argtypes = [vp, dp, dp]
-    lib.pkm_get_step_checks.restype = i
-    lib.pkm_init_pose.argtypes = [vp, ct.c_double, dp, dp]
-    lib.pkm_init_pose.restype = i
-    lib.pkm_inverse_dynamics.argtypes = [vp, dp, dp, dp, dp, P(InverseResult)]
-    lib.pkm_inverse_dynamics.restype = i
-    lib.pkm_advance.argtypes = [vp, ct.c_double, dp, dp]
-    lib.pkm_advance.restype = i
-    lib.pkm_advance_fn.argtypes = [vp, ct.c_double, INPUT_FN, vp, i]
-    lib.pkm_advance_fn.restype = i
-    lib.pkm_get_outputs.argtypes = [vp, dp, dp, P(Outputs)]
-    lib.pkm_get_outputs.restype = i
-    lib.pkm_get_state.argtypes = [vp, dp, dp, dp]
-    lib.pkm_get_state.restype = i
-    lib.pkm_set_state.argtypes = [vp, ct.c_double, dp, dp]
-    lib.pkm_set_state.restype = i
-    # the machine around the mechanism
-    lib.pkm_default_machine_params.argtypes = [P(MachineParams)]
-    lib.pkm_default_machine_params.restype = None
-    lib.pkm_create_machine.argtypes = [P(Params), P(MachineParams), P(vp), ct.c_char_p, ct.c_size_t]
-    lib.pkm_create_machine.restype = i
-    lib.pkm_advance_fn_drives.argtypes = [vp, ct.c_double, INPUT_FN, TORQUE_FN, vp, i]
-    lib.pkm_advance_fn_drives.restype = i
-    lib.pkm_get_machine_outputs.argtypes = [vp, dp, dp, dp, P(MachineOutputs)]
-    lib.pkm_get_machine_outputs.restype = i
-    lib.pkm_inverse_dynamics_machine.argtypes = [vp, dp, dp, dp, dp, P(InverseMachineResult)]
-    lib.pkm_inverse_dynamics_machine.restype = i
-    # analytic derivatives
-    lib.pkm_forward_derivatives.argtypes = [vp, dp, dp, dp, dp, dp]
-    lib.pkm_forward_derivatives.restype = i
-    lib.pkm_inverse_derivatives.argtypes = [vp, dp, dp, dp, dp, dp, dp]
-    lib.pkm_inverse_derivatives.restype = i
-    # calibration: the regressor of the forces in the dynamic parameters
-    sz = ct.c_size_t
-    lib.pkm_regressor_param_count.argtypes = []
-    lib.pkm_regressor_param_count.restype = i
-    for f in (lib.pkm_regressor_param_name, lib.pkm_regressor_param_unit):
-        f.argtypes = [i]
-        f.restype = ct.c_char_p
-    lib.pkm_regressor_params.argtypes = [vp, dp]
-    lib.pkm_regressor_params.restype = i
-    lib.pkm_regressor.argtypes = [vp, dp, dp, dp, dp, dp, dp]
-    lib.pkm_regressor.restype = i
-    lib.pkm_regressor_poses.argtypes = [vp, sz, dp, dp, dp, dp, dp, dp, dp]
-    lib.pkm_regressor_poses.restype = i
-    lib.pkm_regressor_joints.argtypes = [vp, sz, dp, dp, dp, dp, dp, dp, dp, P(sz)]
-    lib.pkm_regressor_joints.restype = i
-    return lib
+    """libpkm (library_path() when no path is given) with its declarations."""
+    return Library(path or library_path())
+
+
+def to_python(lib, struct):
+    """{field: value} of a pkm.h struct but its size: strings as str, arrays
+    as numpy arrays (copies), numbers as float or int."""
+    ffi = lib.ffi
+    out = {}
+    for name, kind in _fields(ffi, ffi.typeof(struct[0])):
+        if kind == "double[]":
+            out[name] = np.frombuffer(ffi.buffer(getattr(struct, name)), dtype=float).copy()
+        elif kind == "array":
+            out[name] = np.array(list(getattr(struct, name)), dtype=np.int64)
+        elif kind == "string":
+            value = getattr(struct, name)
+            out[name] = ffi.string(value).decode() if value != ffi.NULL else None
+        else:
+            out[name] = getattr(struct, name)
+    return out
+
+
+@lru_cache(maxsize=None)
+def _fields(ffi, ctype):
+    """[(field, kind)] of a struct type but its size field: how to_python reads each."""
+    kinds = []
+    for name, field in ctype.fields:
+        t = field.type
+        if name == "size":
+            continue
+        if t.kind == "array":
+            kinds.append((name, "double[]" if t.item.cname == "double" else "array"))
+        elif t.kind == "pointer" and t.item.cname == "char":
+            kinds.append((name, "string"))
+        else:
+            kinds.append((name, "number"))
+    return kinds
+
+
+def _namespace(fields):
+    """Attributes for fields; a field named like a Python keyword gets a
+    trailing underscore (lambda -> lambda_)."""
+    return SimpleNamespace(**{(k + "_" if iskeyword(k) else k): v for k, v in fields.items()})
 
 
 def regressor_params(lib):
     """[(name, unit)] of the regressor's parameter vector pi (pkm.h's
     pkm_regressor_param_name/unit), in pi's order."""
-    return [(lib.pkm_regressor_param_name(j).decode(), lib.pkm_regressor_param_unit(j).decode())
-            for j in range(lib.pkm_regressor_param_count())]
-
-
-_DP = ct.POINTER(ct.c_double)
-
-
-def _d4(a):
-    return None if a is None else D4(*[float(v) for v in a])
+    c, ffi = lib.c, lib.ffi
+    return [(ffi.string(c.pkm_regressor_param_name(j)).decode(), ffi.string(c.pkm_regressor_param_unit(j)).decode())
+            for j in range(c.PKM_REGRESSOR_PARAMS)]
 
 
 class PkmError(RuntimeError):
-    pass
+    """A call that failed: the function, the status and the library's message."""
+
+    def __init__(self, message, status=None):
+        super().__init__(message)
+        self.status = status
 
 
 class Plant:
-    """One pkm_model handle. Keyword arguments override the default parameters
-    (pkm_default_params), e.g. Plant(lib, g=0.0). machine: a dict of
-    pkm_machine_params fields overriding pkm_default_machine_params (the
-    model is then made by pkm_create_machine), e.g. {"rotor_inertia": 1e-7}."""
+    """One pkm_model handle. Keyword arguments set parameters by the FMUs'
+    names (``Plant(lib, g=0.0, payload_mass=0.25)``); an array parameter
+    takes all its values (``beta=[...]``, ``payload_com=(x, y)``) or one
+    (``**{"beta[2]": 0.1}``)."""
 
-    def __init__(self, lib, machine=None, **params):
-        self.lib = lib
-        p = Params()
-        lib.pkm_default_params(ct.byref(p))
-        for k, v in params.items():
-            setattr(p, k, v)
-        self.params = p
-        self.handle = ct.c_void_p()
-        err = ct.create_string_buffer(256)
-        if machine is None:
-            s = lib.pkm_create(ct.byref(p), ct.byref(self.handle), err, 256)
-            what = "pkm_create"
-        else:
-            mp = MachineParams()
-            lib.pkm_default_machine_params(ct.byref(mp))
-            for k, v in machine.items():
-                if k == "payload_com":
-                    mp.payload_com[0], mp.payload_com[1] = v
-                else:
-                    setattr(mp, k, v)
-            self.machine = mp
-            s = lib.pkm_create_machine(ct.byref(p), ct.byref(mp), ct.byref(self.handle), err, 256)
-            what = "pkm_create_machine"
-        if s != PKM_OK:
-            raise PkmError(f"{what}: status {s}: {err.value.decode()}")
+    def __init__(self, lib, **params):
+        self.lib, self.c, self.ffi = lib, lib.c, lib.ffi
+        handle = self.ffi.new("pkm_model**")
+        s = self.c.pkm_create(handle)
+        if s != self.c.PKM_OK:
+            raise PkmError(f"pkm_create: {self._status(s)}", s)
+        self.handle = self.ffi.gc(handle[0], self.c.pkm_destroy)  # destroyed with the object, or by close()
         self._callback = None
+        try:
+            self.set(**params)
+        except Exception:
+            self.close()
+            raise
 
     def close(self):
-        if self.handle:
-            self.lib.pkm_destroy(self.handle)
-            self.handle = ct.c_void_p()
+        if self.handle is not None:
+            self.ffi.release(self.handle)
+            self.handle = None
 
     def __enter__(self):
         return self
@@ -221,141 +180,197 @@ class Plant:
         self.close()
         return False
 
+    def _status(self, s):
+        return self.ffi.string(self.c.pkm_status_string(s)).decode()
+
     def _check(self, s, what):
-        if s != PKM_OK:
-            raise PkmError(f"{what}: status {s}: {self.lib.pkm_last_error(self.handle).decode()}")
+        if s != self.c.PKM_OK:
+            raise PkmError(f"{what}: status {s}: {self.ffi.string(self.c.pkm_last_error(self.handle)).decode()}", s)
+
+    # ---- parameters
+    def _expand(self, params, allowed=None):
+        """[(FMU name, value)] of keyword arguments; TypeError for a name the
+        library (or `allowed`) does not know."""
+        known = self.lib.parameters if allowed is None else allowed
+        items = []
+        for key, value in params.items():
+            if key in known:
+                items.append((key, float(value)))
+                continue
+            elements = [n for n in known if n.startswith(key + "[")]
+            if elements and np.ndim(value) == 1 and len(value) == len(elements):
+                items += [(n, float(v)) for n, v in zip(elements, value)]
+                continue
+            if elements:
+                raise TypeError(f"{key} has {len(elements)} values ({', '.join(elements)}): give them all, "
+                                f"not {value!r}")
+            raise TypeError(f"unknown parameter {key!r}; the known ones: {', '.join(known)}")
+        return items
+
+    def set(self, **params):
+        """Sets parameters as one change (pkm_set_parameters: checked as a
+        set, all or nothing)."""
+        items = self._expand(params)
+        if not items:
+            return
+        names = [self.ffi.new("char[]", n.encode()) for n, _ in items]
+        s = self.c.pkm_set_parameters(self.handle, len(items), self.ffi.new("char*[]", names),
+                                      self.ffi.new("double[]", [v for _, v in items]))
+        self._check(s, "pkm_set_parameters")
 
     def set_solver(self, **settings):
-        s = SolverSettings()
-        self.lib.pkm_default_solver_settings(ct.byref(s))
-        for k, v in settings.items():
-            setattr(s, k, v)
-        self._check(self.lib.pkm_set_solver(self.handle, ct.byref(s)), "pkm_set_solver")
+        """Sets solver settings only (solver, rk4_step, rtol, atol,
+        cvode_method, formulation, the guards, work_budget,
+        energy_tolerance): they keep the run."""
+        solver = {n: i for n, i in self.lib.parameters.items() if i.is_solver_setting}
+        items = self._expand(settings, allowed=solver)
+        self.set(**dict(items))
 
-    def set_step_checks(self, work_budget=1000.0, energy_tolerance=0.0):
-        """The fixed-step solvers' work budget (inner steps per grid step) and
-        the energy audit's run-time check (J, 0 = off): docs/solvers.md."""
-        self._check(self.lib.pkm_set_step_checks(self.handle, work_budget, energy_tolerance), "pkm_set_step_checks")
+    def get(self, name):
+        """The value of parameter `name` (pkm_get_parameter)."""
+        if name not in self.lib.parameters:
+            raise TypeError(f"unknown parameter {name!r}; the known ones: {', '.join(self.lib.parameters)}")
+        v = self.ffi.new("double*")
+        self._check(self.c.pkm_get_parameter(self.handle, name.encode(), v), "pkm_get_parameter")
+        return v[0]
 
-    def step_checks(self):
-        """(work_budget, energy_tolerance)."""
-        b, e = ct.c_double(), ct.c_double()
-        self._check(self.lib.pkm_get_step_checks(self.handle, ct.byref(b), ct.byref(e)), "pkm_get_step_checks")
-        return b.value, e.value
+    def parameters(self):
+        """{name: value} of every parameter."""
+        return {n: self.get(n) for n in self.lib.parameters}
 
+    # ---- helpers
+    def _d4(self, a):
+        return self.ffi.NULL if a is None else self.ffi.new("double[4]", [float(v) for v in a])
+
+    def _inputs(self, F=None, wrench=None, tau=None):
+        """u[PKM_PLANT_INPUTS] = (F, wrench, tau), zero where None."""
+        u = np.zeros(self.c.PKM_PLANT_INPUTS)
+        for k, part in enumerate((F, wrench, tau)):
+            if part is not None:
+                u[4 * k:4 * k + 4] = part
+        return self.ffi.new("double[]", u.tolist())
+
+    def _doubles(self, a):
+        return self.ffi.from_buffer("double[]", a)
+
+    # ---- forward dynamics
     def init_pose(self, t0, pose, velocity=None):
-        self._check(self.lib.pkm_init_pose(self.handle, t0, _d4(pose), _d4(velocity)), "pkm_init_pose")
+        self._check(self.c.pkm_init_pose(self.handle, t0, self._d4(pose), self._d4(velocity)), "pkm_init_pose")
 
-    def inverse_dynamics(self, pose, velocity, acceleration, wrench=None):
-        r = InverseResult()
-        self._check(self.lib.pkm_inverse_dynamics(self.handle, _d4(pose), _d4(velocity), _d4(acceleration),
-                                                  _d4(wrench), ct.byref(r)), "pkm_inverse_dynamics")
-        return r
+    def advance(self, t_end, F=None, wrench=None, tau=None):
+        """Forward dynamics to t_end with constant inputs (pkm_advance)."""
+        self._check(self.c.pkm_advance(self.handle, t_end, self._inputs(F, wrench, tau)), "pkm_advance")
 
-    def advance(self, t_end, F=None, wrench=None):
-        self._check(self.lib.pkm_advance(self.handle, t_end, _d4(F), _d4(wrench)), "pkm_advance")
+    def advance_fn(self, t_end, inputs, torques=None, continuous=True):
+        """Forward dynamics to t_end with inputs(t) -> F[4] (N), or (F,
+        wrench); torques(t) -> tau[4] (N m) if given: both evaluated at the
+        integrator's own times (pkm_advance_fn)."""
 
-    @staticmethod
-    def _input_callback(inputs):
-        """The C callback that writes inputs(t) -> F[4], or (F, wrench), into the C arrays."""
-
-        def cb(_user, t, F, w):
+        def cb(_user, t, u):
             r = inputs(t)
             f, wr = (r if isinstance(r, tuple) else (r, None))
             for k in range(4):
-                F[k] = f[k]
+                u[k] = f[k]
             if wr is not None:
                 for k in range(4):
-                    w[k] = wr[k]
+                    u[4 + k] = wr[k]
+            if torques is not None:
+                tq = torques(t)
+                for k in range(4):
+                    u[8 + k] = tq[k]
 
-        return cb
-
-    def advance_fn(self, t_end, inputs, continuous=True):
-        """inputs(t) -> F[4] (N), or (F, wrench); evaluated at the integrator's own times."""
-
-        self._callback = INPUT_FN(self._input_callback(inputs))  # kept alive for the call
-        self._check(self.lib.pkm_advance_fn(self.handle, t_end, self._callback, None, int(continuous)),
+        self._callback = self.ffi.callback("pkm_input_fn", cb)  # kept alive for the call
+        self._check(self.c.pkm_advance_fn(self.handle, t_end, self._callback, self.ffi.NULL, int(continuous)),
                     "pkm_advance_fn")
 
-    def advance_fn_drives(self, t_end, inputs, torques, continuous=True):
-        """inputs(t) -> F[4] (N), or (F, wrench); torques(t) -> tau[4] (N m);
-        both evaluated at the integrator's own times (pkm_advance_fn_drives)."""
+    def outputs(self, F=None, wrench=None, tau=None):
+        """Every field of pkm_outputs at the current time for these inputs."""
+        o = self.lib.new("pkm_outputs")
+        self._check(self.c.pkm_get_outputs(self.handle, self._inputs(F, wrench, tau), o), "pkm_get_outputs")
+        return _namespace(to_python(self.lib, o))
 
-        cb = self._input_callback(inputs)
+    def state(self):
+        """The run's state (pkm_state) for set_state."""
+        s = self.lib.new("pkm_state")
+        self._check(self.c.pkm_get_state(self.handle, s), "pkm_get_state")
+        return s
 
-        def cb_tau(_user, t, tau):
-            r = torques(t)
-            for k in range(4):
-                tau[k] = r[k]
+    def set_state(self, state):
+        self._check(self.c.pkm_set_state(self.handle, state), "pkm_set_state")
 
-        self._callback = (INPUT_FN(cb), TORQUE_FN(cb_tau))  # kept alive for the call
-        self._check(self.lib.pkm_advance_fn_drives(self.handle, t_end, self._callback[0], self._callback[1], None,
-                                                   int(continuous)), "pkm_advance_fn_drives")
+    # ---- inverse dynamics
+    def inverse_dynamics(self, pose, velocity, acceleration, wrench=None):
+        """Every field of pkm_inverse_result: F, tau, ``lambda_``, q, qd, qdd, beyond_stops."""
+        r = self.lib.new("pkm_inverse_result")
+        self._check(self.c.pkm_inverse_dynamics(self.handle, self._d4(pose), self._d4(velocity),
+                                                self._d4(acceleration), self._d4(wrench), r), "pkm_inverse_dynamics")
+        return _namespace(to_python(self.lib, r))
 
-    def machine_outputs(self, F=None, tau=None, wrench=None):
-        o = MachineOutputs()
-        self._check(self.lib.pkm_get_machine_outputs(self.handle, _d4(F), _d4(tau), _d4(wrench), ct.byref(o)),
-                    "pkm_get_machine_outputs")
-        return o
-
-    def inverse_dynamics_machine(self, pose, velocity, acceleration, wrench=None):
-        r = InverseMachineResult()
-        self._check(self.lib.pkm_inverse_dynamics_machine(self.handle, _d4(pose), _d4(velocity), _d4(acceleration),
-                                                          _d4(wrench), ct.byref(r)), "pkm_inverse_dynamics_machine")
-        return r
-
+    # ---- derivatives
     def forward_derivatives(self, state, inputs=None):
         """pkm_forward_derivatives: (ydot (8,), A (8, 8), B (8, 12)) of the
         reduced forward dynamics at state (x, y, z, phi, dx, dy, dz, dphi) and
-        inputs (PLANT_INPUTS order; None: zero), as numpy arrays."""
+        inputs (PKM_PLANT_INPUTS order; None: zero), as numpy arrays."""
+        n_u = self.c.PKM_PLANT_INPUTS
         y = np.ascontiguousarray(state, dtype=float)
-        if y.shape != (PLANT_STATES,):
-            raise ValueError(f"state must have {PLANT_STATES} values, not shape {y.shape}")
-        u = None
+        if y.shape != (8,):
+            raise ValueError(f"state must have 8 values, not shape {y.shape}")
+        u = self.ffi.NULL
         if inputs is not None:
-            u = np.ascontiguousarray(inputs, dtype=float)
-            if u.shape != (PLANT_INPUTS,):
-                raise ValueError(f"inputs must have {PLANT_INPUTS} values, not shape {u.shape}")
-        yd = np.empty(PLANT_STATES)
-        A, B = np.empty((PLANT_STATES, PLANT_STATES)), np.empty((PLANT_STATES, PLANT_INPUTS))
-        self._check(self.lib.pkm_forward_derivatives(
-            self.handle, y.ctypes.data_as(_DP), None if u is None else u.ctypes.data_as(_DP), yd.ctypes.data_as(_DP),
-            A.ctypes.data_as(_DP), B.ctypes.data_as(_DP)), "pkm_forward_derivatives")
+            u_arr = np.ascontiguousarray(inputs, dtype=float)
+            if u_arr.shape != (n_u,):
+                raise ValueError(f"inputs must have {n_u} values, not shape {u_arr.shape}")
+            u = self._doubles(u_arr)
+        yd, A, B = np.empty(8), np.empty((8, 8)), np.empty((8, n_u))
+        self._check(self.c.pkm_forward_derivatives(self.handle, self._doubles(y), u, self._doubles(yd),
+                                                   self._doubles(A), self._doubles(B)), "pkm_forward_derivatives")
         return yd, A, B
 
     def inverse_derivatives(self, pose, velocity, acceleration, wrench=None):
         """pkm_inverse_derivatives: (F (4,), dF (4, 16)), dF with respect to
         (pose, velocity, acceleration, wrench)."""
         F, dF = np.empty(4), np.empty((4, 16))
-        self._check(self.lib.pkm_inverse_derivatives(self.handle, _d4(pose), _d4(velocity), _d4(acceleration),
-                                                     _d4(wrench), F.ctypes.data_as(_DP), dF.ctypes.data_as(_DP)),
-                    "pkm_inverse_derivatives")
+        self._check(self.c.pkm_inverse_derivatives(self.handle, self._d4(pose), self._d4(velocity),
+                                                   self._d4(acceleration), self._d4(wrench), self._doubles(F),
+                                                   self._doubles(dF)), "pkm_inverse_derivatives")
         return F, dF
 
+    # ---- calibration
     def regressor_params(self):
         """pkm_regressor_params: the model's own parameter vector pi."""
-        pi = np.empty(self.lib.pkm_regressor_param_count())
-        self._check(self.lib.pkm_regressor_params(self.handle, pi.ctypes.data_as(_DP)), "pkm_regressor_params")
+        pi = np.empty(self.c.PKM_REGRESSOR_PARAMS)
+        self._check(self.c.pkm_regressor_params(self.handle, self._doubles(pi)), "pkm_regressor_params")
         return pi
 
     def regressor(self, pose, velocity, acceleration, wrench=None):
         """pkm_regressor: (Y (4, n_pi), F0 (4,)) with F = Y pi + F0."""
-        Y, F0 = np.empty((4, self.lib.pkm_regressor_param_count())), np.empty(4)
-        self._check(self.lib.pkm_regressor(self.handle, _d4(pose), _d4(velocity), _d4(acceleration), _d4(wrench),
-                                           Y.ctypes.data_as(_DP), F0.ctypes.data_as(_DP)), "pkm_regressor")
+        Y, F0 = np.empty((4, self.c.PKM_REGRESSOR_PARAMS)), np.empty(4)
+        self._check(self.c.pkm_regressor(self.handle, self._d4(pose), self._d4(velocity), self._d4(acceleration),
+                                         self._d4(wrench), self._doubles(Y), self._doubles(F0)), "pkm_regressor")
         return Y, F0
 
+    def _batch(self, function, n, args):
+        """A batch call with its done count: PkmError carries `sample`, the
+        first sample not computed."""
+        done = self.ffi.new("size_t*")
+        s = function(self.handle, n, *args, done)
+        if s != self.c.PKM_OK:
+            name = function.__name__ if hasattr(function, "__name__") else "pkm_regressor_*"
+            err = PkmError(f"{name}: status {s}: {self.ffi.string(self.c.pkm_last_error(self.handle)).decode()}", s)
+            err.sample = done[0]
+            raise err
+
     def regressor_poses(self, pose, velocity, acceleration):
-        """pkm_regressor_poses over (n, 4) arrays: (Y (n, 4, n_pi), F0, rho, drho (n, 4))."""
+        """pkm_regressor_poses over (n, 4) arrays: (Y (n, 4, n_pi), F0, rho,
+        drho (n, 4)). On a failure PkmError names the sample; its attribute
+        `sample` holds it."""
         P, V, A = (np.ascontiguousarray(a, dtype=float).reshape(-1, 4) for a in (pose, velocity, acceleration))
         n = len(P)
         if len(V) != n or len(A) != n:
             raise ValueError("pose, velocity and acceleration need the same number of rows")
-        Y = np.empty((n, 4, self.lib.pkm_regressor_param_count()))
+        Y = np.empty((n, 4, self.c.PKM_REGRESSOR_PARAMS))
         F0, rho, drho = np.empty((n, 4)), np.empty((n, 4)), np.empty((n, 4))
-        self._check(self.lib.pkm_regressor_poses(self.handle, n, *(a.ctypes.data_as(_DP) for a in (P, V, A, Y, F0, rho,
-                                                                                                  drho))),
-                    "pkm_regressor_poses")
+        self._batch(self.c.pkm_regressor_poses, n, [self._doubles(a) for a in (P, V, A, Y, F0, rho, drho)])
         return Y, F0, rho, drho
 
     def regressor_joints(self, rho, drho, ddrho, guess=None):
@@ -366,68 +381,9 @@ class Plant:
         n = len(R)
         if len(V) != n or len(A) != n:
             raise ValueError("rho, drho and ddrho need the same number of rows")
-        Y = np.empty((n, 4, self.lib.pkm_regressor_param_count()))
+        Y = np.empty((n, 4, self.c.PKM_REGRESSOR_PARAMS))
         F0, pose = np.empty((n, 4)), np.empty((n, 4))
-        done = ct.c_size_t(0)
-        s = self.lib.pkm_regressor_joints(self.handle, n, R.ctypes.data_as(_DP), V.ctypes.data_as(_DP),
-                                          A.ctypes.data_as(_DP), _d4(guess), Y.ctypes.data_as(_DP),
-                                          F0.ctypes.data_as(_DP), pose.ctypes.data_as(_DP), ct.byref(done))
-        if s != PKM_OK:
-            err = PkmError(f"pkm_regressor_joints: status {s}: {self.lib.pkm_last_error(self.handle).decode()}")
-            err.sample, err.status = done.value, s
-            raise err
+        self._batch(self.c.pkm_regressor_joints, n, [self._doubles(R), self._doubles(V), self._doubles(A),
+                                                     self._d4(guess), self._doubles(Y), self._doubles(F0),
+                                                     self._doubles(pose)])
         return Y, F0, pose
-
-    def outputs(self, F=None, wrench=None):
-        o = Outputs()
-        self._check(self.lib.pkm_get_outputs(self.handle, _d4(F), _d4(wrench), ct.byref(o)), "pkm_get_outputs")
-        return o
-
-
-# --- the layout check against pkm.h ------------------------------------------------------
-_C_TYPES = {"double": (8, 8), "int": (4, 4), "unsigned": (4, 4)}
-
-
-def header_structs(path):
-    """{struct name: [(field name, offset, size)]} for pkm.h's plain structs of
-    doubles and ints (C layout rules for x86_64), and their sizes; `path` is
-    the header pkm.h (in the source tree, which this package does not know)."""
-    import re
-    text = re.sub(r"/\*.*?\*/", " ", Path(path).read_text(), flags=re.S)
-    out = {}
-    for body, name in re.findall(r"typedef\s+struct\s*\{(.*?)\}\s*(\w+)\s*;", text, flags=re.S):
-        fields, offset, align_max = [], 0, 1
-        for decl in body.split(";"):
-            decl = decl.strip()
-            if not decl:
-                continue
-            ctype, rest = decl.split(None, 1)
-            size, align = _C_TYPES[ctype]
-            for item in rest.split(","):
-                m = re.fullmatch(r"\s*(\w+)\s*(?:\[(\d+)\])?\s*", item)
-                count = int(m.group(2) or 1)
-                offset = (offset + align - 1) // align * align
-                fields.append((m.group(1), offset, size * count))
-                offset += size * count
-                align_max = max(align_max, align)
-        out[name] = (fields, (offset + align_max - 1) // align_max * align_max)
-    return out
-
-
-def binding_mismatches(path):
-    """Differences between this binding's structs and those of the header
-    pkm.h at `path` (empty: they agree).
-    pkm.h may have appended fields, as long as they fit in the reserve."""
-    structs = header_structs(path)
-    bad = []
-    for cname, cls in (("pkm_params", Params), ("pkm_solver_settings", SolverSettings), ("pkm_outputs", Outputs),
-                       ("pkm_inverse_result", InverseResult), ("pkm_machine_params", MachineParams),
-                       ("pkm_machine_outputs", MachineOutputs), ("pkm_inverse_machine_result", InverseMachineResult)):
-        fields, size = structs[cname]
-        ours = [(n.rstrip("_"), getattr(cls, n).offset, getattr(cls, n).size) for n, _ in cls._fields_
-                if n != "_reserved"]
-        if fields[:len(ours)] != ours:
-            bad.append(f"{cname}: pkm.h {fields[:len(ours)]} != binding {ours}")
-        if size > ct.sizeof(cls):
-            bad.append(f"{cname}: pkm.h's struct ({size} bytes) does not fit the binding's ({ct.sizeof(cls)} bytes)")
-    return bad

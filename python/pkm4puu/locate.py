@@ -5,21 +5,25 @@ wheel holds them), or a build directory's, each path written once here.
 A file is looked for in the build directory when one is asked for (a
 `build` argument, --build on the command line, or $PKM_BUILD_DIR), else
 in the package itself (pkm4puu/fmus/fmi<v>/<model>.fmu and
-pkm4puu/lib/libpkm.so, which the wheel built from the repository's
+pkm4puu/lib/libpkm.so or its platform's name, which the wheel built from the repository's
 pyproject.toml holds), else in ./build of the current directory (the
 development install, `pip install -e .`, holds none). Nothing outside the
 package is derived from where it is installed, and nothing here knows the
 build tree's programs (who runs one finds it).
 """
 import os
+import sys
 from pathlib import Path
 from typing import Optional, Union
 
 BUILD_ENV = "PKM_BUILD_DIR"
 DEFAULT_BUILD = Path("build")  # relative to the current directory
 
+# The plain C API's shared library (pkm.h) by platform, as the build names it.
+LIBRARY_NAME = {"win32": "pkm.dll", "darwin": "libpkm.dylib"}.get(sys.platform, "libpkm.so")
 # Build-relative paths.
-LIBRARY = "lib/libpkm.so"  # the plain C API, pkm.h
+LIBRARY = f"lib/{LIBRARY_NAME}"
+CDEF = "lib/pkm_cdef.h"  # pkm.h preprocessed for cffi, beside the library (the Python binding, capi.py)
 # Within the build directory: the FMI 2.0 archives at the top, the FMI 3.0
 # ones in FMI3_DIR, the multi-platform ones in DIST_DIR/fmi<version>.
 FMI3_DIR = "fmi3"
@@ -86,7 +90,7 @@ def fmu_path(model: str, fmi: int = 2, build: PathLike = None) -> Path:
 
 
 def library_path(build: PathLike = None) -> Path:
-    """libpkm.so (LIBRARY) as fmu_path finds an archive: the asked-for build
+    """libpkm (LIBRARY) as fmu_path finds an archive: the asked-for build
     directory's, else the package's, else ./build's."""
     return _find(LIBRARY, LIBRARY, build)
 

@@ -4,6 +4,11 @@ authoritative definition), and the geometry they define: for the checks, the
 independent reference models (Pinocchio, MuJoCo) and the examples. Nothing
 here is read from this project's code or outputs.
 
+This is the checks' independent copy, not the product's list of
+parameters: that is the parameter table of the C++ sources, which the FMUs'
+model descriptions, the C API (pkm_parameter_info) and pkm4puu.capi read;
+the tests compare the two (test_fmu_interface.py, test_capi_binding.py).
+
 SI units: the spec's Tables II-III are already converted there (m, kg, kg m^2).
 """
 import math
@@ -150,8 +155,9 @@ class Machine:
         return (-self.friction_viscous * rho_dot
                 - self.friction_coulomb * np.tanh(rho_dot / self.friction_velocity))
 
-    def capi_params(self):
-        """The pkm_machine_params fields this machine sets (end stops: the defaults)."""
+    def parameters(self):
+        """The parameters this machine sets, by the FMUs' names (end stops:
+        the defaults), for the C API: ``capi.Plant(lib, **machine.parameters())``."""
         return {"screw_lead": self.screw_lead, "rotor_inertia": self.rotor_inertia,
                 "friction_viscous": self.friction_viscous, "friction_coulomb": self.friction_coulomb,
                 "friction_velocity": self.friction_velocity, "payload_mass": self.payload_mass,
@@ -166,4 +172,6 @@ PARAMETER_DEFAULTS = {
     "m_slider": M_SLIDER, "m_rod": M_ROD, **{f"I_rod[{k + 1}]": I_ROD[k] for k in range(3)},
     "m_platform": M_PLATFORM, "Izz_platform": IZZ_PLATFORM, "g": G,
 }
-SOLVER_DEFAULTS = {"solver": 0, "rk4_step": 1e-3, "rtol": 1e-8, "atol": 1e-10}
+# The plant's `solver` parameter: 0 CVODE (the default), 1 fixed-step RK4.
+SOLVER_CVODE, SOLVER_RK4 = 0, 1
+SOLVER_DEFAULTS = {"solver": SOLVER_CVODE, "rk4_step": 1e-3, "rtol": 1e-8, "atol": 1e-10}

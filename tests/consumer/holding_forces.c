@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
 /* The holding forces at the home pose through the installed C API: each
- * actuator carries 2.655616050 N (docs/model.md); the header's version must be
- * the library's. Exit status 0 when both hold. */
+ * actuator carries 2.655616050 N (docs/model.md); the header's version and
+ * ABI version must be the library's. Exit status 0 when all hold. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -10,18 +10,16 @@
 
 int main(void) {
   const double home[4] = {0.0, 0.0, 0.05, 0.0}, zero[4] = {0.0, 0.0, 0.0, 0.0};
-  pkm_params p;
   pkm_model* m = NULL;
-  pkm_inverse_result r;
-  char err[256] = "";
+  pkm_inverse_result r = {.size = sizeof(pkm_inverse_result)};
   int i, bad = 0;
-  if (strcmp(pkm_version(), PKM_VERSION_STRING) != 0) {
-    fprintf(stderr, "library %s, header %s\n", pkm_version(), PKM_VERSION_STRING);
+  if (strcmp(pkm_version(), PKM_VERSION_STRING) != 0 || pkm_abi_version() != PKM_ABI_VERSION) {
+    fprintf(stderr, "library %s (ABI %d), header %s (ABI %d)\n", pkm_version(), pkm_abi_version(),
+            PKM_VERSION_STRING, PKM_ABI_VERSION);
     return 1;
   }
-  pkm_default_params(&p);
-  if (pkm_create(&p, &m, err, sizeof err) != PKM_OK) {
-    fprintf(stderr, "pkm_create: %s\n", err);
+  if (pkm_create(&m) != PKM_OK) {
+    fprintf(stderr, "pkm_create failed\n");
     return 1;
   }
   if (pkm_inverse_dynamics(m, home, zero, zero, NULL, &r) != PKM_OK) {

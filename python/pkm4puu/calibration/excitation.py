@@ -78,7 +78,7 @@ class _Problem:
         self.plant, self.base, self.pi, self.limits = plant, base, pi, limits
         self.period, self.harmonics, self.center = period, harmonics, np.asarray(center, float)
         self.t = np.arange(samples) * period / samples
-        self.rho_min, self.rho_max = plant.machine.rho_min, plant.machine.rho_max
+        self.rho_min, self.rho_max = plant.get("rho_min"), plant.get("rho_max")
         self._cache = {}  # x's bytes -> (objective, constraints): SLSQP asks both at the same points
 
     def trajectory(self, x):

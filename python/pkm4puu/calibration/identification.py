@@ -209,7 +209,7 @@ def identify(t, rho, F, *, cutoff=20.0, order=4, trim=None, model=None, physical
             raise IdentificationError(f"too short: {len(t)} samples, the identification needs at least "
                                       f"{2 * trim_n + 3 * nb + 30} (the filter's edges, {trim_n} at each end, "
                                       f"and 3 rows per base parameter)")
-        rho_min, rho_max = plant.machine.rho_min, plant.machine.rho_max
+        rho_min, rho_max = plant.get("rho_min"), plant.get("rho_max")
         outside = np.argwhere((rho < rho_min) | (rho > rho_max))
         if len(outside):
             k, i = outside[0]
@@ -328,8 +328,8 @@ def start_values(base, x, std, model, lib):
     known = make_plant(lib, model)
     with known:
         pi_known = known.regressor_params()
-        payload_Izz_known = known.machine.payload_Izz
-        v_s = known.machine.friction_velocity
+        payload_Izz_known = known.get("payload_Izz")
+        v_s = known.get("friction_velocity")
     pi = pi_known.copy()
     warnings = []
     for j, lead in enumerate(base.independent):

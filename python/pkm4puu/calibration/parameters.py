@@ -10,7 +10,6 @@ determine (docs/calibration.md).
 """
 from __future__ import annotations
 
-import ctypes as ct
 import re
 from dataclasses import dataclass
 
@@ -19,7 +18,7 @@ import numpy as np
 from .. import capi, extras
 
 # Lower bounds of pi's entries that make a parameter set the FMUs accept
-# (src/pkm4puu/model/param_ranges.hpp): masses >= 1 mg, the rod's and the
+# (the parameter table, src/pkm4puu/model/parameter_table.hpp): masses >= 1 mg, the rod's and the
 # platform's inertias >= 1e-12 kg m^2, the payload, rotor and friction >= 0;
 # the payload's first moments are signed.
 LOWER = {"m_slider": 1e-6, "m_rod": 1e-6, "I_rod[1]": 1e-12, "I_rod[2]": 1e-12, "I_rod[3]": 1e-12,
@@ -27,42 +26,29 @@ LOWER = {"m_slider": 1e-6, "m_rod": 1e-6, "I_rod[1]": 1e-12, "I_rod[2]": 1e-12, 
          "payload_my": -np.inf, "payload_Izz_P": 0.0, "rotor_inertia": 0.0, "friction_viscous": 0.0,
          "friction_coulomb": 0.0}
 
-_INDEXED = re.compile(r"^(\w+)\[(\d+)\]$")
-
-
 def make_plant(lib, values=None):
     """A capi.Plant of the spec's parameters with `values` (the FMUs'
     parameter names: "m_rod", "I_rod[2]", "payload_com[1]", "screw_lead", ...)
     set over them. Raises KeyError naming a name that is no parameter (or an
     index out of its vector's 1..n), capi.PkmError naming an invalid value."""
-    params, machine = {}, {}
-    p0, m0 = capi.Params(), capi.MachineParams()
-    lib.pkm_default_params(ct.byref(p0))
-    lib.pkm_default_machine_params(ct.byref(m0))
-    for name, value in (values or {}).items():
-        m = _INDEXED.match(name)
-        field, index = (m.group(1), int(m.group(2))) if m else (name, None)
-        if field in dict(capi.Params._fields_):
-            target, defaults = params, p0
-        elif field in dict(capi.MachineParams._fields_):
-            target, defaults = machine, m0
-        else:
-            raise KeyError(f"{name!r} is no parameter of the model")
-        size = len(getattr(defaults, field)) if hasattr(getattr(defaults, field), "__len__") else None
-        if (index is None) != (size is None) or (index is not None and not 1 <= index <= size):
-            raise KeyError(f"{name!r} is no parameter of the model: {field} is " +
-                           (f"a vector, {field}[1] to {field}[{size}]" if size else "a number, without an index"))
-        if index is None:
-            target[field] = float(value)
-        else:
-            arr = target.setdefault(field, list(getattr(defaults, field)))
-            arr[index - 1] = float(value)
-    for k, v in list(params.items()):
-        if isinstance(v, list):
-            params[k] = (ct.c_double * len(v))(*v)
-    if "payload_com" in machine:
-        machine["payload_com"] = tuple(machine["payload_com"])
-    return capi.Plant(lib, machine=machine, **params)
+    values = dict(values or {})
+    for name in values:
+        if name not in lib.parameters:
+            raise KeyError(f"{name!r} is no parameter of the model" + _what_it_is(lib, name))
+    return capi.Plant(lib, **{name: float(v) for name, v in values.items()})
+
+
+def _what_it_is(lib, name):
+    """": beta is a vector, beta[1] to beta[4]" where `name` misses a
+    parameter by its index (or has one where the parameter has none)."""
+    base = name.split("[", 1)[0]
+    indices = sorted(int(m.group(1)) for m in (re.fullmatch(re.escape(base) + r"\[(\d+)\]", n)
+                                                 for n in lib.parameters) if m)
+    if indices:
+        return f": {base} is a vector, {base}[{indices[0]}] to {base}[{indices[-1]}]"
+    if base != name and base in lib.parameters:
+        return f": {base} is a number, without an index"
+    return ""
 
 
 @dataclass

@@ -38,10 +38,10 @@ What is compared:
   inertia, viscous and Coulomb friction, an off-centre payload (with g = 0
   and with gravity on, then from the holding forces plus the sine) and all
   terms together (the C API driven by motor torques), each built into
-  Pinocchio and MuJoCo independently; the C API by pkm_create_machine. The
+  Pinocchio and MuJoCo independently; the C API by its parameters. The
   same reference, the C API as above, MuJoCo at 0.125 ms; and inverse
   dynamics with every term along the auto-test
-  (pkm_inverse_dynamics_machine against Pinocchio's RNEA with armature,
+  (pkm_inverse_dynamics against Pinocchio's RNEA with armature,
   payload and friction).
 
 The figures need matplotlib (the extra `plots`).
@@ -80,8 +80,8 @@ TOL_REF_PHI = 1e-11  # rad
 
 REF_RTOL, REF_ATOL = 1e-13, 1e-15
 CAPI_SOLVERS = {
-    "CVODE": {"solver": pkm_capi.PKM_SOLVER_CVODE, "rtol": 1e-12, "atol": 1e-14},
-    "RK4": {"solver": pkm_capi.PKM_SOLVER_RK4, "rk4_step": 1e-3},
+    "CVODE": {"solver": spec.SOLVER_CVODE, "rtol": 1e-12, "atol": 1e-14},
+    "RK4": {"solver": spec.SOLVER_RK4, "rk4_step": 1e-3},
 }
 OUT = ["x", "y", "z", "phi", "delta_rho1"]
 
@@ -214,11 +214,10 @@ def capi_run(lib, settings, machine=None, g=0.0, forces=motions.comparison_force
     """The comparison test through the C API: pkm_advance_fn to each 1 ms
     point with the forces from a callback at the integrator's own times
     (continuous: CVODE is not restarted), outputs read at each point.
-    With a machine (spec.Machine) the model is made by pkm_create_machine
-    with its parameters (end stops at their defaults) and the run also
-    returns "rho" (4 columns) and "stop_force" (pkm_get_machine_outputs);
-    torques (tau1..tau4 of t, N m) are then applied through
-    pkm_advance_fn_drives, on top of forces."""
+    With a machine (spec.Machine) the model has its parameters (end stops at
+    their defaults) and the run also returns "rho" (4 columns) and
+    "stop_force" (pkm_get_outputs); torques (tau1..tau4 of t, N m) are then
+    applied through the same callback, on top of forces."""
     rows, res, rho, stop = [], [], [], []
     calls = []
 
@@ -227,22 +226,18 @@ def capi_run(lib, settings, machine=None, g=0.0, forces=motions.comparison_force
         return forces(t)
 
     t0 = time.perf_counter()
-    with pkm_capi.Plant(lib, machine=None if machine is None else machine.capi_params(), g=g) as m:
+    with pkm_capi.Plant(lib, g=g, **({} if machine is None else machine.parameters())) as m:
         m.set_solver(**settings)
         m.init_pose(0.0, spec.P0)
         for k, t in enumerate(TIMES):
             if k > 0:
-                if torques is None:
-                    m.advance_fn(t, inputs, continuous=True)
-                else:
-                    m.advance_fn_drives(t, inputs, torques, continuous=True)
-            o = m.outputs(forces(t))
+                m.advance_fn(t, inputs, torques, continuous=True)
+            o = m.outputs(forces(t), tau=None if torques is None else torques(t))
             rows.append(list(o.pose) + [o.rho[0]])
             res.append(o.constraint_residual)
             rho.append(list(o.rho))
             if machine is not None:
-                mo = m.machine_outputs(forces(t), None if torques is None else torques(t))
-                stop.append(list(mo.stop_force))
+                stop.append(list(o.stop_force))
     Y = np.array(rows)
     out = {"t": TIMES.copy(), "x": Y[:, 0], "y": Y[:, 1], "z": Y[:, 2], "phi": Y[:, 3],
            "delta_rho1": Y[:, 4] - Y[0, 4], "constraint": np.array(res), "input_times": np.array(calls),
@@ -302,8 +297,8 @@ def mujoco_sweep():
 # Pinocchio integrator, MuJoCo's joint damping), Coulomb friction with the
 # spec's tanh law (a joint force in both: MuJoCo through its passive-force
 # callback) and an off-centre payload (a second body rigidly attached to the
-# platform in both). The C API gets the same numbers through
-# pkm_create_machine, its end stops at their defaults.
+# platform in both). The C API gets the same numbers as parameters, its end
+# stops at their defaults.
 #
 # Bounds: the issue's 1e-8 m for x, y, z and delta rho1; for phi 1e-7 rad,
 # 1e-8 m over the spec's 0.1 m lever for phi (the actuator Jacobian's
@@ -350,7 +345,7 @@ class MachineCase:
     of this machine, plus the spec's sine on F1 and F4: the machine then
     starts in equilibrium and the sine moves it. torques: the C API gets the
     sine as motor torques (2 pi / p) tau = F instead of forces, through
-    pkm_advance_fn_drives (the engines get the forces)."""
+    pkm_advance_fn's inputs (the engines get the forces)."""
 
     def __init__(self, name, machine, g=0.0, torques=False, mujoco=True):
         self.name, self.machine, self.g, self.use_torques, self.mujoco = name, machine, g, torques, mujoco
@@ -441,12 +436,12 @@ def pinocchio_inverse_machine(machine, times=AUTOTEST_TIMES, g=spec.G):
 
 def capi_inverse_machine(lib, machine, times=AUTOTEST_TIMES):
     """F, tau, lambda and the beyond_stops flags along the auto-test from
-    pkm_inverse_dynamics_machine."""
+    pkm_inverse_dynamics."""
     F, tau, lam = np.empty((len(times), 4)), np.empty((len(times), 4)), np.empty((len(times), 12))
     flags = np.empty(len(times), dtype=int)
-    with pkm_capi.Plant(lib, machine=machine.capi_params()) as m:
+    with pkm_capi.Plant(lib, **machine.parameters()) as m:
         for k, t in enumerate(times):
-            r = m.inverse_dynamics_machine(*motions.autotest_motion(t))
+            r = m.inverse_dynamics(*motions.autotest_motion(t))
             F[k], tau[k], lam[k], flags[k] = r.F, r.tau, r.lambda_, r.beyond_stops
     return {"F": F, "tau": tau, "lambda": lam, "beyond_stops": flags}
 

@@ -23,7 +23,7 @@ Status PlantData::make_plant(Context& ctx, const char* function, std::unique_ptr
   auto plant_new = std::make_unique<pkm::Plant>(model);
   std::string why;
   if (plant_new->set_solver(s, &why) != pkm::Status::Ok) {
-    ctx.log.error("%s: parameter %s", function, why.c_str());
+    ctx.log.error("%s: %s", function, why.c_str());
     return Status::Error;
   }
   out = std::move(plant_new);
@@ -37,25 +37,16 @@ bool PlantData::built_from(const pkm::Model& model, const pkm::SolverSettings& s
 
 Status PlantData::configuration(Context& ctx, const char* function, pkm::Model& model,
                                 pkm::SolverSettings& s) const {
+  const pkm::Configuration c = parameters();
   std::string why;
-  if (pkm::make_model(params, model, &why) != pkm::Status::Ok) {
+  if (pkm::make_model(c.params, model, &why) != pkm::Status::Ok) {
     ctx.log.error("%s: %s", function, why.c_str());
     return Status::Error;
   }
-  s = pkm::SolverSettings{};
-  s.solver = static_cast<pkm::Solver>(solver);
-  s.rk4_step = rk4_step;
-  s.rtol = rtol;
-  s.atol = atol;
-  s.cvode_method = static_cast<pkm::CvodeMethod>(cvode_method);
-  s.formulation = static_cast<pkm::Formulation>(formulation);
-  s.max_jacobian_condition = limits.max_jacobian_condition;
-  s.min_leg_measure = limits.min_leg_measure;
-  s.work_budget = work_budget;
-  s.energy_tolerance = energy_tolerance;
+  s = c.solver;
   const std::string invalid = pkm::validate(s);
   if (!invalid.empty()) {
-    ctx.log.error("%s: parameter %s", function, invalid.c_str());
+    ctx.log.error("%s: %s", function, invalid.c_str());
     return Status::Error;
   }
   return Status::OK;
@@ -65,6 +56,9 @@ Status PlantData::build(Context& ctx, const char* function) {
   std::unique_ptr<pkm::Plant> p;
   const Status st = make_plant(ctx, function, p);
   if (st != Status::OK) return st;
+  const pkm::InitialState initial = parameters().initial;
+  const auto& pose0 = initial.pose0;
+  const auto& vel0 = initial.vel0;
   const pkm::Pose pose_0(pose0[0], pose0[1], pose0[2], pose0[3]);
   const pkm::Pose vel_0(vel0[0], vel0[1], vel0[2], vel0[3]);
   const pkm::Status s = p->initialize(0.0, pose_0, vel_0);  // model time: since ctx.start_time

@@ -47,7 +47,7 @@
 #include <memory>
 
 #include "models/common/dependencies.hpp"
-#include "models/common/mechanism_parameters.hpp"
+#include "models/common/parameter_variables.hpp"
 #include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
 #include "pkm4puu/sim/plant.hpp"
 
@@ -57,7 +57,6 @@ namespace pkm_fmi {
 namespace pkm4puu_model {
 
 
-constexpr pkm::SolverSettings kDefaultSolver{};
 constexpr int kStates = 10;  // pose, velocity, actuator_work, dissipated_energy
 constexpr int kIndicators = pkm::kGuardIndicators + pkm::kContactIndicators;
 constexpr int kInputs = 12;  // F[1..4], Fe[1..3], Me_z, tau[1..4]
@@ -86,17 +85,6 @@ enum : std::uint8_t {
 };
 
 struct PlantData final : MechanismData {
-  // Parameters beyond the mechanism's: initial state and solver settings.
-  double pose0[4] = {0.0, 0.0, 0.05, 0.0};
-  double vel0[4] = {0.0, 0.0, 0.0, 0.0};
-  std::int32_t solver = static_cast<std::int32_t>(kDefaultSolver.solver);
-  double rk4_step = kDefaultSolver.rk4_step;
-  double rtol = kDefaultSolver.rtol;
-  double atol = kDefaultSolver.atol;
-  std::int32_t cvode_method = static_cast<std::int32_t>(kDefaultSolver.cvode_method);
-  std::int32_t formulation = static_cast<std::int32_t>(kDefaultSolver.formulation);
-  double work_budget = kDefaultSolver.work_budget;
-  double energy_tolerance = kDefaultSolver.energy_tolerance;
   // Inputs u = [F1..F4, Fe1..Fe3, Me_z, tau1..tau4] at the current time, and du/dt.
   double u[kInputs] = {kHoldingForce, kHoldingForce, kHoldingForce, kHoldingForce};
   double du[kInputs] = {};

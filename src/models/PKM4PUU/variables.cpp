@@ -40,7 +40,7 @@ constexpr std::uint8_t kEverything = kSliders | kSliderRates | kOnInputs;
 constexpr std::uint8_t kWrench = kOnInputs | kOnWrench;  // the kind of Fe, Me_z
 
 // clang-format off
-constexpr Variable kVariables[] = {
+constexpr Variable kOwnVariables[] = {
   time_variable(0),
   // Inputs: 1..8.
   real_input(1, "F[1]", kHoldingForce, "N", "Actuator force on the slider of leg 1, along +z", PLANT(u), 0, PLANT(du), kOnInputs),
@@ -143,55 +143,18 @@ constexpr Variable kVariables[] = {
   real_input(91, "tau[2]", 0.0, "N.m", "Motor torque of leg 2's drive", PLANT(u), 9, PLANT(du), kOnInputs),
   real_input(92, "tau[3]", 0.0, "N.m", "Motor torque of leg 3's drive", PLANT(u), 10, PLANT(du), kOnInputs),
   real_input(93, "tau[4]", 0.0, "N.m", "Motor torque of leg 4's drive", PLANT(u), 11, PLANT(du), kOnInputs),
-  // Parameters: the mechanism (100..120), the initial state (130..137), the
-  // solver (140..147), the end stops' compliance (148..149), the machine (150..160).
-  PKM_FMI_MECHANISM_PARAMETERS,
-  initial_state_parameter(130, "x0", 0.0, "m", "Initial x of P", PLANT(pose0), 0, -pkm::kMaxLength, pkm::kMaxLength, 0),
-  initial_state_parameter(131, "y0", 0.0, "m", "Initial y of P", PLANT(pose0), 1, -pkm::kMaxLength, pkm::kMaxLength, 1),
-  initial_state_parameter(132, "z0", 0.05, "m", "Initial z of P (home pose: 0.05 m)", PLANT(pose0), 2, -pkm::kMaxLength, pkm::kMaxLength, 2),
-  initial_state_parameter(133, "phi0", 0.0, "rad", "Initial platform rotation about z", PLANT(pose0), 3, -pkm::kMaxAngle, pkm::kMaxAngle, 3),
-  initial_state_parameter(134, "dx0", 0.0, "m/s", "Initial velocity of P, x component", PLANT(vel0), 0, -pkm::kMaxSpeed, pkm::kMaxSpeed, 4),
-  initial_state_parameter(135, "dy0", 0.0, "m/s", "Initial velocity of P, y component", PLANT(vel0), 1, -pkm::kMaxSpeed, pkm::kMaxSpeed, 5),
-  initial_state_parameter(136, "dz0", 0.0, "m/s", "Initial velocity of P, z component", PLANT(vel0), 2, -pkm::kMaxSpeed, pkm::kMaxSpeed, 6),
-  initial_state_parameter(137, "dphi0", 0.0, "rad/s", "Initial platform angular velocity about z", PLANT(vel0), 3, -pkm::kMaxSpeed / pkm::kConditionLength, pkm::kMaxSpeed / pkm::kConditionLength, 7),
-  integer_parameter(140, "solver", static_cast<int>(kDefaultSolver.solver),
-                    "Co-Simulation integrator: 0 = CVODE (variable step, rtol and atol), 1 = fixed-step RK4 (rk4_step), as in "
-                    "the paper, sub-stepped where friction or a held end stop is stiff, 2 = fixed-step Rosenbrock (ROS2, "
-                    "linearly implicit with the analytic Jacobian: stiff friction and end stops in real time)",
-                    PLANT_SCALAR(solver), 0, 2),
-  real_parameter(141, "rk4_step", kDefaultSolver.rk4_step, "s",
-                 "Fixed step of RK4 and Rosenbrock: a communication step is split into whole steps no longer than this", PLANT_SCALAR(rk4_step), 0,
-                 pkm::kMinRk4Step, pkm::kMaxRk4Step),
-  real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance", PLANT_SCALAR(rtol), 0, pkm::kMinRtol, pkm::kMaxRtol),
-  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)", PLANT_SCALAR(atol), 0, pkm::kMinAtol, pkm::kMaxAtol),
-  integer_parameter(144, "cvode_method", static_cast<int>(kDefaultSolver.cvode_method),
-                    "CVODE method: 0 = Adams-Moulton (non-stiff), 1 = BDF", PLANT_SCALAR(cvode_method), 0, 1),
-  integer_parameter(145, "formulation", static_cast<int>(kDefaultSolver.formulation),
-                    "Forward dynamics: 0 = augmented saddle-point system (Eq. 12), 1 = null-space projection with a QR "
-                    "(Eq. 13), 2 = null space from the leg blocks (Eq. 13, leg-partitioned)",
-                    PLANT_SCALAR(formulation), 0, 2),
-  PKM_FMI_GUARD_PARAMETERS,
-  mechanism_parameter(148, "stop_stiffness", "N/m",
-                 "Stiffness k of the compliant end stops: k delta + d delta_dot pushes a slider back past rho_min or rho_max by delta (never pulls)",
-                 PKM_FMI_PARAM(stop_stiffness), 0),
-  mechanism_parameter(149, "stop_damping", "N.s/m", "Damping d of the end stops",
-                 PKM_FMI_PARAM(stop_damping), 0),
-  PKM_FMI_MACHINE_PARAMETERS,
-  real_parameter(161, "work_budget", kDefaultSolver.work_budget, "",
-                 "Fixed-step solvers: inner steps (grid steps, stiff sub-steps, bisection trials locating end-stop "
-                 "events) allowed per grid step, summed over a communication step; a step that needs more returns "
-                 "Discard with the reason", PLANT_SCALAR(work_budget), 0, pkm::kMinWorkBudget, pkm::kMaxWorkBudget),
-  real_parameter(162, "energy_tolerance", kDefaultSolver.energy_tolerance, "J",
-                 "Energy audit as a run-time check: a communication step whose audit residual (change of "
-                 "kinetic + potential - actuator_work + dissipated_energy) exceeds this returns Discard with the "
-                 "figures; 0 = off", PLANT_SCALAR(energy_tolerance), 0, 0.0, pkm::kMaxEnergyTolerance),
 };
 // clang-format on
 
 #undef PLANT
 #undef PLANT_SCALAR
 
-static_assert(sorted_by_vr(kVariables, std::size(kVariables)), "the table must be sorted by value reference");
+// Parameters: the mechanism (100..120), the initial state (130..137), the
+// solver (140..147), the end stops' compliance (148..149), the machine
+// (150..160), the solver's checks (161..162): the parameter table's rows.
+static_assert(sorted_by_vr(kOwnVariables, std::size(kOwnVariables)), "the table must be sorted by value reference");
+constexpr auto kVariables = merge_by_vr(kOwnVariables, parameter_variables<pkm::kFmuPlant>());
+static_assert(sorted_by_vr(kVariables.data(), kVariables.size()), "value references must be unique");
 
 std::unique_ptr<ModelData> create() { return std::make_unique<PlantData>(); }
 
@@ -217,8 +180,8 @@ const ModelDefinition kDefinition{
     "are the singularity guards, whose crossing ends the simulation with a logged reason, and the end stops, "
     "whose crossings are events logged under logEvents. A pose that no leg can reach is refused by "
     "SetContinuousStates with Discard. FMU states can be saved, restored and serialised.</p>",
-    kVariables,
-    std::size(kVariables),
+    kVariables.data(),
+    kVariables.size(),
     /*n_states=*/kStates,
     /*n_position_states=*/4,
     /*n_event_indicators=*/kIndicators,

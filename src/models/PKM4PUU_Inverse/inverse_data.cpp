@@ -13,17 +13,19 @@
 namespace pkm_fmi {
 namespace pkm4puu_inverse_model {
 
-Status InverseData::make(Context& ctx, const char* function, pkm::Model& out) const {
+Status InverseData::make(Context& ctx, const char* function, pkm::Model& out) {
+  const pkm::Configuration c = parameters();
   std::string why;
-  if (pkm::make_model(params, out, &why) != pkm::Status::Ok) {
+  if (pkm::make_model(c.params, out, &why) != pkm::Status::Ok) {
     ctx.log.error("%s: %s", function, why.c_str());
     return Status::Error;
   }
-  why = pkm::validate(limits);
+  why = pkm::validate(c.solver.limits());
   if (!why.empty()) {
-    ctx.log.error("%s: parameter %s", function, why.c_str());
+    ctx.log.error("%s: %s", function, why.c_str());
     return Status::Error;
   }
+  limits = c.solver.limits();
   return Status::OK;
 }
 
@@ -36,7 +38,7 @@ Status InverseData::exit_initialization(Context& ctx) {
 }
 
 const pkm::Model* InverseData::current_model(Context& ctx, const char* function,
-                                             std::optional<pkm::Model>& temporary) const {
+                                             std::optional<pkm::Model>& temporary) {
   if (ctx.initialization_mode) return make(ctx, function, temporary.emplace()) == Status::OK ? &*temporary : nullptr;
   if (!model) ctx.log.error("%s: outputs not available (initialisation did not succeed)", function);
   return model.get();
@@ -88,18 +90,22 @@ Status InverseData::compute_outputs(Context& ctx, const pkm::Model& with, unsign
     pkm::GuardReport guard;
     if (pkm::check_jacobian(J, measure2, limits, &guard) == pkm::Status::Singular) return beyond_guard(guard);
   }
+  // Every group computed before any output is written: a failure writes nothing.
+  pkm::InverseDynamicsResult full;
   if (groups & kGroupMultipliers) {  // the whole reduced path, angles and lambda
-    pkm::InverseDynamicsResult full;
     const pkm::Status sf = pkm::inverse_dynamics(*m, p, pd, pdd, we, full);
     if (sf != pkm::Status::Ok) return failed(sf);
-    for (int k = 0; k < 12; ++k) lambda[k] = full.lambda[k];
   }
+  double cond = condition;
   if (groups & kGroupCondition) {  // the actuator Jacobian's SVD
     pkm::Vec16 q;
     const pkm::Status sq = pkm::closed_form_position(*m, p, q);
     if (sq != pkm::Status::Ok) return failed(sq);
-    condition = pkm::actuator_jacobian_condition(*m, q);
+    cond = pkm::actuator_jacobian_condition(*m, q);
   }
+  if (groups & kGroupMultipliers)
+    for (int k = 0; k < 12; ++k) lambda[k] = full.lambda[k];
+  condition = cond;
   if (!(groups & kGroupActuators)) return Status::OK;
   for (int i = 0; i < 4; ++i) {
     F[i] = r.F[i];

@@ -28,7 +28,7 @@
 #include <optional>
 
 #include "models/common/dependencies.hpp"
-#include "models/common/mechanism_parameters.hpp"
+#include "models/common/parameter_variables.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 
 namespace pkm_fmi {
@@ -55,6 +55,8 @@ struct InverseData final : MechanismData {
   unsigned beyond_stops = 0;
   // Built at the end of initialisation.
   std::unique_ptr<pkm::Model> model;
+  // The singularity guards' limits of the model last made (make).
+  pkm::GuardLimits limits{};
 
   void reset() override { model.reset(); }
   Status exit_initialization(Context& ctx) override;
@@ -72,11 +74,12 @@ struct InverseData final : MechanismData {
   Status partial_derivatives(Context& ctx, const Variable* const unknowns[], std::size_t nu,
                              const Variable* const knowns[], std::size_t nk, double J[]) override;
 
-  Status make(Context& ctx, const char* function, pkm::Model& out) const;
+  /// The model of the current parameters, and their guards' limits into `limits`.
+  Status make(Context& ctx, const char* function, pkm::Model& out);
   /// The model to evaluate with: the instance's, or in initialisation mode
   /// one made into `temporary` (constructed only then) from the current
   /// parameters; nullptr (logged) if there is none.
-  const pkm::Model* current_model(Context& ctx, const char* function, std::optional<pkm::Model>& temporary) const;
+  const pkm::Model* current_model(Context& ctx, const char* function, std::optional<pkm::Model>& temporary);
 };
 
 }  // namespace pkm4puu_inverse_model

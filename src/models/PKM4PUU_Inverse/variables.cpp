@@ -27,7 +27,7 @@ constexpr std::uint8_t kMultipliers = kOnPositions | kOnRates | kOnInputs;
 constexpr std::uint8_t kForces = kMultipliers | kOnHeight | kOnHeightRate;
 
 // clang-format off
-constexpr Variable kVariables[] = {
+constexpr Variable kOwnVariables[] = {
   time_variable(0),
   // Inputs: 1..16.
   real_input(1, "x", 0.0, "m", "Platform reference point P (centre of mass), x in the base frame", INV(pose), 0, nullptr, kOnPositions),
@@ -77,17 +77,17 @@ constexpr Variable kVariables[] = {
   real_output(51, "lambda[12]", "N", "Lagrange multiplier of leg 4's loop closure, z row (Eq. 10)", INV(lambda), 11, kMultipliers, kGroupMultipliers),
   real_output(52, "leg_measure_min", "", "Smallest |cos(theta2) sin(theta2)| of the four legs (0 at a leg singularity; the guard min_leg_measure)", INV_SCALAR(leg_measure_min), 0, kOnPositions, kGroupActuators),
   real_output(53, "jacobian_condition", "", "Condition number of the 4x4 actuator Jacobian d(rho)/d(x, y, z, phi), its phi column divided by 0.1 m (the guard max_jacobian_condition)", INV_SCALAR(condition), 0, kOnPositions, kGroupCondition),
-  // Parameters: the mechanism (100..120), the guards (146..147), the machine (150..160).
-  PKM_FMI_MECHANISM_PARAMETERS,
-  PKM_FMI_GUARD_PARAMETERS,
-  PKM_FMI_MACHINE_PARAMETERS,
 };
 // clang-format on
 
 #undef INV
 #undef INV_SCALAR
 
-static_assert(sorted_by_vr(kVariables, std::size(kVariables)), "the table must be sorted by value reference");
+// Parameters: the mechanism (100..120), the guards (146..147), the machine
+// (150..160): the parameter table's rows.
+static_assert(sorted_by_vr(kOwnVariables, std::size(kOwnVariables)), "the table must be sorted by value reference");
+constexpr auto kVariables = merge_by_vr(kOwnVariables, parameter_variables<pkm::kFmuInverse>());
+static_assert(sorted_by_vr(kVariables.data(), kVariables.size()), "value references must be unique");
 static_assert(kVariables[1].vr == 1 && kVariables[16].vr == 16 && kVariables[17].vr == 20,
               "partial_derivatives: the inputs are value references 1..16, in the order of their row");
 
@@ -106,8 +106,8 @@ const ModelDefinition kDefinition{
     "then. A pose beyond a singularity guard (min_leg_measure, max_jacobian_condition, as in the plant) makes "
     "it return Discard with the reason logged and the outputs of the last pose within the guards. At rest at "
     "the home pose (0, 0, 0.05 m, 0) with g = 9.81 m/s2 each actuator carries 2.655616050 N.</p>",
-    kVariables,
-    std::size(kVariables),
+    kVariables.data(),
+    kVariables.size(),
     /*n_states=*/0,
     /*n_position_states=*/0,
     /*n_event_indicators=*/0,

@@ -8,6 +8,7 @@
 #include "pkm4puu/base/sin_cos.hpp"
 #include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/kinematics/leg_kinematics.hpp"
+#include "pkm4puu/model/parameter_table.hpp"
 
 namespace pkm {
 namespace {
@@ -53,19 +54,11 @@ double exact_condition(const Mat4& J) {
 }  // namespace
 
 std::string validate(const GuardLimits& g) {
-  char buf[200];
-  if (!(g.max_jacobian_condition > 1.0)) {  // also NaN; +inf switches the check off
-    std::snprintf(buf, sizeof buf,
-                  "max_jacobian_condition = %.17g must be greater than 1 (a condition number is at least 1)",
-                  g.max_jacobian_condition);
-    return buf;
-  }
-  if (!(g.min_leg_measure >= 0.0) || !(g.min_leg_measure < 0.5)) {
-    std::snprintf(buf, sizeof buf,
-                  "min_leg_measure = %.17g must lie in [0, 0.5) (|cos theta2 sin theta2| is at most 0.5)",
-                  g.min_leg_measure);
-    return buf;
-  }
+  // Each limit against its row (parameter_table.hpp); +inf switches the
+  // condition check off.
+#define PKM_PARAMETER_ROW(...) PKM_PARAMETER_CHECK(g, __VA_ARGS__)
+  PKM_PARAMETER_TABLE(PKM_PARAMETER_ONLY_Guard)
+#undef PKM_PARAMETER_ROW
   return {};
 }
 

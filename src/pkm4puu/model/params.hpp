@@ -55,8 +55,8 @@ struct Params {
   double payload_Izz = 0.0;                  // kg*m^2, >= 0
 };
 
-/// Physical ranges of the parameters: validate() and the FMUs' variable
-/// table (the modelDescription's min/max) use these same numbers. A machine
+/// Physical ranges of the parameters, which the parameter table
+/// (parameter_table.hpp) gives each parameter of Params. A machine
 /// of this kind spans decimetres; these bounds leave room for any real one
 /// and refuse what only overflows (g = 1e300 made the first step's size NaN).
 constexpr double kMaxLength = 10.0;     // m: lengths, |rho_min|, |rho_max|, |payload_com|, screw_lead
@@ -79,8 +79,10 @@ constexpr double kMinMass = 1e-6;       // kg
 constexpr double kMinInertia = 1e-12;   // kg*m^2
 constexpr double kMinSlipSpeed = 1e-9;  // m/s
 
-/// Checks every parameter. Returns an empty string when they are valid,
-/// otherwise a message that names the offending parameter and its value.
+/// Checks every parameter against its row of the parameter table, then
+/// what no row says alone (rho_max above rho_min, the rod's principal
+/// moments). Returns an empty string when they are valid, otherwise a
+/// message that names the offending parameter and its value.
 std::string validate(const Params& p);
 
 }  // namespace pkm
