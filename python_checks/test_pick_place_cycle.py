@@ -74,9 +74,9 @@ def test_standard_cycle_csv(standard, pkm_library):
     assert np.all(vel[[0, k, k + 1, -1]] == 0.0)
     F = data[:, 13:17]
     rows = np.append(np.arange(0, len(data), 97), [k, k + 1])
-    with capi.Plant(capi.load(pkm_library), machine={"payload_mass": spec.CYCLE_PAYLOAD}) as loaded, \
+    with capi.Plant(capi.load(pkm_library), payload_mass=spec.CYCLE_PAYLOAD) as loaded, \
             capi.Plant(capi.load(pkm_library)) as empty:
-        ref = np.array([(loaded if mass[r] else empty).inverse_dynamics_machine(pose[r], vel[r], data[r, 9:13]).F
+        ref = np.array([(loaded if mass[r] else empty).inverse_dynamics(pose[r], vel[r], data[r, 9:13]).F
                         for r in rows])
     np.testing.assert_allclose(F[rows], ref, rtol=0, atol=1e-9)  # the CSV's 12 digits
     assert np.abs(F).max() <= spec.CYCLE_F_MAX * (1 + 1e-5)
@@ -214,8 +214,8 @@ def test_limits_below_holding_the_payload_name_the_actuator(pkm_library):
     s = float(re.search(r"at s = ([0-9.]+)", line).group(1))
     i, force = re.search(r"needs F\[(\d)\] = ([-0-9.]+) N", line).groups()
     pose = _arch_pose(spec.CYCLE_A, s)
-    with capi.Plant(capi.load(pkm_library), machine={"payload_mass": spec.CYCLE_PAYLOAD}) as plant:
-        F = plant.inverse_dynamics_machine(pose, [0.0] * 4, [0.0] * 4).F
+    with capi.Plant(capi.load(pkm_library), payload_mass=spec.CYCLE_PAYLOAD) as plant:
+        F = plant.inverse_dynamics(pose, [0.0] * 4, [0.0] * 4).F
     assert abs(F[int(i) - 1]) > 3.0
     assert F[int(i) - 1] == pytest.approx(float(force), abs=1e-3)
 

@@ -1,20 +1,19 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """pkm4puu.planning's time-optimal traversal: optimal (a limit active on every
 grid interval but the switches; the time converging with the grid), within
-its limits by an independent recomputation (pkm_inverse_dynamics_machine and
+its limits by an independent recomputation (pkm_inverse_dynamics and
 pkm_inverse_dynamics at the planned motion), its coefficients against
 finite differences of the inverse dynamics, and its time against two
 closed forms: a path limited by the slider speed alone, and a vertical
 path where the machine is a one-dimensional double integrator."""
 import math
-import re
 
 import numpy as np
 import pytest
 
 from pkm4puu import capi, spec
 from pkm4puu.planning import Limits, arch, plan_cycle, plan_segment
-from pkm4puu.planning import capi_adapter, segment, topp
+from pkm4puu.planning import segment, topp
 from pkm4puu.planning.capi_adapter import InverseDynamics
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
@@ -71,7 +70,7 @@ def test_time_converges_first_order_with_the_grid():
 
 def test_recomputed_forces_and_speeds_stay_within_the_limits(cycle, lib):
     """Along the plan, sampled every 0.1 ms, the forces from
-    pkm_inverse_dynamics_machine and the slider rates from
+    pkm_inverse_dynamics and the slider rates from
     pkm_inverse_dynamics (not the planner's pkm_regressor_poses) at the
     planned pose, velocity and acceleration stay within f_max and v_max up
     to the grid's interpolation error, which is second order: at most twice
@@ -79,8 +78,8 @@ def test_recomputed_forces_and_speeds_stay_within_the_limits(cycle, lib):
     coarse = plan_cycle(grid=segment.GRID // 4, dt=1e-3)
     zero = np.zeros(4)
     for seg, rough in zip(cycle.segments, coarse.segments):
-        with capi.Plant(lib, machine={"payload_mass": seg.payload_mass}) as plant:
-            F = np.array([plant.inverse_dynamics_machine(p, v, a).F
+        with capi.Plant(lib, payload_mass=seg.payload_mass) as plant:
+            F = np.array([plant.inverse_dynamics(p, v, a).F
                           for p, v, a in zip(seg.pose, seg.velocity, seg.acceleration)])
             drho = np.array([plant.inverse_dynamics(p, v, zero).qd[0:12:3] for p, v in zip(seg.pose, seg.velocity)])
         np.testing.assert_allclose(seg.F, F, rtol=0, atol=1e-11)
@@ -116,7 +115,7 @@ def test_coefficients_match_finite_differences_of_the_inverse_dynamics(lib):
     """F = a sdd + b sd^2 + c along a time law s(t) = s0 + w t + k t^2, with
     the platform's velocity and acceleration from central differences of
     the pose p(s(t)) in time (not from p'(s), p''(s)) and the forces from
-    pkm_inverse_dynamics_machine. The differences' error is estimated by
+    pkm_inverse_dynamics. The differences' error is estimated by
     halving their step (it falls 4-fold): the planner's forces must agree
     within it."""
     path = arch()
@@ -130,11 +129,11 @@ def test_coefficients_match_finite_differences_of_the_inverse_dynamics(lib):
 
     def fd(step):
         out = []
-        with capi.Plant(lib, machine={"payload_mass": 0.25}) as plant:
+        with capi.Plant(lib, payload_mass=0.25) as plant:
             for t in times:
                 p = path(s0 + w * (t + np.array([-step, 0.0, step])) + k * (t + np.array([-step, 0.0, step])) ** 2)
                 v, acc = (p[2] - p[0]) / (2 * step), (p[2] - 2 * p[1] + p[0]) / step ** 2
-                out.append(plant.inverse_dynamics_machine(p[1], v, acc).F)
+                out.append(plant.inverse_dynamics(p[1], v, acc).F)
         return np.array(out)
 
     coarse, fine = fd(2e-4), fd(1e-4)
@@ -223,10 +222,3 @@ def test_drive_limits_act_through_the_screw():
         a1, b1, c1, _ = topp.path_coefficients(rotor, path, s)
     np.testing.assert_allclose(a1 - a0, J * (2 * math.pi / p) ** 2 * drho_ds, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(c1, c0, rtol=0, atol=1e-12)
-
-
-def test_guard_status_codes_are_pkm_h_s(pkm_header):
-    """The adapter's PKM_ERR_UNREACHABLE and PKM_ERR_SINGULAR are pkm.h's."""
-    enum = dict((name, int(v)) for name, v in re.findall(r"(PKM_\w+)\s*=\s*(\d+)", pkm_header.read_text()))
-    assert capi_adapter.PKM_ERR_UNREACHABLE == enum["PKM_ERR_UNREACHABLE"]
-    assert capi_adapter.PKM_ERR_SINGULAR == enum["PKM_ERR_SINGULAR"]

@@ -15,10 +15,6 @@ import numpy as np
 
 from .. import capi
 
-# pkm.h's pkm_status values the guards answer with
-PKM_ERR_UNREACHABLE = 4
-PKM_ERR_SINGULAR = 5
-
 _LIBRARIES = {}
 
 
@@ -41,20 +37,19 @@ class PoseError(ValueError):
 
 
 class InverseDynamics:
-    """One model of the machine (pkm_create_machine): `params` overrides
-    pkm_default_params (e.g. {"g": 0.0}), `machine` pkm_default_machine_params
-    (screw_lead, rotor_inertia, friction_viscous, ...), the payload
-    `payload_mass` kg at P. ValueError naming the parameter if the C API
-    refuses one."""
+    """One model of the machine (pkm_create, then its parameters by the
+    FMUs' names): `params` and `machine` override the defaults (e.g.
+    {"g": 0.0}; screw_lead, rotor_inertia, friction_viscous, ...), the
+    payload `payload_mass` kg at P. ValueError naming the parameter if the C
+    API refuses one."""
 
     def __init__(self, payload_mass=0.0, machine=None, params=None, build=None):
-        machine = dict(machine or {})
-        machine["payload_mass"] = float(payload_mass)
+        values = {**(params or {}), **(machine or {}), "payload_mass": float(payload_mass)}
         try:
-            self._plant = capi.Plant(_library(build), machine=machine, **(params or {}))
-        except capi.PkmError as e:
+            self._plant = capi.Plant(_library(build), **values)
+        except (capi.PkmError, TypeError) as e:
             raise ValueError(str(e)) from None
-        self.rho_limits = (self._plant.machine.rho_min, self._plant.machine.rho_max)
+        self.rho_limits = (self._plant.get("rho_min"), self._plant.get("rho_max"))
         self._pi = self._plant.regressor_params()
 
     def close(self):
@@ -87,19 +82,21 @@ class InverseDynamics:
     def check_poses(self, pose):
         """Raises PoseError at the first pose the machine cannot take: the C
         API's guards (pkm_init_pose: each leg's reach, leg and parallel
-        singularities), then the sliders' travel (pkm_inverse_dynamics_machine's
+        singularities), then the sliders' travel (pkm_inverse_dynamics's
         beyond_stops)."""
         P = np.asarray(pose, dtype=float).reshape(-1, 4)
-        plant, lib = self._plant, self._plant.lib
+        plant = self._plant
         zero = np.zeros(4)
         for k in range(len(P)):
-            status = lib.pkm_init_pose(plant.handle, 0.0, capi.D4(*P[k]), None)
-            if status != capi.PKM_OK:
-                text = lib.pkm_last_error(plant.handle).decode()
-                kind = {PKM_ERR_UNREACHABLE: "unreachable", PKM_ERR_SINGULAR: "singular"}.get(status, "invalid")
+            try:
+                plant.init_pose(0.0, P[k])
+            except capi.PkmError as e:
+                text = plant.ffi.string(plant.c.pkm_last_error(plant.handle)).decode()
+                kind = {plant.c.PKM_ERR_UNREACHABLE: "unreachable", plant.c.PKM_ERR_SINGULAR: "singular"}.get(e.status,
+                                                                                                "invalid")
                 leg = re.search(r"\bleg (\d)\b", text)
-                raise PoseError(kind, k, text, int(leg.group(1)) if leg else None)
-            beyond = plant.inverse_dynamics_machine(P[k], zero, zero).beyond_stops
+                raise PoseError(kind, k, text, int(leg.group(1)) if leg else None) from None
+            beyond = plant.inverse_dynamics(P[k], zero, zero).beyond_stops
             if beyond:
                 bit = (beyond & -beyond).bit_length() - 1  # bit i-1: below rho_min; 3+i: above rho_max
                 leg, low = bit % 4 + 1, bit < 4
