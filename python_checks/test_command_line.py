@@ -11,6 +11,7 @@ import math
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -225,7 +226,8 @@ def test_engines_runs_on_the_packages_own_files_without_a_build(capsys, monkeypa
     pkg, empty = tmp_path / "pkg", tmp_path / "empty"
     for target, source in ((pkg / "fmus" / "fmi2" / plant_fmu.name, plant_fmu),
                            (pkg / "fmus" / "fmi2" / inverse_fmu.name, inverse_fmu),
-                           (pkg / locate.LIBRARY, pkm_library)):
+                           (pkg / locate.LIBRARY, pkm_library),
+                           (pkg / locate.CDEF, pkm_library.with_name(Path(locate.CDEF).name))):
         target.parent.mkdir(parents=True, exist_ok=True)
         target.symlink_to(source)
     empty.mkdir()
