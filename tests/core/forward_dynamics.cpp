@@ -75,13 +75,13 @@ TEST(ForwardDynamics, StateDerivativeHotPathEqualsFullEvaluation) {
 
 namespace {
 
-// The legs' lanes of the hot path (ReducedDynamics::platform_derivative) that
-// this processor can run: the scalar instance of the same template, the
-// baseline lanes and, where the processor has it, the AVX variant.
-std::vector<ReducedDynamics::LegLanes> lane_kernels() {
-  using K = ReducedDynamics::LegLanes;
-  std::vector<K> k = {K::Best, K::Scalar, K::Generic};
-  if (lanes_available(K::Avx)) k.push_back(K::Avx);
+// The copies of the hot path's legs (ReducedDynamics::platform_derivative)
+// that this build and processor run: the scalar instance of the same
+// template, the baseline lanes and, where the processor has it, AVX.
+std::vector<lanes::Kernel> lane_kernels() {
+  using K = lanes::Kernel;
+  std::vector<K> k = {K::Best, K::Scalar, K::Baseline};
+  if (PKM_LANES_AVX_DISPATCH && lanes::cpu_runs_avx()) k.push_back(K::Avx);
   return k;
 }
 

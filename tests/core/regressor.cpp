@@ -170,30 +170,6 @@ TEST(Regressor, FromTheSlidersMeasurementsEqualsFromThePlatformMotion) {
   }
 }
 
-TEST(Regressor, BaselineLanesGiveTheSameBitsAsAvx) {
-  // Model::avx picks the lanes' AVX variant (regressor_lanes.cpp) where the
-  // processor has it; the baseline variant runs the same expressions in the
-  // same order, so both entry points agree to the bit.
-  const Model avx = model_of(machine_params());
-  Model base = avx;
-  base.avx = false;
-  if (!avx.avx) GTEST_SKIP() << "no AVX here: only the baseline variant runs";
-  for (unsigned seed = 1; seed <= 20; ++seed) {
-    const Motion mo = random_motion(avx, seed);
-    RegressorSample a, b;
-    ASSERT_EQ(regressor(avx, mo.pose, mo.vel, mo.acc, mo.we, a), Status::Ok);
-    ASSERT_EQ(regressor(base, mo.pose, mo.vel, mo.acc, mo.we, b), Status::Ok);
-    EXPECT_EQ(a.Y, b.Y) << "seed " << seed;
-    EXPECT_EQ(a.F0, b.F0) << "seed " << seed;
-    RegressorSample ja, jb;
-    ja.pose = jb.pose = Pose(0.0, 0.0, 0.05, 0.0);
-    ASSERT_EQ(joint_regressor(avx, a.rho, a.rhod, Vec4::Zero(), mo.we, ja), Status::Ok);
-    ASSERT_EQ(joint_regressor(base, a.rho, a.rhod, Vec4::Zero(), mo.we, jb), Status::Ok);
-    EXPECT_EQ(ja.pose, jb.pose) << "seed " << seed;
-    EXPECT_EQ(ja.Y, jb.Y) << "seed " << seed;
-  }
-}
-
 TEST(Regressor, RefusesNonFiniteAndUnreachableInput) {
   const Model m = model_of(machine_params());
   RegressorSample r;

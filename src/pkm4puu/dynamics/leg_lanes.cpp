@@ -35,7 +35,7 @@ Status positions_scalar(const Model& m, const PlatformConfig& pc, Vec4& rho) {
   return Status::Ok;
 }
 
-Status positions_generic(const Model& m, const PlatformConfig& pc, Vec4& rho) {
+Status positions_baseline(const Model& m, const PlatformConfig& pc, Vec4& rho) {
   return positions_as_lanes(m, pc, rho);
 }
 
@@ -68,16 +68,15 @@ Status legs_scalar(const Model& m, const PlatformConfig& pc, const Pose& pd, con
   return Status::Ok;
 }
 
-Status legs_generic(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
+Status legs_baseline(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
                     LegSums& sums) {
   return legs_as_lanes(m, pc, pd, f, stops, sums);
 }
 
 #if PKM_LANES_AVX_DISPATCH
-// The same source compiled for AVX (no FMA: no contraction, the same bits),
-// taken where the processor has it (Model::avx, asked once by make_model).
-PKM_LANES_AVX_TARGET Status legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
-                                               const Vec16& f, unsigned stops, LegSums& sums) {
+// The same source compiled for AVX (no FMA: no contraction, the same bits).
+PKM_LANES_AVX_TARGET Status legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
+                                     unsigned stops, LegSums& sums) {
   return legs_as_lanes(m, pc, pd, f, stops, sums);
 }
 PKM_LANES_AVX_TARGET Status positions_avx(const Model& m, const PlatformConfig& pc, Vec4& rho) {
@@ -85,58 +84,17 @@ PKM_LANES_AVX_TARGET Status positions_avx(const Model& m, const PlatformConfig& 
 }
 #endif
 
-using LegsKernel = Status (*)(const Model&, const PlatformConfig&, const Pose&, const Vec16&, unsigned, LegSums&);
-using PositionsKernel = Status (*)(const Model&, const PlatformConfig&, Vec4&);
-struct Kernels {
-  LegsKernel legs;
-  PositionsKernel positions;
-};
-
-// The variant `kind` of the legs' lanes (Best: AVX where model_avx, i.e.
-// Model::avx); false for an AVX variant this build or processor cannot run.
-bool kernels_for(bool model_avx, LegLanes kind, Kernels& k) {
-  using K = LegLanes;
-  k = {legs_generic, positions_generic};
-  switch (kind) {
-    case K::Generic: return true;
-    case K::Scalar: k = {legs_scalar, positions_scalar}; return true;
-    case K::Best:
-#if PKM_LANES_AVX_DISPATCH
-      if (model_avx) k = {legs_avx, positions_avx};
-#else
-      (void)model_avx;
-#endif
-      return true;
-    case K::Avx:
-#if PKM_LANES_AVX_DISPATCH
-      if (!lanes::cpu_runs_avx()) return false;
-      k = {legs_avx, positions_avx};
-      return true;
-#else
-      return false;
-#endif
-  }
-  return false;
-}
-
 }  // namespace
 
-bool lanes_available(LegLanes kind) {
-  Kernels k;
-  return kernels_for(false, kind, k);
-}
-
 Status leg_sums(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
-                LegSums& sums, LegLanes kind) {
-  Kernels k;
-  if (!kernels_for(m.avx, kind, k)) return Status::InvalidArgument;
-  return k.legs(m, pc, pd, f, stops, sums);
+                LegSums& sums, lanes::Kernel kind) {
+  return lanes::run<legs_scalar, legs_baseline, PKM_LANES_AVX_COPY(legs_avx)>(kind, m.avx, Status::InvalidArgument, m,
+                                                                             pc, pd, f, stops, sums);
 }
 
-Status lane_actuator_positions(const Model& m, const PlatformConfig& pc, Vec4& rho, LegLanes kind) {
-  Kernels k;
-  if (!kernels_for(m.avx, kind, k)) return Status::InvalidArgument;
-  return k.positions(m, pc, rho);
+Status lane_actuator_positions(const Model& m, const PlatformConfig& pc, Vec4& rho, lanes::Kernel kind) {
+  return lanes::run<positions_scalar, positions_baseline, PKM_LANES_AVX_COPY(positions_avx)>(
+      kind, m.avx, Status::InvalidArgument, m, pc, rho);
 }
 
 Status actuator_positions(const Model& m, const Pose& pose, Vec4& rho) {
