@@ -264,28 +264,33 @@ PKM_LANES_INLINE bool resolve(Kernel kind, bool model_avx, bool has_scalar, Kern
   return kind == Kernel::Baseline;
 }
 
-// A kernel's AVX copy as run's argument: nullptr where the build compiles none.
+/// A kernel's compiled copies: `body` (one PKM_LANES_INLINE function of
+/// the legs as lanes) compiled for the baseline instruction set and, where
+/// PKM_LANES_AVX_DISPATCH, for AVX (no FMA: no contraction, the same bits).
+template <class Fn, Fn* body>
+struct Copies;
+template <class R, class... A, R (*body)(A...)>
+struct Copies<R(A...), body> {
+  static R baseline(A... a) { return body(a...); }
 #if PKM_LANES_AVX_DISPATCH
-#define PKM_LANES_AVX_COPY(fn) fn
-#else
-#define PKM_LANES_AVX_COPY(fn) nullptr
+  PKM_LANES_AVX_TARGET static R avx(A... a) { return body(a...); }
 #endif
+};
 
-/// Runs the copy of a kernel that resolve() picks for `kind`, calling it
-/// directly (kScalar, kBaseline, kAvx: the copies, each a function of the
-/// same signature, or nullptr where the kernel has none); `missing` where
-/// the copy is missing.
-template <auto kScalar, auto kBaseline, auto kAvx, class R, class... Args>
+/// Runs the copy of a kernel (K: its Copies; kScalar: its one-leg copy, a
+/// function of the same signature, or nullptr) that resolve() picks for
+/// `kind`, calling it directly; `missing` where that copy is missing.
+template <class K, auto kScalar = nullptr, class R, class... Args>
 PKM_LANES_INLINE R run(Kernel kind, bool model_avx, R missing, Args&&... args) {
   Kernel copy = Kernel::Baseline;
   if (!resolve(kind, model_avx, !std::is_null_pointer_v<decltype(kScalar)>, copy)) return missing;
-  if constexpr (!std::is_null_pointer_v<decltype(kAvx)>) {
-    if (copy == Kernel::Avx) return kAvx(std::forward<Args>(args)...);
-  }
+#if PKM_LANES_AVX_DISPATCH
+  if (copy == Kernel::Avx) return K::avx(std::forward<Args>(args)...);
+#endif
   if constexpr (!std::is_null_pointer_v<decltype(kScalar)>) {
     if (copy == Kernel::Scalar) return kScalar(std::forward<Args>(args)...);
   }
-  return kBaseline(std::forward<Args>(args)...);
+  return K::baseline(std::forward<Args>(args)...);
 }
 
 /// T's number of lanes and its broadcast constant.

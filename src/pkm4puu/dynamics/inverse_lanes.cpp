@@ -190,28 +190,14 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
 }
 
 template <bool kFull>
-Status inverse_legs_baseline(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd,
-                             const Wrench& we, InverseDynamicsResult* full, InverseActuators* act) {
-  return legs_inverse<kFull>(m, pc, pd, pdd, we, full, act);
-}
+using InverseCopies = lanes::Copies<decltype(legs_inverse<kFull>), legs_inverse<kFull>>;
 
-#if PKM_LANES_AVX_DISPATCH
-template <bool kFull>
-PKM_LANES_AVX_TARGET Status inverse_legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
-                                             const Pose& pdd, const Wrench& we, InverseDynamicsResult* full,
-                                             InverseActuators* act) {
-  return legs_inverse<kFull>(m, pc, pd, pdd, we, full, act);
-}
-#endif
-
-// Both entry points: kBest a constant (the product's calls: only Model::avx
-// is asked), or the copy asked for.
-template <bool kBest>
+// Both entry points, inlined: the product's with `kind` the constant Best
+// (only Model::avx is asked at run time), the tests' with the copy asked for.
 PKM_LANES_INLINE Status inverse_entry(const Model& m, const Pose& pose, const Pose& pd, const Pose& pdd,
                                       const Wrench& we, InverseDynamicsResult* full, InverseActuators* act,
                                       lanes::Kernel kind) {
   if (!pose.allFinite() || !pd.allFinite() || !pdd.allFinite() || !we.allFinite()) return Status::NonFinite;
-  if (kBest) kind = lanes::Kernel::Best;
   PlatformConfig pc;
 #if defined(__GLIBC__)
   // platform_config's cos and sin in one call (glibc's sincos: the same
@@ -222,22 +208,20 @@ PKM_LANES_INLINE Status inverse_entry(const Model& m, const Pose& pose, const Po
   pc = platform_config(pose);
 #endif
   if (full)
-    return lanes::run<nullptr, inverse_legs_baseline<true>, PKM_LANES_AVX_COPY(inverse_legs_avx<true>)>(
-        kind, m.avx, Status::InvalidArgument, m, pc, pd, pdd, we, full, nullptr);
-  return lanes::run<nullptr, inverse_legs_baseline<false>, PKM_LANES_AVX_COPY(inverse_legs_avx<false>)>(
-      kind, m.avx, Status::InvalidArgument, m, pc, pd, pdd, we, nullptr, act);
+    return lanes::run<InverseCopies<true>>(kind, m.avx, Status::InvalidArgument, m, pc, pd, pdd, we, full, nullptr);
+  return lanes::run<InverseCopies<false>>(kind, m.avx, Status::InvalidArgument, m, pc, pd, pdd, we, nullptr, act);
 }
 
 }  // namespace
 
 Status reduced_inverse(const Model& m, const Pose& pose, const Pose& pd, const Pose& pdd, const Wrench& we,
                        InverseDynamicsResult* full, InverseActuators* act) {
-  return inverse_entry<true>(m, pose, pd, pdd, we, full, act, lanes::Kernel::Best);
+  return inverse_entry(m, pose, pd, pdd, we, full, act, lanes::Kernel::Best);
 }
 
 Status reduced_inverse(const Model& m, const Pose& pose, const Pose& pd, const Pose& pdd, const Wrench& we,
                        InverseDynamicsResult* full, InverseActuators* act, lanes::Kernel kind) {
-  return inverse_entry<false>(m, pose, pd, pdd, we, full, act, kind);
+  return inverse_entry(m, pose, pd, pdd, we, full, act, kind);
 }
 
 }  // namespace pkm

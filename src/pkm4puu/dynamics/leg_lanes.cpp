@@ -35,10 +35,6 @@ Status positions_scalar(const Model& m, const PlatformConfig& pc, Vec4& rho) {
   return Status::Ok;
 }
 
-Status positions_baseline(const Model& m, const PlatformConfig& pc, Vec4& rho) {
-  return positions_as_lanes(m, pc, rho);
-}
-
 // The four legs as lanes, their contributions summed in leg order
 // ((0 + leg 0) + leg 1) + ... as the scalar accumulation does.
 PKM_LANES_INLINE Status legs_as_lanes(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
@@ -54,47 +50,21 @@ PKM_LANES_INLINE Status legs_as_lanes(const Model& m, const PlatformConfig& pc, 
 
 Status legs_scalar(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
                    LegSums& sums) {
-  for (double& x : sums.mr) x = 0.0;
-  for (double& x : sums.rhs) x = 0.0;
-  for (int i = 0; i < kLegs; ++i) {
-    LegContribution<double> c;
-    const Status s = leg_contribution(m, i, pc, pd, stops, leg_inputs(m, i, f[leg_offset(i)]), c);
-    if (s != Status::Ok) return s;
-    for (int n = 0; n < 10; ++n) sums.mr[n] += c.mr[n];
-    for (int n = 0; n < 4; ++n) sums.rhs[n] += c.rhs[n];
-    sums.rho[i] = c.rho;
-    sums.rhod[i] = c.rhod;
-  }
-  return Status::Ok;
+  return legs_one_at_a_time(m, pc, pd, f, stops, sums);
 }
 
-Status legs_baseline(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
-                    LegSums& sums) {
-  return legs_as_lanes(m, pc, pd, f, stops, sums);
-}
-
-#if PKM_LANES_AVX_DISPATCH
-// The same source compiled for AVX (no FMA: no contraction, the same bits).
-PKM_LANES_AVX_TARGET Status legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
-                                     unsigned stops, LegSums& sums) {
-  return legs_as_lanes(m, pc, pd, f, stops, sums);
-}
-PKM_LANES_AVX_TARGET Status positions_avx(const Model& m, const PlatformConfig& pc, Vec4& rho) {
-  return positions_as_lanes(m, pc, rho);
-}
-#endif
+using LegsCopies = lanes::Copies<decltype(legs_as_lanes), legs_as_lanes>;
+using PositionsCopies = lanes::Copies<decltype(positions_as_lanes), positions_as_lanes>;
 
 }  // namespace
 
 Status leg_sums(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
                 LegSums& sums, lanes::Kernel kind) {
-  return lanes::run<legs_scalar, legs_baseline, PKM_LANES_AVX_COPY(legs_avx)>(kind, m.avx, Status::InvalidArgument, m,
-                                                                             pc, pd, f, stops, sums);
+  return lanes::run<LegsCopies, legs_scalar>(kind, m.avx, Status::InvalidArgument, m, pc, pd, f, stops, sums);
 }
 
 Status lane_actuator_positions(const Model& m, const PlatformConfig& pc, Vec4& rho, lanes::Kernel kind) {
-  return lanes::run<positions_scalar, positions_baseline, PKM_LANES_AVX_COPY(positions_avx)>(
-      kind, m.avx, Status::InvalidArgument, m, pc, rho);
+  return lanes::run<PositionsCopies, positions_scalar>(kind, m.avx, Status::InvalidArgument, m, pc, rho);
 }
 
 Status actuator_positions(const Model& m, const Pose& pose, Vec4& rho) {

@@ -178,19 +178,9 @@ PKM_LANES_INLINE void add_share(const LegShare<double>& s, int leg, LegPartialSu
 Status partials_scalar(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
                        LegPartialSums& out) {
   LegSums& sums = out.sums;
-  for (double& v : sums.mr) v = 0.0;
-  for (double& v : sums.rhs) v = 0.0;
   LegKeep<double> keep[kLegs];
-  for (int i = 0; i < kLegs; ++i) {
-    LegContribution<double> c;
-    const Status s = leg_contribution(m, i, pc, pd, stops, leg_inputs(m, i, f[leg_offset(i)]), c, &keep[i]);
-    if (s != Status::Ok) return s;
-    for (int n = 0; n < 10; ++n) sums.mr[n] += c.mr[n];
-    for (int n = 0; n < 4; ++n) sums.rhs[n] += c.rhs[n];
-    sums.rho[i] = c.rho;
-    sums.rhod[i] = c.rhod;
-  }
-  const Status s = ReducedDynamics::solve_leg_sums(m, f.segment<4>(kPlatform), sums, pc, pd[3], out.pdd);
+  Status s = legs_one_at_a_time(m, pc, pd, f, stops, sums, keep);
+  if (s == Status::Ok) s = ReducedDynamics::solve_leg_sums(m, f.segment<4>(kPlatform), sums, pc, pd[3], out.pdd);
   if (s != Status::Ok) return s;
   for (int i = 0; i < kLegs; ++i) {
     LegShare<double> share;
@@ -229,24 +219,13 @@ PKM_LANES_INLINE Status partials_as_lanes(const Model& m, const PlatformConfig& 
   return Status::Ok;
 }
 
-Status partials_baseline(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
-                        LegPartialSums& out) {
-  return partials_as_lanes(m, pc, pd, f, stops, out);
-}
-
-#if PKM_LANES_AVX_DISPATCH
-PKM_LANES_AVX_TARGET Status partials_avx(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
-                                         unsigned stops, LegPartialSums& out) {
-  return partials_as_lanes(m, pc, pd, f, stops, out);
-}
-#endif
+using PartialsCopies = lanes::Copies<decltype(partials_as_lanes), partials_as_lanes>;
 
 }  // namespace
 
 Status leg_partial_sums(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
                         LegPartialSums& out, lanes::Kernel kind) {
-  return lanes::run<partials_scalar, partials_baseline, PKM_LANES_AVX_COPY(partials_avx)>(
-      kind, m.avx, Status::InvalidArgument, m, pc, pd, f, stops, out);
+  return lanes::run<PartialsCopies, partials_scalar>(kind, m.avx, Status::InvalidArgument, m, pc, pd, f, stops, out);
 }
 
 }  // namespace pkm

@@ -143,68 +143,35 @@ PKM_LANES_INLINE Status legs_sliders(const Model& m, const PlatformConfig& pc, V
   return Status::Ok;
 }
 
-// Each kernel's baseline and AVX copies (the same source; no FMA: the same bits).
-Status regressor_baseline(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd, const Wrench& we,
-                          RegressorSample& out) {
-  return legs_regressor(m, pc, pd, pdd, we, out);
-}
-Status joint_regressor_baseline(const Model& m, const PlatformConfig& pc, const Vec4& rhod, const Vec4& rhodd,
-                                const Wrench& we, RegressorSample& out) {
-  return legs_joint_regressor(m, pc, rhod, rhodd, we, out);
-}
-Status sliders_baseline(const Model& m, const PlatformConfig& pc, Vec4& rho, Mat4& Arho) {
-  return legs_sliders(m, pc, rho, Arho);
-}
-
-#if PKM_LANES_AVX_DISPATCH
-PKM_LANES_AVX_TARGET Status regressor_avx(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd,
-                                          const Wrench& we, RegressorSample& out) {
-  return legs_regressor(m, pc, pd, pdd, we, out);
-}
-PKM_LANES_AVX_TARGET Status joint_regressor_avx(const Model& m, const PlatformConfig& pc, const Vec4& rhod,
-                                                const Vec4& rhodd, const Wrench& we, RegressorSample& out) {
-  return legs_joint_regressor(m, pc, rhod, rhodd, we, out);
-}
-PKM_LANES_AVX_TARGET Status sliders_avx(const Model& m, const PlatformConfig& pc, Vec4& rho, Mat4& Arho) {
-  return legs_sliders(m, pc, rho, Arho);
-}
-#endif
+using RegressorCopies = lanes::Copies<decltype(legs_regressor), legs_regressor>;
+using JointCopies = lanes::Copies<decltype(legs_joint_regressor), legs_joint_regressor>;
+using SlidersCopies = lanes::Copies<decltype(legs_sliders), legs_sliders>;
 
 }  // namespace
 
-// The copies of each kernel, as lanes::run's arguments.
-#define PKM_REGRESSOR_COPIES nullptr, regressor_baseline, PKM_LANES_AVX_COPY(regressor_avx)
-#define PKM_JOINT_REGRESSOR_COPIES nullptr, joint_regressor_baseline, PKM_LANES_AVX_COPY(joint_regressor_avx)
-#define PKM_SLIDERS_COPIES nullptr, sliders_baseline, PKM_LANES_AVX_COPY(sliders_avx)
-
 Status regressor_lanes(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd, const Wrench& we,
                        RegressorSample& out) {
-  return lanes::run<PKM_REGRESSOR_COPIES>(lanes::Kernel::Best, m.avx, Status::InvalidArgument, m, pc, pd, pdd, we, out);
+  return lanes::run<RegressorCopies>(lanes::Kernel::Best, m.avx, Status::InvalidArgument, m, pc, pd, pdd, we, out);
 }
 Status regressor_lanes(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd, const Wrench& we,
                        RegressorSample& out, lanes::Kernel kind) {
-  return lanes::run<PKM_REGRESSOR_COPIES>(kind, m.avx, Status::InvalidArgument, m, pc, pd, pdd, we, out);
+  return lanes::run<RegressorCopies>(kind, m.avx, Status::InvalidArgument, m, pc, pd, pdd, we, out);
 }
 
 Status joint_regressor_lanes(const Model& m, const PlatformConfig& pc, const Vec4& rhod, const Vec4& rhodd,
                              const Wrench& we, RegressorSample& out) {
-  return lanes::run<PKM_JOINT_REGRESSOR_COPIES>(lanes::Kernel::Best, m.avx, Status::InvalidArgument, m, pc, rhod,
-                                                rhodd, we, out);
+  return lanes::run<JointCopies>(lanes::Kernel::Best, m.avx, Status::InvalidArgument, m, pc, rhod, rhodd, we, out);
 }
 Status joint_regressor_lanes(const Model& m, const PlatformConfig& pc, const Vec4& rhod, const Vec4& rhodd,
                              const Wrench& we, RegressorSample& out, lanes::Kernel kind) {
-  return lanes::run<PKM_JOINT_REGRESSOR_COPIES>(kind, m.avx, Status::InvalidArgument, m, pc, rhod, rhodd, we, out);
+  return lanes::run<JointCopies>(kind, m.avx, Status::InvalidArgument, m, pc, rhod, rhodd, we, out);
 }
 
 Status slider_positions_lanes(const Model& m, const PlatformConfig& pc, Vec4& rho, Mat4& Arho) {
-  return lanes::run<PKM_SLIDERS_COPIES>(lanes::Kernel::Best, m.avx, Status::InvalidArgument, m, pc, rho, Arho);
+  return lanes::run<SlidersCopies>(lanes::Kernel::Best, m.avx, Status::InvalidArgument, m, pc, rho, Arho);
 }
 Status slider_positions_lanes(const Model& m, const PlatformConfig& pc, Vec4& rho, Mat4& Arho, lanes::Kernel kind) {
-  return lanes::run<PKM_SLIDERS_COPIES>(kind, m.avx, Status::InvalidArgument, m, pc, rho, Arho);
+  return lanes::run<SlidersCopies>(kind, m.avx, Status::InvalidArgument, m, pc, rho, Arho);
 }
-
-#undef PKM_REGRESSOR_COPIES
-#undef PKM_JOINT_REGRESSOR_COPIES
-#undef PKM_SLIDERS_COPIES
 
 }  // namespace pkm
