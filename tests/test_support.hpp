@@ -77,6 +77,19 @@ Eigen::Matrix<double, N, 1> random_vec(unsigned seed, double scale) {
   return v;
 }
 
+/// A random state with accelerations within `acc` (m/s^2; the rotation's ten
+/// times that, rad/s^2) and an external wrench within `we` (N; its moment a
+/// tenth, N*m).
+struct RandomMotion {
+  Pose pose, vel, acc;
+  Wrench we;
+};
+inline RandomMotion random_motion(const Model& m, unsigned seed, double acc = 2.0, double we = 1.0) {
+  const RandomState s = random_state(m, seed);
+  const Vec4 a = random_vec<4>(seed + 1000, acc), w = random_vec<4>(seed + 2000, we);
+  return {s.pose, s.vel, Pose(a[0], a[1], a[2], 10.0 * a[3]), Wrench(w[0], w[1], w[2], 0.1 * w[3])};
+}
+
 /// Fourth-order central difference of s -> f(s) at s = 0.
 template <class F>
 auto d_ds(F f, double h) -> decltype(f(0.0)) {

@@ -40,17 +40,16 @@ TEST(ForwardDynamics, InvertsInverseDynamics) {
   // give that acceleration and the same multipliers back.
   const Model m = default_model();
   for (unsigned seed = 1; seed <= 8; ++seed) {
-    const RandomState s = random_state(m, seed);
-    const Pose acc = random_vec<4>(400 + seed, 3.0);
-    const Wrench we = random_vec<4>(500 + seed, 0.3);
+    const RandomMotion mo = random_motion(m, seed, 3.0, 0.3);
     InverseDynamicsResult r;
-    ASSERT_EQ(inverse_dynamics(m, s.pose, s.vel, acc, we, r), Status::Ok);
+    ASSERT_EQ(inverse_dynamics(m, mo.pose, mo.vel, mo.acc, mo.we, r), Status::Ok);
     for (int k = 0; k < 3; ++k) {
       Vec16 qdd;
       Vec12 lam;
-      ASSERT_EQ(forward_dynamics(m, static_cast<Formulation>(k), r.q, r.qd, generalized_forces(r.F, we), qdd, lam),
+      ASSERT_EQ(forward_dynamics(m, static_cast<Formulation>(k), r.q, r.qd, generalized_forces(r.F, mo.we), qdd, lam),
                 Status::Ok);
-      EXPECT_LT((qdd.segment<4>(kPlatform) - acc).lpNorm<Eigen::Infinity>(), 1e-10 * acc.lpNorm<Eigen::Infinity>());
+      EXPECT_LT((qdd.segment<4>(kPlatform) - mo.acc).lpNorm<Eigen::Infinity>(),
+                1e-10 * mo.acc.lpNorm<Eigen::Infinity>());
       EXPECT_LT(rel_diff(lam, r.lambda), 1e-10);
     }
   }

@@ -38,11 +38,9 @@ struct KernelRun {
   }
 };
 
-/// The kernels under test, each run at (m, the motion) with one copy.
-struct Motion {
-  Pose pose, vel, acc;
+/// A random motion with the applied forces and the stops held.
+struct Motion : RandomMotion {
   Vec16 f;
-  Wrench we;
   unsigned stops;
 };
 
@@ -116,13 +114,11 @@ KernelRun run_kernel(int which, const Model& m, const Motion& mo, Kernel kind) {
 /// a wrench; every fourth pushed off the workspace, every fifth with fast
 /// sliders (the friction's tanh saturated), stops held in several patterns.
 Motion motion(const Model& m, unsigned seed) {
-  RandomState s = random_state(m, seed);
-  if (seed % 5 == 0) s.vel *= 20.0;
-  Motion mo{s.pose, s.vel, random_vec<4>(seed + 300, 3.0), Vec16::Zero(), random_vec<4>(seed + 400, 0.5), 0u};
+  const unsigned stops[] = {kStopsFromState, 0u, 0x0Fu, 0xF0u, 0x5Au};
+  Motion mo{random_motion(m, seed, 3.0, 0.5), Vec16::Zero(), stops[seed % 5]};
+  if (seed % 5 == 0) mo.vel *= 20.0;
   if (seed % 4 == 0) mo.pose.head<3>() += random_vec<3>(seed + 500, 0.05);
   mo.f = generalized_forces(random_vec<4>(seed + 600, 3.0), mo.we);
-  const unsigned stops[] = {kStopsFromState, 0u, 0x0Fu, 0xF0u, 0x5Au};
-  mo.stops = stops[seed % 5];
   return mo;
 }
 
