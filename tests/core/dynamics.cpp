@@ -77,9 +77,8 @@ TEST(Dynamics, InverseDynamicsSatisfiesEquationOneWithExternalWrench) {
   // external wrench on the platform, at random states and accelerations.
   const Model m = default_model();
   for (unsigned seed = 1; seed <= 6; ++seed) {
-    const RandomMotion mo = random_motion(m, seed, 2.0, 0.5);
-    InverseDynamicsResult r;
-    ASSERT_EQ(inverse_dynamics(m, mo.pose, mo.vel, mo.acc, mo.we, r), Status::Ok);
+    const Motion mo = random_motion(m, seed, 2.0, 0.5);
+    const InverseDynamicsResult r = inverse_dynamics_of(m, mo);
     Mat16 M;
     mass_matrix(m, r.q, M);
     Mat12x16 Cq;

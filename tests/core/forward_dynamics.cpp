@@ -40,9 +40,8 @@ TEST(ForwardDynamics, InvertsInverseDynamics) {
   // give that acceleration and the same multipliers back.
   const Model m = default_model();
   for (unsigned seed = 1; seed <= 8; ++seed) {
-    const RandomMotion mo = random_motion(m, seed, 3.0, 0.3);
-    InverseDynamicsResult r;
-    ASSERT_EQ(inverse_dynamics(m, mo.pose, mo.vel, mo.acc, mo.we, r), Status::Ok);
+    const Motion mo = random_motion(m, seed, 3.0, 0.3);
+    const InverseDynamicsResult r = inverse_dynamics_of(m, mo);
     for (int k = 0; k < 3; ++k) {
       Vec16 qdd;
       Vec12 lam;

@@ -39,7 +39,7 @@ struct KernelRun {
 };
 
 /// A random motion with the applied forces and the stops held.
-struct Motion : RandomMotion {
+struct KernelInput : Motion {
   Vec16 f;
   unsigned stops;
 };
@@ -51,7 +51,7 @@ constexpr int kKernels = 8;
 // The kernels with a one-leg (Scalar) copy.
 constexpr bool kHasScalar[kKernels] = {true, true, true, false, false, false, false, false};
 
-KernelRun run_kernel(int which, const Model& m, const Motion& mo, Kernel kind) {
+KernelRun run_kernel(int which, const Model& m, const KernelInput& mo, Kernel kind) {
   KernelRun r;
   const PlatformConfig pc = platform_config(mo.pose);
   switch (which) {
@@ -113,9 +113,9 @@ KernelRun run_kernel(int which, const Model& m, const Motion& mo, Kernel kind) {
 /// A state from the auto-test's neighbourhood with forces, accelerations and
 /// a wrench; every fourth pushed off the workspace, every fifth with fast
 /// sliders (the friction's tanh saturated), stops held in several patterns.
-Motion motion(const Model& m, unsigned seed) {
+KernelInput kernel_input(const Model& m, unsigned seed) {
   const unsigned stops[] = {kStopsFromState, 0u, 0x0Fu, 0xF0u, 0x5Au};
-  Motion mo{random_motion(m, seed, 3.0, 0.5), Vec16::Zero(), stops[seed % 5]};
+  KernelInput mo{random_motion(m, seed, 3.0, 0.5), Vec16::Zero(), stops[seed % 5]};
   if (seed % 5 == 0) mo.vel *= 20.0;
   if (seed % 4 == 0) mo.pose.head<3>() += random_vec<3>(seed + 500, 0.05);
   mo.f = generalized_forces(random_vec<4>(seed + 600, 3.0), mo.we);
@@ -137,7 +137,7 @@ TEST(LaneKernels, EveryCopyGivesTheBaselineBits) {
     EXPECT_EQ(with_avx.avx, lanes::cpu_runs_avx());
     int compared[kKernels] = {}, failed = 0;
     for (unsigned seed = 1; seed <= 120; ++seed) {
-      const Motion mo = motion(with_avx, seed);
+      const KernelInput mo = kernel_input(with_avx, seed);
       for (int k = 0; k < kKernels; ++k) {
         SCOPED_TRACE(std::string(kKernelNames[k]) + ", seed " + std::to_string(seed));
         const KernelRun base = run_kernel(k, with_avx, mo, Kernel::Baseline);

@@ -16,7 +16,6 @@ namespace {
 
 // A machine with every term of pi non-zero: every_machine_term() (rotors,
 // friction, an off-centre payload).
-using Motion = RandomMotion;
 
 RegressorSample regressor_at(const Model& m, const Motion& mo) {
   RegressorSample r;
@@ -24,11 +23,7 @@ RegressorSample regressor_at(const Model& m, const Motion& mo) {
   return r;
 }
 
-Vec4 inverse_forces(const Model& m, const Motion& mo) {
-  InverseDynamicsResult r;
-  EXPECT_EQ(inverse_dynamics(m, mo.pose, mo.vel, mo.acc, mo.we, r), Status::Ok);
-  return r.F;
-}
+Vec4 inverse_forces(const Model& m, const Motion& mo) { return inverse_dynamics_of(m, mo).F; }
 
 /// The model whose pi is `pi` (the struct's other fields from `base`).
 Model model_with(const Params& base, const ParamVector& pi) {
@@ -130,8 +125,7 @@ TEST(Regressor, FromTheSlidersMeasurementsEqualsFromThePlatformMotion) {
   const Model m = model_of(p);
   for (unsigned seed = 1; seed <= 10; ++seed) {
     const Motion mo = random_motion(m, seed);
-    InverseDynamicsResult id;
-    ASSERT_EQ(inverse_dynamics(m, mo.pose, mo.vel, mo.acc, mo.we, id), Status::Ok);
+    const InverseDynamicsResult id = inverse_dynamics_of(m, mo);
     Vec4 rho, rhod, rhodd;
     for (int i = 0; i < kLegs; ++i) {
       rho[i] = id.q[leg_offset(i)];
