@@ -251,8 +251,9 @@ def main(argv=None):
     lines = ["| | time per simulated second, median (best) | MuJoCo's time / this | max ‖C(q)‖ (m) "
              "| max difference from the reference, position (m) / φ (rad) | forces |", "|---|---|---|---|---|---|"]
     for label, key, c, d, forces in rows:
+        cs, ds = "" if c is None else f"{c:.1e}", "" if d is None else f"{d[0]:.1e} / {d[1]:.1e}"
         lines.append(f"| {label} | {1e3 * median[key]:.2f} ms ({1e3 * best[key]:.2f}) | {t_mj / median[key]:.1f}× | "
-                     f"{'' if c is None else f'{c:.1e}'} | {'' if d is None else f'{d[0]:.1e} / {d[1]:.1e}'} | {forces} |")
+                     f"{cs} | {ds} | {forces} |")
     table = "\n".join(lines)
 
     cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")

@@ -74,7 +74,7 @@ Figure summarise(std::vector<double> v, long per_batch) {
 template <class Body>
 Figure time_per_call(Body&& body) {
   long n = 1;
-  for (double dt = 0; n < (1L << 26); n = static_cast<long>(std::ceil(n * std::clamp(1.2 * effort.batch_s / dt, 2.0, 10.0)))) {
+  for (double dt = 0; n < (1L << 26); n = std::lround(n * std::clamp(1.2 * effort.batch_s / dt, 2.0, 10.0))) {
     const double t0 = bench_now();
     for (long k = 0; k < n; ++k) body();
     if ((dt = bench_now() - t0) >= effort.batch_s) break;
@@ -295,7 +295,7 @@ void line(const char* name, const Figure& f, double baseline, const std::string&
               f.median / baseline, note.c_str());
 }
 void heading(const char* title, const char* ratio) {
-  std::printf("%s\n   %-48s %12s %12s %10s  %s\n", title, "evaluation", "median/call", "min/call", ratio, "target / note");
+  std::printf("%s\n   %-48s %12s %12s %10s  target / note\n", title, "evaluation", "median/call", "min/call", ratio);
 }
 std::string target_mark(double value, double target, const char* unit = "x") {
   char s[48];
@@ -351,8 +351,8 @@ std::array<double, 2> derivatives_section(Core& b) {
       b, "inverse_dynamics_derivatives",
       pkm::inverse_dynamics_derivatives(b.model, nudge(pk, b.p, k++), b.pd, b.pdd, Wrench::Zero(), d), d.dp(0, 0));
   const Figure id1 = id();
-  const Figure reg = PKM_TIMED(b, "regressor", pkm::regressor(b.model, nudge(pk, b.p, k++), b.pd, b.pdd, Wrench::Zero(), rs),
-                               rs.Y(0, 0));
+  const Figure reg = PKM_TIMED(
+      b, "regressor", pkm::regressor(b.model, nudge(pk, b.p, k++), b.pd, b.pdd, Wrench::Zero(), rs), rs.Y(0, 0));
   const Figure id2 = id();
   Vec4 rho, rhod, rhodd;  // the sliders' motion, from the same inverse dynamics
   b.check(pkm::inverse_dynamics(b.model, b.p, b.pd, b.pdd, Wrench::Zero(), r, false), "inverse_dynamics");
@@ -461,7 +461,8 @@ RunInfo plant_run(Core& b, const pkm::SolverSettings& st, pkm::InputSignal input
   for (long k = 0; k <= b.n_out; ++k) {
     Pose q = b.p0, qd, qdd;
     if (!at_rest) b.path.eval(static_cast<double>(k) * b.h, q, qd, qdd);
-    info.err = std::max(info.err, (last.states[static_cast<size_t>(k)].head<3>() - q.head<3>()).lpNorm<Eigen::Infinity>());
+    const Vec8& x = last.states[static_cast<size_t>(k)];
+    info.err = std::max(info.err, (x.head<3>() - q.head<3>()).lpNorm<Eigen::Infinity>());
   }
   return info;
 }

@@ -109,7 +109,8 @@ static int load_mujoco(const char* mjcf, const char* state, mjModel** m, mjData*
   *m = mj_loadXML(mjcf, NULL, error, sizeof error);
   *d = *m ? mj_makeData(*m) : NULL;
   ok = *m && *d && fp && (*m)->nq == 16 && (*m)->nv == 16;
-  for (i = 0; ok && i < 48; ++i) ok = fscanf(fp, "%lf", &(i < 16 ? (*d)->qpos : i < 32 ? (*d)->qvel : (*d)->qacc)[i % 16]) == 1;
+  for (i = 0; ok && i < 48; ++i)
+    ok = fscanf(fp, "%lf", &(i < 16 ? (*d)->qpos : i < 32 ? (*d)->qvel : (*d)->qacc)[i % 16]) == 1;
   if (fp) fclose(fp);
   if (!ok) fprintf(stderr, "pkm_fmu_bench inverse: cannot load %s / %s %s\n", mjcf, state, error);
   return ok;

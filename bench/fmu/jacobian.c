@@ -112,8 +112,9 @@ static int jacobian_run(const Plant* plant, const Options* o) {
   printf("\n");
   for (kind = CASE_FMI; kind < N_CASES; kind += 2) {
     const double target = 2.0 + med[kind + 1] / med[CASE_CAPI], ratio = med[kind] / med[CASE_CAPI];
-    printf("%s/(a) %.2f, target <= 2 + %s/(a) = %.2f  %s; FMI overhead %.3f us a call\n", kind == CASE_FMI ? "(b)" : "(d)",
-           ratio, kind == CASE_FMI ? "(c)" : "(e)", target, ratio <= target ? "ok" : "OVER", med[kind + 1] / N_KNOWNS);
+    printf("%s/(a) %.2f, target <= 2 + %s/(a) = %.2f  %s; FMI overhead %.3f us a call\n",
+           kind == CASE_FMI ? "(b)" : "(d)", ratio, kind == CASE_FMI ? "(c)" : "(e)", target,
+           ratio <= target ? "ok" : "OVER", med[kind + 1] / N_KNOWNS);
   }
   printf("(b), (d) against (a) at the last point: largest |difference| %.2e, relative to the largest entry %.2e\n",
          diff, scale > 0.0 ? diff / scale : diff);

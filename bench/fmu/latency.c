@@ -24,7 +24,7 @@
 
 static double F[TICKS][4], dF[TICKS][4];
 
-/* The median, p99, p99.9 and the largest of sorted[0..n-1] (us), and the p99.9 (max_ratio: the largest) over the median. */
+/* The median, p99, p99.9 and largest of sorted[0..n-1] (us); the p99.9 (max_ratio: the largest) over the median. */
 static void quantiles(const char* name, const double* sorted, size_t n, int max_ratio) {
   const double median = bench_quantile(sorted, n, 0.5), p999 = bench_quantile(sorted, n, 0.999);
   printf("%-44s %9.3f %9.3f %9.3f %9.3f   %s %5.2f\n", name, 1e6 * median, 1e6 * bench_quantile(sorted, n, 0.99),
