@@ -10,8 +10,9 @@
 #include <string.h>
 #include <time.h>
 #if defined(_WIN32)
+#ifndef NOMINMAX
 #define NOMINMAX
-#define WIN32_LEAN_AND_MEAN
+#endif
 #include <windows.h>
 #else
 #include <sys/utsname.h>
