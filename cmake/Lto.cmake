@@ -4,9 +4,8 @@
 # tests (pkm_core, pkm_capi, pkm_fmi_models, pkm_autotest_lib) are compiled
 # to fat LTO objects (the intermediate code and ordinary machine code), so
 # that the tests and the build tools link the machine code without a
-# link-time optimisation pass of their own: about 20 such links of 10-30 s
-# each were a third of the test command's build. The tests that check the shipped binaries load the
-# FMUs themselves (dlopen), which are optimised at link time as before.
+# link-time optimisation pass of their own. The tests that check the shipped
+# binaries load the FMUs themselves (dlopen), optimised at link time.
 #
 #   PKM_LTO  (option, ON) in Release builds; OFF: no LTO anywhere.
 #   pkm_without_lto(<target>...)  links those targets without LTO;

@@ -50,11 +50,11 @@ foreach(_t IN ITEMS win64 aarch64)
   add_custom_target(pkm_sundials_${_t}
     COMMAND ${PROJECT_SOURCE_DIR}/scripts/cross_sundials.sh ${_t} ${_prefix}
     COMMENT "Static CVODE for ${_t} (cached in ${_prefix})" VERBATIM)
-  # Windows also builds the tick bench, compared with linux64's below (under
-  # qemu a timing says nothing about aarch64 hardware).
+  # Windows also builds the core bench, its ticks compared with linux64's
+  # below (under qemu a timing says nothing about aarch64 hardware).
   set(_extra_targets)
   if(_t STREQUAL "win64")
-    set(_extra_targets pkm_tick_bench)
+    set(_extra_targets pkm_bench)
   endif()
   set(_products)
   foreach(_id IN ITEMS PKM4PUU PKM4PUU_Inverse)
@@ -83,12 +83,12 @@ foreach(_t IN ITEMS win64 aarch64)
              COMMAND ${CMAKE_CTEST_COMMAND} --test-dir ${_bin} --output-on-failure --no-tests=error)
     set_tests_properties(platform_${_t}_fmi_tests PROPERTIES FIXTURES_REQUIRED linux64_traces TIMEOUT 900)
     if(PKM_BUILD_BENCHMARKS AND _t STREQUAL "win64")
-      # The tick bench built for both, run alternately under wine: the
-      # ratio to linux64 against its 1.2x target (printed, not asserted)
-      # and the poses after 1 s within 1e-12 (bench/platform_ticks.py).
+      # The core bench's ticks built for both, run alternately under wine:
+      # the ratio to linux64 against its 1.2x target (printed, not asserted)
+      # and the poses after 1 s within 1e-12 (tests/platform_ticks.py).
       add_test(NAME platform_win64_tick_ratio
-               COMMAND ${PKM_FMU_PYTHON} ${PROJECT_SOURCE_DIR}/bench/platform_ticks.py
-                       --host $<TARGET_FILE:pkm_tick_bench> --other ${_bin}/bench/pkm_tick_bench.exe
+               COMMAND ${PKM_FMU_PYTHON} ${PROJECT_SOURCE_DIR}/tests/platform_ticks.py
+                       --host $<TARGET_FILE:pkm_bench> --other ${_bin}/bench/pkm_bench.exe
                        --runner wine --name win64 --rounds 1)
       set_tests_properties(platform_win64_tick_ratio PROPERTIES TIMEOUT 300)
     endif()

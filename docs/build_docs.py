@@ -27,10 +27,11 @@
    the machine, derivatives and robustness checks, and the starting points
    the importers page recommends.
 4. The performance page's tables come from the benchmarks of this build,
-   run short (pkm_bench --quick, pkm_tick_bench, pkm_fmu_bench step, latency
-   and cost with few batches, bench/engines_bench.py --quick), each printed
-   output whole (rows others add appear without editing the page), with the
-   machine, compiler, build type and date of the run.
+   run short (pkm_bench --quick core and ticks, pkm_fmu_bench cost and
+   latency with few batches, bench/engines_bench.py --quick, which runs
+   pkm_fmu_bench compare and inverse), each printed output whole (rows
+   others add appear without editing the page), with the machine, compiler,
+   build type and date of the run; and the test fmu_allocations' table.
 5. The wall time of each step so far, for the performance page; then
    sphinx-build -W --keep-going, on a fresh environment (-E) so that every
    page is read and every warning shows on every run.
@@ -417,18 +418,19 @@ def main():
 
     def run_benchmarks():
         # The performance page: every benchmark of the build, short runs.
-        programs = {n: build / "bench" / n for n in ("pkm_bench", "pkm_tick_bench", "pkm_fmu_bench")}
+        programs = {n: build / d / n for d, n in (("bench", "pkm_bench"), ("bench", "pkm_fmu_bench"),
+                                                  ("tests", "fmu_allocations"))}
         missing = [str(p) for p in programs.values() if not p.is_file()]
         if missing:
             sys.exit(f"build_docs: no {', '.join(missing)}: build them first (cmake --build {build} --target "
-                     "pkm_bench pkm_tick_bench pkm_fmu_bench)")
+                     "pkm_bench pkm_fmu_bench fmu_allocations)")
         write_text(generated / "perf_machine.md", machine_of_run(build))
-        fmu_bench = programs["pkm_fmu_bench"]
+        fmu_bench, core_bench = programs["pkm_fmu_bench"], programs["pkm_bench"]
         bench("pkm_fmu_bench cost", [fmu_bench, "cost", "--batches", "3", "--seconds", "0.5"], "perf_fmu_cost.md")
-        bench("pkm_fmu_bench step", [fmu_bench, "step", "--batches", "5"], "perf_fmu_step.md")
         bench("pkm_fmu_bench latency", [fmu_bench, "latency", "--batches", "100"], "perf_fmu_latency.md")
-        bench("pkm_bench --quick", [programs["pkm_bench"], "--quick"], "perf_pkm_bench.md")
-        bench("pkm_tick_bench", [programs["pkm_tick_bench"]], "perf_tick_bench.md")
+        bench("fmu_allocations", [programs["fmu_allocations"]], "perf_fmu_allocations.md")
+        bench("pkm_bench --quick core", [core_bench, "--quick", "core"], "perf_pkm_bench.md")
+        bench("pkm_bench --quick ticks", [core_bench, "--quick", "ticks"], "perf_pkm_ticks.md")
         if engines_python:
             print(f"build_docs: not run: bench/engines_bench.py ({engines_python}); the performance page's "
                   "include of its tables is missing, so the build fails", flush=True)
@@ -494,7 +496,7 @@ def main():
     step("the examples (closed_loop_control, linearize_lqr, drive_sizing, ssp_cosim, pick_and_place)", run_examples)
     step("pick-and-place (pkm4puu cycle, its table, bench/pick_place_bench.py)", run_pick_and_place)
     step("the tests' printed figures (machine, derivatives, starting points, long run)", run_tests_figures)
-    step("the benchmarks (pkm_bench, pkm_tick_bench, pkm_fmu_bench, engines_bench.py), short", run_benchmarks)
+    step("the benchmarks (pkm_bench, pkm_fmu_bench, engines_bench.py), short", run_benchmarks)
     write_step_times(generated / "perf_docs_times.md")
     step("sphinx-build -W", run_sphinx)
     print(f"build_docs: site in {out}/index.html, {time.monotonic() - total:.1f} s in all")

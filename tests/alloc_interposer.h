@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
 /* The project's one allocation counter: a malloc interposer, linked into
  * the C test harnesses that drive an FMU binary (tests/fmu_allocations.c,
- * tests/fmu_alloc_faults.c), the core's allocation test
- * (tests/core/allocations.cpp) and pkm_bench. The program defines
+ * tests/fmu_alloc_faults.c) and the core's allocation test
+ * (tests/core/allocations.cpp). The program defines
  * malloc, calloc, realloc and the aligned allocators itself (glibc's own
  * implementations, __libc_*, underneath), so every heap allocation of the
  * process -- the FMU's operator new, SUNDIALS' malloc, the C++ runtime

@@ -38,7 +38,7 @@
 #include "fmi2FunctionTypes.h"
 
 #define PKM_HARNESS_NAME "fmu_alloc_faults"
-#include "harness.h"
+#include "fmu_harness.h"
 
 #define STATIC_FORCE 2.655616050 /* N, docs/model.md */
 #define H 1e-3

@@ -31,7 +31,7 @@
 #include "fmi2FunctionTypes.h"
 
 #define PKM_HARNESS_NAME "fmu_allocations"
-#include "harness.h"
+#include "fmu_harness.h"
 
 #define STATIC_FORCE 2.655616050 /* N, docs/model.md "Bodies" */
 #define PI 3.14159265358979323846
@@ -57,30 +57,9 @@ static void quiet_logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2
 }
 
 static int read_refs(const char* text, Refs* r) {
-  static const char* control[12] = PKM_CONTROLLER_OUTPUTS;
-  char name[16];
-  const char* root = strstr(text, "<fmiModelDescription");
-  const char* p = text;
-  int i, ok = 1;
-  if (!root || !attribute(root, strchr(root, '>'), "guid", r->guid, sizeof r->guid)) return 0;
-  for (i = 0; i < 4; ++i) {
-    snprintf(name, sizeof name, "F[%d]", i + 1);
-    ok &= lookup_value_reference(text, name, &r->F[i]);
-  }
-  for (i = 0; i < 12; ++i) ok &= lookup_value_reference(text, control[i], &r->control[i]);
-  ok &= lookup_value_reference(text, "solver", &r->solver);
-  r->n_outputs = 0;
-  while ((p = strstr(p, "<ScalarVariable")) != NULL) {
-    const char* end = strstr(p, "</ScalarVariable>");
-    char buf[64];
-    const char* real;
-    if (!end) break;
-    real = strstr(p, "<Real");
-    if (attribute(p, end, "causality", buf, sizeof buf) && strcmp(buf, "output") == 0 && real && real < end &&
-        attribute(p, end, "valueReference", buf, sizeof buf) && r->n_outputs < MAX_OUTPUTS)
-      r->outputs[r->n_outputs++] = (fmi2ValueReference)strtoul(buf, NULL, 10);
-    p = end;
-  }
+  const int ok = read_controller_interface(text, r->guid, sizeof r->guid, r->F, r->control) &&
+                 lookup_value_reference(text, "solver", &r->solver);
+  r->n_outputs = real_outputs(text, r->outputs, MAX_OUTPUTS);
   return ok && r->n_outputs > 12;
 }
 

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "pkm4puu/dynamics/inverse_dynamics.hpp"
 #include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/model/model.hpp"
 #include "reference_model.hpp"
@@ -75,6 +76,36 @@ Eigen::Matrix<double, N, 1> random_vec(unsigned seed, double scale) {
   Eigen::Matrix<double, N, 1> v;
   for (int i = 0; i < N; ++i) v[i] = u(gen);
   return v;
+}
+
+/// A motion of the platform: pose, rate, acceleration, external wrench.
+struct Motion {
+  Pose pose, vel, acc;
+  Wrench we;
+};
+
+/// A random state with accelerations within `acc` (m/s^2; the rotation's ten
+/// times that, rad/s^2) and an external wrench within `we` (N; its moment a
+/// tenth, N*m).
+inline Motion random_motion(const Model& m, unsigned seed, double acc = 2.0, double we = 1.0) {
+  const RandomState s = random_state(m, seed);
+  const Vec4 a = random_vec<4>(seed + 1000, acc), w = random_vec<4>(seed + 2000, we);
+  return {s.pose, s.vel, Pose(a[0], a[1], a[2], 10.0 * a[3]), Wrench(w[0], w[1], w[2], 0.1 * w[3])};
+}
+
+/// A path's motion at t (no wrench).
+template <class Path>
+Motion path_motion(const Path& path, double t) {
+  Motion x{Pose::Zero(), Pose::Zero(), Pose::Zero(), Wrench::Zero()};
+  path.eval(t, x.pose, x.vel, x.acc);
+  return x;
+}
+
+/// The inverse dynamics of a motion (a failure where it does not solve).
+inline InverseDynamicsResult inverse_dynamics_of(const Model& m, const Motion& mo) {
+  InverseDynamicsResult r;
+  EXPECT_EQ(inverse_dynamics(m, mo.pose, mo.vel, mo.acc, mo.we, r), Status::Ok);
+  return r;
 }
 
 /// Fourth-order central difference of s -> f(s) at s = 0.

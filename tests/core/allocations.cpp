@@ -5,8 +5,7 @@
 // sliders), and 1000 one-ms RK4 Plant::advance calls after initialisation
 // (the FMU's tick, tests/fmu_allocations.c, rests on these). Counted by the
 // malloc interposer (tests/alloc_interposer.c: every malloc-family call of
-// the process, operator new included); pkm_bench prints the same windows'
-// counts beside its timings.
+// the process, operator new included).
 #include <gtest/gtest.h>
 
 #include <vector>

@@ -14,7 +14,6 @@
 #include "pkm4puu/kinematics/actuator_positions.hpp"
 #include "pkm4puu/dynamics/state_derivative.hpp"
 #include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
-#include "pkm4puu/dynamics/leg_lanes_derivatives.hpp"
 #include "pkm4puu/integrators/rk4.hpp"
 #include "test_support.hpp"
 
@@ -195,28 +194,6 @@ TEST(ForwardDerivatives, LanesMatchTheLegByLegAssemblyToRounding) {
       EXPECT_LT(eB, 1e-12);
       EXPECT_LT(eJ, 1e-12);
       EXPECT_LT(eR, 1e-12);
-    }
-  }
-}
-
-TEST(ForwardDerivatives, EveryLaneVariantGivesTheSameBits) {
-  // The same template for one leg, SSE2/NEON pairs and AVX, no contraction.
-  const Model m = model_of(every_machine_term());
-  for (const Case& c : kCases) {
-    SCOPED_TRACE(c.name);
-    const Vec16 f = generalized_forces(m, kF, kTau, kWe);
-    LegPartialSums ref;
-    ASSERT_EQ(leg_partial_sums(m, platform_config(c.pose), c.vel, f, kStopsFromState, ref, LegLanes::Scalar),
-              Status::Ok);
-    for (LegLanes kind : {LegLanes::Generic, LegLanes::Avx, LegLanes::Best}) {
-      if (!lanes_available(kind)) continue;
-      LegPartialSums out;
-      ASSERT_EQ(leg_partial_sums(m, platform_config(c.pose), c.vel, f, kStopsFromState, out, kind), Status::Ok);
-      EXPECT_EQ(out.pdd, ref.pdd);
-      EXPECT_EQ(out.dp, ref.dp);
-      EXPECT_EQ(out.dpd, ref.dpd);
-      EXPECT_EQ(out.J_rho, ref.J_rho);
-      EXPECT_EQ(out.drhod_dp, ref.drhod_dp);
     }
   }
 }

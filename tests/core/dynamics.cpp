@@ -77,17 +77,14 @@ TEST(Dynamics, InverseDynamicsSatisfiesEquationOneWithExternalWrench) {
   // external wrench on the platform, at random states and accelerations.
   const Model m = default_model();
   for (unsigned seed = 1; seed <= 6; ++seed) {
-    const RandomState s = random_state(m, seed);
-    const Pose acc = random_vec<4>(50 + seed, 2.0);
-    const Wrench we = random_vec<4>(70 + seed, 0.5);
-    InverseDynamicsResult r;
-    ASSERT_EQ(inverse_dynamics(m, s.pose, s.vel, acc, we, r), Status::Ok);
+    const Motion mo = random_motion(m, seed, 2.0, 0.5);
+    const InverseDynamicsResult r = inverse_dynamics_of(m, mo);
     Mat16 M;
     mass_matrix(m, r.q, M);
     Mat12x16 Cq;
     constraint_jacobian(m, r.q, Cq);
     const Vec16 lhs = M * r.qdd + coriolis(m, r.q, r.qd) + gravity(m, r.q) + Cq.transpose() * r.lambda;
-    EXPECT_LT((lhs - generalized_forces(r.F, we)).lpNorm<Eigen::Infinity>(), 1e-12);
-    EXPECT_LT((r.qdd.segment<4>(kPlatform) - acc).lpNorm<Eigen::Infinity>(), 1e-12);
+    EXPECT_LT((lhs - generalized_forces(r.F, mo.we)).lpNorm<Eigen::Infinity>(), 1e-12);
+    EXPECT_LT((r.qdd.segment<4>(kPlatform) - mo.acc).lpNorm<Eigen::Infinity>(), 1e-12);
   }
 }

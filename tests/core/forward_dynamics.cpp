@@ -40,17 +40,15 @@ TEST(ForwardDynamics, InvertsInverseDynamics) {
   // give that acceleration and the same multipliers back.
   const Model m = default_model();
   for (unsigned seed = 1; seed <= 8; ++seed) {
-    const RandomState s = random_state(m, seed);
-    const Pose acc = random_vec<4>(400 + seed, 3.0);
-    const Wrench we = random_vec<4>(500 + seed, 0.3);
-    InverseDynamicsResult r;
-    ASSERT_EQ(inverse_dynamics(m, s.pose, s.vel, acc, we, r), Status::Ok);
+    const Motion mo = random_motion(m, seed, 3.0, 0.3);
+    const InverseDynamicsResult r = inverse_dynamics_of(m, mo);
     for (int k = 0; k < 3; ++k) {
       Vec16 qdd;
       Vec12 lam;
-      ASSERT_EQ(forward_dynamics(m, static_cast<Formulation>(k), r.q, r.qd, generalized_forces(r.F, we), qdd, lam),
+      ASSERT_EQ(forward_dynamics(m, static_cast<Formulation>(k), r.q, r.qd, generalized_forces(r.F, mo.we), qdd, lam),
                 Status::Ok);
-      EXPECT_LT((qdd.segment<4>(kPlatform) - acc).lpNorm<Eigen::Infinity>(), 1e-10 * acc.lpNorm<Eigen::Infinity>());
+      EXPECT_LT((qdd.segment<4>(kPlatform) - mo.acc).lpNorm<Eigen::Infinity>(),
+                1e-10 * mo.acc.lpNorm<Eigen::Infinity>());
       EXPECT_LT(rel_diff(lam, r.lambda), 1e-10);
     }
   }
@@ -75,13 +73,13 @@ TEST(ForwardDynamics, StateDerivativeHotPathEqualsFullEvaluation) {
 
 namespace {
 
-// The legs' lanes of the hot path (ReducedDynamics::platform_derivative) that
-// this processor can run: the scalar instance of the same template, the
-// baseline lanes and, where the processor has it, the AVX variant.
-std::vector<ReducedDynamics::LegLanes> lane_kernels() {
-  using K = ReducedDynamics::LegLanes;
-  std::vector<K> k = {K::Best, K::Scalar, K::Generic};
-  if (lanes_available(K::Avx)) k.push_back(K::Avx);
+// The copies of the hot path's legs (ReducedDynamics::platform_derivative)
+// that this build and processor run: the scalar instance of the same
+// template, the baseline lanes and, where the processor has it, AVX.
+std::vector<lanes::Kernel> lane_kernels() {
+  using K = lanes::Kernel;
+  std::vector<K> k = {K::Best, K::Scalar, K::Baseline};
+  if (PKM_LANES_AVX_DISPATCH && lanes::cpu_runs_avx()) k.push_back(K::Avx);
   return k;
 }
 

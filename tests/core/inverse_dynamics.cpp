@@ -130,27 +130,3 @@ TEST(InverseDynamics, ReducedGivesTheGeneralPathsStatuses) {
   }
 }
 
-TEST(InverseDynamics, BaselineLanesGiveTheSameBitsAsAvx) {
-  // Model::avx picks the lanes' AVX variant where the processor has it; the
-  // baseline variant (SSE2 pairs) runs the same expressions in the same order.
-  Model avx = model_of(every_machine_term());
-  Model base = avx;
-  base.avx = false;
-  if (!avx.avx) GTEST_SKIP() << "no AVX here: only the baseline variant runs";
-  for (unsigned seed = 1; seed <= 50; ++seed) {
-    const RandomState s = random_state(avx, seed);
-    const Pose acc = random_vec<4>(3000 + seed, 3.0);
-    const Wrench we = random_vec<4>(4000 + seed, 0.5);
-    InverseDynamicsResult a, b;
-    ASSERT_EQ(inverse_dynamics(avx, s.pose, s.vel, acc, we, a), Status::Ok);
-    ASSERT_EQ(inverse_dynamics(base, s.pose, s.vel, acc, we, b), Status::Ok);
-    EXPECT_EQ(a.F, b.F);
-    EXPECT_EQ(a.q, b.q);
-    EXPECT_EQ(a.lambda, b.lambda);
-    InverseActuators x, y;
-    ASSERT_EQ(inverse_actuators(avx, s.pose, s.vel, acc, we, x), Status::Ok);
-    ASSERT_EQ(inverse_actuators(base, s.pose, s.vel, acc, we, y), Status::Ok);
-    EXPECT_EQ(x.F, y.F);
-    EXPECT_EQ(x.J_rho, y.J_rho);
-  }
-}

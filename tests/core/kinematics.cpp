@@ -117,25 +117,20 @@ TEST(Kinematics, ServoProblemsMatchDerivativesOfThePath) {
   const Model m = default_model();
   const RestToRest path;
   auto q_at = [&](double t) {
-    Pose p, pd, pdd;
-    path.eval(t, p, pd, pdd);
     Vec16 q;
-    EXPECT_EQ(closed_form_position(m, p, q), Status::Ok);
+    EXPECT_EQ(closed_form_position(m, path_motion(path, t).pose, q), Status::Ok);
     return q;
   };
   for (double t : {0.3, 0.7, 1.0, 1.45}) {
-    Pose p, pd, pdd;
-    path.eval(t, p, pd, pdd);
+    const Motion x = path_motion(path, t);
     const Vec16 q = q_at(t);
     Vec16 qd, qdd;
-    ASSERT_EQ(solve_velocity(m, q, pd, qd), Status::Ok);
-    ASSERT_EQ(solve_acceleration(m, q, qd, pdd, qdd), Status::Ok);
+    ASSERT_EQ(solve_velocity(m, q, x.vel, qd), Status::Ok);
+    ASSERT_EQ(solve_acceleration(m, q, qd, x.acc, qdd), Status::Ok);
     const Vec16 qd_fd = d_ds([&](double e) { return q_at(t + e); }, 1e-4);
     const Vec16 qdd_fd = d_ds([&](double e) {
-      Pose p2, pd2, pdd2;
-      path.eval(t + e, p2, pd2, pdd2);
       Vec16 v;
-      EXPECT_EQ(solve_velocity(m, q_at(t + e), pd2, v), Status::Ok);
+      EXPECT_EQ(solve_velocity(m, q_at(t + e), path_motion(path, t + e).vel, v), Status::Ok);
       return v;
     }, 1e-4);
     EXPECT_LT((qd - qd_fd).lpNorm<Eigen::Infinity>(), 1e-10) << "t = " << t;

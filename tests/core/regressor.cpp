@@ -14,38 +14,16 @@ using namespace pkm_test;
 
 namespace {
 
-/// A machine with every term of pi non-zero: rotors, friction, an
-/// off-centre payload (its payload values are spelled out again by the
-/// round-trip test below).
-Params machine_params() {
-  Params p;
-  p.rotor_inertia = 2e-7;
-  p.friction_viscous = 3.0;
-  p.friction_coulomb = 0.8;
-  p.friction_velocity = 0.02;
-  p.payload_mass = 0.2;
-  p.payload_com = {0.012, -0.007};
-  p.payload_Izz = 1.5e-4;
-  return p;
+// A machine with every term of pi non-zero: every_machine_term() (rotors,
+// friction, an off-centre payload).
+
+RegressorSample regressor_at(const Model& m, const Motion& mo) {
+  RegressorSample r;
+  EXPECT_EQ(regressor(m, mo.pose, mo.vel, mo.acc, mo.we, r), Status::Ok);
+  return r;
 }
 
-struct Motion {
-  Pose pose, vel, acc;
-  Wrench we;
-};
-
-Motion random_motion(const Model& m, unsigned seed) {
-  const RandomState s = random_state(m, seed);
-  const Vec4 a = random_vec<4>(seed + 1000, 1.0);
-  const Vec4 w = random_vec<4>(seed + 2000, 1.0);
-  return {s.pose, s.vel, Pose(2.0 * a[0], 2.0 * a[1], 2.0 * a[2], 20.0 * a[3]), Wrench(w[0], w[1], w[2], 0.1 * w[3])};
-}
-
-Vec4 inverse_forces(const Model& m, const Motion& mo) {
-  InverseDynamicsResult r;
-  EXPECT_EQ(inverse_dynamics(m, mo.pose, mo.vel, mo.acc, mo.we, r), Status::Ok);
-  return r.F;
-}
+Vec4 inverse_forces(const Model& m, const Motion& mo) { return inverse_dynamics_of(m, mo).F; }
 
 /// The model whose pi is `pi` (the struct's other fields from `base`).
 Model model_with(const Params& base, const ParamVector& pi) {
@@ -58,17 +36,17 @@ Model model_with(const Params& base, const ParamVector& pi) {
 }  // namespace
 
 TEST(Regressor, ParameterVectorRoundTripsThroughTheParameterStruct) {
-  const Params p = machine_params();
+  const Params p = every_machine_term();
   const ParamVector pi = parameter_vector(p);
   // The payload's entries as the model uses them (model.cpp): m c, I + m |c|^2.
-  EXPECT_EQ(pi[kPiPayloadMx], 0.2 * 0.012);
-  EXPECT_EQ(pi[kPiPayloadMy], 0.2 * -0.007);
-  EXPECT_DOUBLE_EQ(pi[kPiPayloadIzzP], 1.5e-4 + 0.2 * (0.012 * 0.012 + 0.007 * 0.007));
+  EXPECT_EQ(pi[kPiPayloadMx], 0.3 * 0.02);  // every_machine_term()'s payload: 0.3 kg at (0.02, -0.012) m
+  EXPECT_EQ(pi[kPiPayloadMy], 0.3 * -0.012);
+  EXPECT_DOUBLE_EQ(pi[kPiPayloadIzzP], 1.2e-4 + 0.3 * (0.02 * 0.02 + 0.012 * 0.012));
   Params q;
   ASSERT_EQ(apply_parameter_vector(pi, q), Status::Ok);
   EXPECT_LT((parameter_vector(q) - pi).cwiseAbs().maxCoeff(), 1e-18);
-  EXPECT_NEAR(q.payload_com[0], 0.012, 1e-17);
-  EXPECT_NEAR(q.payload_Izz, 1.5e-4, 1e-19);
+  EXPECT_NEAR(q.payload_com[0], 0.02, 1e-17);
+  EXPECT_NEAR(q.payload_Izz, 1.2e-4, 1e-19);
   for (int j = 0; j < kParams; ++j) EXPECT_NE(regressor_param_info(j).name, nullptr);
   EXPECT_EQ(regressor_param_info(kParams).name, nullptr);
 }
@@ -89,15 +67,14 @@ TEST(Regressor, RefusesParameterVectorsThatAreNoParameterSet) {
 
 TEST(Regressor, TimesTheParametersEqualsInverseDynamicsWithTheMachine) {
   for (const bool machine : {false, true}) {
-    const Params p = machine ? machine_params() : Params{};
+    const Params p = machine ? every_machine_term() : Params{};
     const Model m = model_of(p);
     const ParamVector pi = parameter_vector(p);
     for (unsigned seed = 1; seed <= 40; ++seed) {
       const Motion mo = random_motion(m, seed);
-      RegressorSample r;
-      ASSERT_EQ(regressor(m, mo.pose, mo.vel, mo.acc, mo.we, r), Status::Ok);
-      const Vec4 F = inverse_forces(m, mo);
-      EXPECT_LT(rel_diff(Vec4(r.Y * pi + r.F0), F), 1e-12) << "seed " << seed << " machine " << machine;
+      const RegressorSample r = regressor_at(m, mo);
+      EXPECT_LT(rel_diff(Vec4(r.Y * pi + r.F0), inverse_forces(m, mo)), 1e-12)
+          << "seed " << seed << " machine " << machine;
     }
   }
 }
@@ -105,13 +82,11 @@ TEST(Regressor, TimesTheParametersEqualsInverseDynamicsWithTheMachine) {
 TEST(Regressor, EachColumnIsTheInverseDynamicsSlopeInItsParameter) {
   // The forces are linear in pi: a central difference is exact up to
   // rounding, with a step of a hundredth of each parameter's own size.
-  const Params p = machine_params();
-  const Model m = model_of(p);
+  const Params p = every_machine_term();
   const ParamVector pi = parameter_vector(p);
   for (unsigned seed = 1; seed <= 6; ++seed) {
-    const Motion mo = random_motion(m, seed);
-    RegressorSample r;
-    ASSERT_EQ(regressor(m, mo.pose, mo.vel, mo.acc, mo.we, r), Status::Ok);
+    const Motion mo = random_motion(model_of(p), seed);
+    const RegressorSample r = regressor_at(model_of(p), mo);
     for (int j = 0; j < kParams; ++j) {
       const double h = 0.01 * std::fabs(pi[j]);  // I_rod keeps its triangle inequality
       ParamVector up = pi, down = pi;
@@ -128,7 +103,7 @@ TEST(Regressor, EachColumnIsTheInverseDynamicsSlopeInItsParameter) {
 }
 
 TEST(Regressor, BeyondAStopTheStopForceIsInTheOffset) {
-  Params p = machine_params();
+  Params p = every_machine_term();
   p.stop_damping = 0.0;  // the stop pushes with k delta whatever the rate
   const Model m0 = model_of(p);
   const Motion mo = random_motion(m0, 3);
@@ -146,12 +121,11 @@ TEST(Regressor, BeyondAStopTheStopForceIsInTheOffset) {
 }
 
 TEST(Regressor, FromTheSlidersMeasurementsEqualsFromThePlatformMotion) {
-  const Params p = machine_params();
+  const Params p = every_machine_term();
   const Model m = model_of(p);
   for (unsigned seed = 1; seed <= 10; ++seed) {
     const Motion mo = random_motion(m, seed);
-    InverseDynamicsResult id;
-    ASSERT_EQ(inverse_dynamics(m, mo.pose, mo.vel, mo.acc, mo.we, id), Status::Ok);
+    const InverseDynamicsResult id = inverse_dynamics_of(m, mo);
     Vec4 rho, rhod, rhodd;
     for (int i = 0; i < kLegs; ++i) {
       rho[i] = id.q[leg_offset(i)];
@@ -170,32 +144,8 @@ TEST(Regressor, FromTheSlidersMeasurementsEqualsFromThePlatformMotion) {
   }
 }
 
-TEST(Regressor, BaselineLanesGiveTheSameBitsAsAvx) {
-  // Model::avx picks the lanes' AVX variant (regressor_lanes.cpp) where the
-  // processor has it; the baseline variant runs the same expressions in the
-  // same order, so both entry points agree to the bit.
-  const Model avx = model_of(machine_params());
-  Model base = avx;
-  base.avx = false;
-  if (!avx.avx) GTEST_SKIP() << "no AVX here: only the baseline variant runs";
-  for (unsigned seed = 1; seed <= 20; ++seed) {
-    const Motion mo = random_motion(avx, seed);
-    RegressorSample a, b;
-    ASSERT_EQ(regressor(avx, mo.pose, mo.vel, mo.acc, mo.we, a), Status::Ok);
-    ASSERT_EQ(regressor(base, mo.pose, mo.vel, mo.acc, mo.we, b), Status::Ok);
-    EXPECT_EQ(a.Y, b.Y) << "seed " << seed;
-    EXPECT_EQ(a.F0, b.F0) << "seed " << seed;
-    RegressorSample ja, jb;
-    ja.pose = jb.pose = Pose(0.0, 0.0, 0.05, 0.0);
-    ASSERT_EQ(joint_regressor(avx, a.rho, a.rhod, Vec4::Zero(), mo.we, ja), Status::Ok);
-    ASSERT_EQ(joint_regressor(base, a.rho, a.rhod, Vec4::Zero(), mo.we, jb), Status::Ok);
-    EXPECT_EQ(ja.pose, jb.pose) << "seed " << seed;
-    EXPECT_EQ(ja.Y, jb.Y) << "seed " << seed;
-  }
-}
-
 TEST(Regressor, RefusesNonFiniteAndUnreachableInput) {
-  const Model m = model_of(machine_params());
+  const Model m = model_of(every_machine_term());
   RegressorSample r;
   const double nan = std::nan("");
   EXPECT_EQ(regressor(m, Pose(0, 0, 0.05, nan), Pose::Zero(), Pose::Zero(), Wrench::Zero(), r), Status::NonFinite);
@@ -212,7 +162,7 @@ TEST(Regressor, BaseParametersFromTheColumnPivotedQrOfStackedRegressors) {
   // docs/calibration.md: of the 14 parameters 12 combinations are
   // identifiable; the platform's and the payload's mass, and their inertias
   // about P, enter only as sums.
-  const Params p = machine_params();
+  const Params p = every_machine_term();
   const Model m = model_of(p);
   constexpr int kSamples = 60;
   Eigen::MatrixXd W(4 * kSamples, kParams);

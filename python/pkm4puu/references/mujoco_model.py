@@ -95,8 +95,8 @@ def mjcf(g=spec.G, timestep=1e-3, integrator="RK4", solref=DEFAULT_SOLREF, solim
     # Everything this model does not use is switched off (contacts, springs,
     # dampers, limits, friction loss, sensors, control clamping, collision
     # filtering, midphase) and so is the solver's warm start: the results are
-    # bit-identical and mj_step is ~7% faster (engines_bench.py times MuJoCo
-    # at its best).
+    # bit-identical and mj_step faster, so the engines benchmark times MuJoCo
+    # at its best.
     damper = "" if machine is not None else ' damper="disable"'
     flags = (f'<flag contact="disable" spring="disable"{damper} limit="disable" frictionloss="disable" '
              'sensor="disable" clampctrl="disable" filterparent="disable" midphase="disable" warmstart="disable"'

@@ -46,7 +46,7 @@ const pkm::Model* InverseData::current_model(Context& ctx, const char* function,
 
 Status InverseData::update_outputs(Context& ctx, unsigned groups) {
   // After initialisation the instance's model, as current_model gives it,
-  // without the optional (its storage zeroed on every call: 20 ns of a tick).
+  // without the optional (whose storage would be zeroed on every call).
   if (!ctx.initialization_mode && model) return compute_outputs(ctx, *model, groups);
   std::optional<pkm::Model> temporary;
   const pkm::Model* m = current_model(ctx, "get", temporary);

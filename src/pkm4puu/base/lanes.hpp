@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// Four doubles as lanes: the legs' arithmetic of the derivative's hot path
-// (reduced_dynamics.cpp) written once, for one leg (T = double) or for the
-// four legs at once (T = Pack), with the same operations per lane.
+// Four doubles as lanes: the legs' arithmetic of the lane kernels (the state
+// derivative and its Jacobians, the inverse dynamics, the regressor) written
+// once, for one leg (T = double) or for the four legs at once (T = Pack),
+// with the same operations per lane.
 //
 // IEEE addition, subtraction, multiplication, division and square root are
 // correctly rounded lane by lane, so a lane holds the same bits as the
@@ -19,6 +20,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
+#include <utility>
 
 #if (defined(__GNUC__) || defined(__clang__)) && !defined(PKM_LANES_PORTABLE)
 #define PKM_LANES_VECTOR_EXTENSIONS 1
@@ -219,7 +222,11 @@ PKM_LANES_INLINE double sqrt(double x) { return std::sqrt(x); }
 
 /// Whether this x86-64 processor and its operating system run AVX (CPUID's
 /// AVX and OSXSAVE bits, XCR0's XMM and YMM state): asked once per model
-/// (make_model), so no static data of our own holds it.
+/// (make_model), so no static data of our own holds it. Out of line, so
+/// that a caller's registers stay clear of CPUID's.
+#if PKM_LANES_VECTOR_EXTENSIONS
+__attribute__((noinline, cold))
+#endif
 inline bool cpu_runs_avx() {
 #if PKM_LANES_VECTOR_EXTENSIONS && defined(__x86_64__)
   unsigned a = 0, b = 0, c = 0, d = 0;
@@ -232,6 +239,58 @@ inline bool cpu_runs_avx() {
 #else
   return false;
 #endif
+}
+
+/// The compiled copies of a lane kernel, one template each: Scalar (one leg
+/// at a time, T = double, where the kernel has that instance), Baseline (the
+/// four legs as lanes in the baseline instruction set: SSE2 pairs on x86-64,
+/// NEON on aarch64, the plain struct elsewhere), Avx (one AVX register, where
+/// PKM_LANES_AVX_DISPATCH). Best is Avx where the model's processor runs it
+/// (Model::avx), else Baseline. Every copy gives the same bits.
+enum class Kernel { Best, Scalar, Baseline, Avx };
+
+/// The copy that runs for `kind`: Best resolved (Avx where `model_avx`,
+/// Model::avx, and the build has it, else Baseline); false where that copy
+/// is missing (Scalar of a kernel without one; Avx where the build or the
+/// processor has none). The one place a lane kernel's copy is chosen.
+PKM_LANES_INLINE bool resolve(Kernel kind, bool model_avx, bool has_scalar, Kernel& copy) {
+  if (kind == Kernel::Best) {  // first: the product's every call
+    copy = PKM_LANES_AVX_DISPATCH && model_avx ? Kernel::Avx : Kernel::Baseline;
+    return true;
+  }
+  copy = kind;
+  if (kind == Kernel::Scalar) return has_scalar;
+  if (kind == Kernel::Avx) return PKM_LANES_AVX_DISPATCH && cpu_runs_avx();
+  return kind == Kernel::Baseline;
+}
+
+/// A kernel's compiled copies: `body` (one PKM_LANES_INLINE function of
+/// the legs as lanes) compiled for the baseline instruction set and, where
+/// PKM_LANES_AVX_DISPATCH, for AVX (no FMA: no contraction, the same bits).
+template <class Fn, Fn* body>
+struct Copies;
+template <class R, class... A, R (*body)(A...)>
+struct Copies<R(A...), body> {
+  static R baseline(A... a) { return body(a...); }
+#if PKM_LANES_AVX_DISPATCH
+  PKM_LANES_AVX_TARGET static R avx(A... a) { return body(a...); }
+#endif
+};
+
+/// Runs the copy of a kernel (K: its Copies; kScalar: its one-leg copy, a
+/// function of the same signature, or nullptr) that resolve() picks for
+/// `kind`, calling it directly; `missing` where that copy is missing.
+template <class K, auto kScalar = nullptr, class R, class... Args>
+PKM_LANES_INLINE R run(Kernel kind, bool model_avx, R missing, Args&&... args) {
+  Kernel copy = Kernel::Baseline;
+  if (!resolve(kind, model_avx, !std::is_null_pointer_v<decltype(kScalar)>, copy)) return missing;
+#if PKM_LANES_AVX_DISPATCH
+  if (copy == Kernel::Avx) return K::avx(std::forward<Args>(args)...);
+#endif
+  if constexpr (!std::is_null_pointer_v<decltype(kScalar)>) {
+    if (copy == Kernel::Scalar) return kScalar(std::forward<Args>(args)...);
+  }
+  return K::baseline(std::forward<Args>(args)...);
 }
 
 /// T's number of lanes and its broadcast constant.

@@ -2,9 +2,8 @@
 // sin and cos of one angle (the platform's phi, once per state derivative).
 //
 // std::sin and std::cos everywhere but Windows, where GCC makes them one
-// call to sincos as on Linux, but MinGW-w64's libm evaluates it in x87
-// long double at about five times glibc's cost (measured under wine on the
-// same machine: 50 ns against 10 ns; five calls in an RK4 tick). There the
+// call to sincos as on Linux, but MinGW-w64's libm evaluates it in x87 long
+// double, several times glibc's cost (docs/performance.md). There the
 // Taylor series below, in doubles, after reducing x by multiples of pi/2:
 // on |r| <= pi/4 the first omitted terms, r^19/19! and r^20/20!, are below
 // 1e-19, so the error is the rounding of the evaluation, within 2 ulp

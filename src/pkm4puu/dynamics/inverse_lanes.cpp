@@ -84,7 +84,7 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
   if (kFull) {
     // The angles (q only) first, stored at once: their divisions and
     // polynomials then run beside the forces' work instead of after it (the
-    // compiler would otherwise sink them to their use, 25 ns later).
+    // compiler would otherwise sink them to their use).
     // leg_inverse_kinematics' theta1 = atan2(qy, qx) + atan2(h', A) lies in
     // (-pi, 3 pi/2]: atan2(s1, c1) + 2 pi where that is below 0 and qy is not.
     const Pack th1 = atan2_lanes(lp.s1, lp.c1);
@@ -190,24 +190,13 @@ PKM_LANES_INLINE Status legs_inverse(const Model& m, const PlatformConfig& pc, c
 }
 
 template <bool kFull>
-Status inverse_legs_generic(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd,
-                            const Wrench& we, InverseDynamicsResult* full, InverseActuators* act) {
-  return legs_inverse<kFull>(m, pc, pd, pdd, we, full, act);
-}
+using InverseCopies = lanes::Copies<decltype(legs_inverse<kFull>), legs_inverse<kFull>>;
 
-#if PKM_LANES_AVX_DISPATCH
-template <bool kFull>
-PKM_LANES_AVX_TARGET Status inverse_legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
-                                                       const Pose& pdd, const Wrench& we, InverseDynamicsResult* full,
-                                                       InverseActuators* act) {
-  return legs_inverse<kFull>(m, pc, pd, pdd, we, full, act);
-}
-#endif
-
-}  // namespace
-
-Status reduced_inverse(const Model& m, const Pose& pose, const Pose& pd, const Pose& pdd, const Wrench& we,
-                       InverseDynamicsResult* full, InverseActuators* act) {
+// Both entry points, inlined: the product's with `kind` the constant Best
+// (only Model::avx is asked at run time), the tests' with the copy asked for.
+PKM_LANES_INLINE Status inverse_entry(const Model& m, const Pose& pose, const Pose& pd, const Pose& pdd,
+                                      const Wrench& we, InverseDynamicsResult* full, InverseActuators* act,
+                                      lanes::Kernel kind) {
   if (!pose.allFinite() || !pd.allFinite() || !pdd.allFinite() || !we.allFinite()) return Status::NonFinite;
   PlatformConfig pc;
 #if defined(__GLIBC__)
@@ -218,13 +207,21 @@ Status reduced_inverse(const Model& m, const Pose& pose, const Pose& pd, const P
 #else
   pc = platform_config(pose);
 #endif
-#if PKM_LANES_AVX_DISPATCH
-  if (m.avx)
-    return full ? inverse_legs_avx<true>(m, pc, pd, pdd, we, full, nullptr)
-                : inverse_legs_avx<false>(m, pc, pd, pdd, we, nullptr, act);
-#endif
-  return full ? inverse_legs_generic<true>(m, pc, pd, pdd, we, full, nullptr)
-              : inverse_legs_generic<false>(m, pc, pd, pdd, we, nullptr, act);
+  if (full)
+    return lanes::run<InverseCopies<true>>(kind, m.avx, Status::InvalidArgument, m, pc, pd, pdd, we, full, nullptr);
+  return lanes::run<InverseCopies<false>>(kind, m.avx, Status::InvalidArgument, m, pc, pd, pdd, we, nullptr, act);
+}
+
+}  // namespace
+
+Status reduced_inverse(const Model& m, const Pose& pose, const Pose& pd, const Pose& pdd, const Wrench& we,
+                       InverseDynamicsResult* full, InverseActuators* act) {
+  return inverse_entry(m, pose, pd, pdd, we, full, act, lanes::Kernel::Best);
+}
+
+Status reduced_inverse(const Model& m, const Pose& pose, const Pose& pd, const Pose& pdd, const Wrench& we,
+                       InverseDynamicsResult* full, InverseActuators* act, lanes::Kernel kind) {
+  return inverse_entry(m, pose, pd, pdd, we, full, act, kind);
 }
 
 }  // namespace pkm

@@ -11,6 +11,7 @@
 // tau_i) (Eq. 10 leg by leg), computed only when asked.
 #pragma once
 
+#include "pkm4puu/base/lanes.hpp"
 #include "pkm4puu/model/model.hpp"
 
 namespace pkm {
@@ -23,8 +24,13 @@ struct InverseActuators;
 /// platform motion (pose, pd, pdd) under the external wrench `we`, into
 /// `full` (q, qd, qdd, lambda, F, tau, beyond_stops) if given, else into
 /// `act`. Status::Unreachable if a leg is out of reach, ::Singular at a leg
-/// or parallel singularity, ::NonFinite for a non-finite argument.
+/// or parallel singularity, ::NonFinite for a non-finite argument,
+/// The Best copy (lanes::Kernel); the overload with `kind` runs the copy
+/// asked for, ::InvalidArgument for one this build, processor or kernel does
+/// not have (it has no one-leg Scalar copy).
 Status reduced_inverse(const Model& m, const Pose& pose, const Pose& pd, const Pose& pdd, const Wrench& we,
                        InverseDynamicsResult* full, InverseActuators* act);
+Status reduced_inverse(const Model& m, const Pose& pose, const Pose& pd, const Pose& pdd, const Wrench& we,
+                       InverseDynamicsResult* full, InverseActuators* act, lanes::Kernel kind);
 
 }  // namespace pkm

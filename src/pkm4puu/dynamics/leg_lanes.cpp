@@ -35,10 +35,6 @@ Status positions_scalar(const Model& m, const PlatformConfig& pc, Vec4& rho) {
   return Status::Ok;
 }
 
-Status positions_generic(const Model& m, const PlatformConfig& pc, Vec4& rho) {
-  return positions_as_lanes(m, pc, rho);
-}
-
 // The four legs as lanes, their contributions summed in leg order
 // ((0 + leg 0) + leg 1) + ... as the scalar accumulation does.
 PKM_LANES_INLINE Status legs_as_lanes(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
@@ -54,89 +50,21 @@ PKM_LANES_INLINE Status legs_as_lanes(const Model& m, const PlatformConfig& pc, 
 
 Status legs_scalar(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
                    LegSums& sums) {
-  for (double& x : sums.mr) x = 0.0;
-  for (double& x : sums.rhs) x = 0.0;
-  for (int i = 0; i < kLegs; ++i) {
-    LegContribution<double> c;
-    const Status s = leg_contribution(m, i, pc, pd, stops, leg_inputs(m, i, f[leg_offset(i)]), c);
-    if (s != Status::Ok) return s;
-    for (int n = 0; n < 10; ++n) sums.mr[n] += c.mr[n];
-    for (int n = 0; n < 4; ++n) sums.rhs[n] += c.rhs[n];
-    sums.rho[i] = c.rho;
-    sums.rhod[i] = c.rhod;
-  }
-  return Status::Ok;
+  return legs_one_at_a_time(m, pc, pd, f, stops, sums);
 }
 
-Status legs_generic(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
-                    LegSums& sums) {
-  return legs_as_lanes(m, pc, pd, f, stops, sums);
-}
-
-#if PKM_LANES_AVX_DISPATCH
-// The same source compiled for AVX (no FMA: no contraction, the same bits),
-// taken where the processor has it (Model::avx, asked once by make_model).
-PKM_LANES_AVX_TARGET Status legs_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
-                                               const Vec16& f, unsigned stops, LegSums& sums) {
-  return legs_as_lanes(m, pc, pd, f, stops, sums);
-}
-PKM_LANES_AVX_TARGET Status positions_avx(const Model& m, const PlatformConfig& pc, Vec4& rho) {
-  return positions_as_lanes(m, pc, rho);
-}
-#endif
-
-using LegsKernel = Status (*)(const Model&, const PlatformConfig&, const Pose&, const Vec16&, unsigned, LegSums&);
-using PositionsKernel = Status (*)(const Model&, const PlatformConfig&, Vec4&);
-struct Kernels {
-  LegsKernel legs;
-  PositionsKernel positions;
-};
-
-// The variant `kind` of the legs' lanes (Best: AVX where model_avx, i.e.
-// Model::avx); false for an AVX variant this build or processor cannot run.
-bool kernels_for(bool model_avx, LegLanes kind, Kernels& k) {
-  using K = LegLanes;
-  k = {legs_generic, positions_generic};
-  switch (kind) {
-    case K::Generic: return true;
-    case K::Scalar: k = {legs_scalar, positions_scalar}; return true;
-    case K::Best:
-#if PKM_LANES_AVX_DISPATCH
-      if (model_avx) k = {legs_avx, positions_avx};
-#else
-      (void)model_avx;
-#endif
-      return true;
-    case K::Avx:
-#if PKM_LANES_AVX_DISPATCH
-      if (!lanes::cpu_runs_avx()) return false;
-      k = {legs_avx, positions_avx};
-      return true;
-#else
-      return false;
-#endif
-  }
-  return false;
-}
+using LegsCopies = lanes::Copies<decltype(legs_as_lanes), legs_as_lanes>;
+using PositionsCopies = lanes::Copies<decltype(positions_as_lanes), positions_as_lanes>;
 
 }  // namespace
 
-bool lanes_available(LegLanes kind) {
-  Kernels k;
-  return kernels_for(false, kind, k);
-}
-
 Status leg_sums(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
-                LegSums& sums, LegLanes kind) {
-  Kernels k;
-  if (!kernels_for(m.avx, kind, k)) return Status::InvalidArgument;
-  return k.legs(m, pc, pd, f, stops, sums);
+                LegSums& sums, lanes::Kernel kind) {
+  return lanes::run<LegsCopies, legs_scalar>(kind, m.avx, Status::InvalidArgument, m, pc, pd, f, stops, sums);
 }
 
-Status lane_actuator_positions(const Model& m, const PlatformConfig& pc, Vec4& rho, LegLanes kind) {
-  Kernels k;
-  if (!kernels_for(m.avx, kind, k)) return Status::InvalidArgument;
-  return k.positions(m, pc, rho);
+Status lane_actuator_positions(const Model& m, const PlatformConfig& pc, Vec4& rho, lanes::Kernel kind) {
+  return lanes::run<PositionsCopies, positions_scalar>(kind, m.avx, Status::InvalidArgument, m, pc, rho);
 }
 
 Status actuator_positions(const Model& m, const Pose& pose, Vec4& rho) {

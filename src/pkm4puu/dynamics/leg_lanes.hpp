@@ -6,21 +6,11 @@
 // lane keeps the scalar expressions' order: the same bits as leg by leg.
 #pragma once
 
+#include "pkm4puu/base/lanes.hpp"
 #include "pkm4puu/kinematics/leg_kinematics.hpp"
 #include "pkm4puu/model/model.hpp"
 
 namespace pkm {
-
-/// The variants of the legs' lanes: the same template, the same bits;
-/// tests run each of them explicitly.
-enum class LegLanes {
-  Best,     // Avx where m.avx (x86-64 GCC/Clang; on Windows with unaligned moves), else Generic
-  Scalar,   // one leg at a time (the same template for double)
-  Generic,  // the baseline instruction set (SSE2 pairs on x86-64, NEON on aarch64)
-  Avx,      // AVX; Status::InvalidArgument where unavailable
-};
-/// Whether this build and processor run the variant.
-bool lanes_available(LegLanes kind);
 
 /// The four legs' sums for the reduced system.
 struct LegSums {
@@ -32,16 +22,16 @@ struct LegSums {
 /// The legs' sums at the platform state (pc, pd) with the applied forces
 /// f (on rho_i at leg_offset(i)) plus the passive joint forces (stops held
 /// as `stops`). On failure the status of the first failing leg
-/// (Unreachable, Singular), as leg by leg; InvalidArgument for an
-/// unavailable variant.
+/// (Unreachable, Singular), as leg by leg; InvalidArgument for a copy
+/// (lanes::Kernel) this build or processor does not have.
 Status leg_sums(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
-                LegSums& sums, LegLanes kind = LegLanes::Best);
+                LegSums& sums, lanes::Kernel kind = lanes::Kernel::Best);
 
 /// The actuator positions rho_1..4 by the legs' inverse kinematics of
 /// leg_sums (actuator_positions without the finiteness check). On failure
 /// Status::Unreachable (the first failing leg's), rho untouched;
-/// InvalidArgument for an unavailable variant.
+/// InvalidArgument for an unavailable copy.
 Status lane_actuator_positions(const Model& m, const PlatformConfig& pc, Vec4& rho,
-                               LegLanes kind = LegLanes::Best);
+                               lanes::Kernel kind = lanes::Kernel::Best);
 
 }  // namespace pkm

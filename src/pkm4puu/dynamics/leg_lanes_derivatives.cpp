@@ -162,10 +162,12 @@ PKM_LANES_INLINE void leg_share(const Model& m, int first, unsigned stops, const
   o.rdp[3] = (na01 * k.a13 + na02 * k.a23) + n0;
 }
 
+// Summed from leg 0's share on, ((s0 + s1) + s2) + s3 as the lanes' sum
+// (not from +0, which would turn a sum of -0s into +0).
 PKM_LANES_INLINE void add_share(const LegShare<double>& s, int leg, LegPartialSums& out) {
   for (int n = 0; n < 16; ++n) {
-    out.dp(n / 4, n % 4) += s.dp[n];
-    out.dpd(n / 4, n % 4) += s.dpd[n];
+    out.dp(n / 4, n % 4) = leg == 0 ? s.dp[n] : out.dp(n / 4, n % 4) + s.dp[n];
+    out.dpd(n / 4, n % 4) = leg == 0 ? s.dpd[n] : out.dpd(n / 4, n % 4) + s.dpd[n];
   }
   for (int c = 0; c < 4; ++c) {
     out.J_rho(leg, c) = s.jr[c];
@@ -176,22 +178,10 @@ PKM_LANES_INLINE void add_share(const LegShare<double>& s, int leg, LegPartialSu
 Status partials_scalar(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
                        LegPartialSums& out) {
   LegSums& sums = out.sums;
-  for (double& v : sums.mr) v = 0.0;
-  for (double& v : sums.rhs) v = 0.0;
   LegKeep<double> keep[kLegs];
-  for (int i = 0; i < kLegs; ++i) {
-    LegContribution<double> c;
-    const Status s = leg_contribution(m, i, pc, pd, stops, leg_inputs(m, i, f[leg_offset(i)]), c, &keep[i]);
-    if (s != Status::Ok) return s;
-    for (int n = 0; n < 10; ++n) sums.mr[n] += c.mr[n];
-    for (int n = 0; n < 4; ++n) sums.rhs[n] += c.rhs[n];
-    sums.rho[i] = c.rho;
-    sums.rhod[i] = c.rhod;
-  }
-  const Status s = ReducedDynamics::solve_leg_sums(m, f.segment<4>(kPlatform), sums, pc, pd[3], out.pdd);
+  Status s = legs_one_at_a_time(m, pc, pd, f, stops, sums, keep);
+  if (s == Status::Ok) s = ReducedDynamics::solve_leg_sums(m, f.segment<4>(kPlatform), sums, pc, pd[3], out.pdd);
   if (s != Status::Ok) return s;
-  out.dp.setZero();
-  out.dpd.setZero();
   for (int i = 0; i < kLegs; ++i) {
     LegShare<double> share;
     leg_share(m, i, stops, keep[i], sums.rho[i], pd, out.pdd, share);
@@ -229,37 +219,13 @@ PKM_LANES_INLINE Status partials_as_lanes(const Model& m, const PlatformConfig& 
   return Status::Ok;
 }
 
-Status partials_generic(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
-                        LegPartialSums& out) {
-  return partials_as_lanes(m, pc, pd, f, stops, out);
-}
-
-#if PKM_LANES_AVX_DISPATCH
-PKM_LANES_AVX_TARGET Status partials_avx(const Model& m, const PlatformConfig& pc, const Pose& pd,
-                                                   const Vec16& f, unsigned stops, LegPartialSums& out) {
-  return partials_as_lanes(m, pc, pd, f, stops, out);
-}
-#endif
+using PartialsCopies = lanes::Copies<decltype(partials_as_lanes), partials_as_lanes>;
 
 }  // namespace
 
 Status leg_partial_sums(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
-                        LegPartialSums& out, LegLanes kind) {
-  switch (kind) {
-    case LegLanes::Scalar: return partials_scalar(m, pc, pd, f, stops, out);
-    case LegLanes::Generic: return partials_generic(m, pc, pd, f, stops, out);
-    case LegLanes::Best:
-#if PKM_LANES_AVX_DISPATCH
-      if (m.avx) return partials_avx(m, pc, pd, f, stops, out);
-#endif
-      return partials_generic(m, pc, pd, f, stops, out);
-    case LegLanes::Avx:
-#if PKM_LANES_AVX_DISPATCH
-      if (lanes::cpu_runs_avx()) return partials_avx(m, pc, pd, f, stops, out);
-#endif
-      return Status::InvalidArgument;
-  }
-  return Status::InvalidArgument;
+                        LegPartialSums& out, lanes::Kernel kind) {
+  return lanes::run<PartialsCopies, partials_scalar>(kind, m.avx, Status::InvalidArgument, m, pc, pd, f, stops, out);
 }
 
 }  // namespace pkm

@@ -25,6 +25,6 @@ struct LegPartialSums {
 /// external wrench) plus the passive joint forces (stops as in leg_sums).
 /// Statuses as leg_sums, Singular from the solve.
 Status leg_partial_sums(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f, unsigned stops,
-                        LegPartialSums& out, LegLanes kind = LegLanes::Best);
+                        LegPartialSums& out, lanes::Kernel kind = lanes::Kernel::Best);
 
 }  // namespace pkm

@@ -184,4 +184,23 @@ PKM_LANES_INLINE void sum_lanes(const LegContribution<lanes::Pack>& c, LegSums& 
   }
 }
 
+// The four legs one at a time (the Scalar copies), summed as above; keep
+// (if given) receives each leg's LegKeep. The first failing leg's status.
+inline Status legs_one_at_a_time(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
+                                 unsigned stops, LegSums& sums, LegKeep<double>* keep = nullptr) {
+  for (double& x : sums.mr) x = 0.0;
+  for (double& x : sums.rhs) x = 0.0;
+  for (int i = 0; i < kLegs; ++i) {
+    LegContribution<double> c;
+    const Status s =
+        leg_contribution(m, i, pc, pd, stops, leg_inputs(m, i, f[leg_offset(i)]), c, keep ? keep + i : nullptr);
+    if (s != Status::Ok) return s;
+    for (int n = 0; n < 10; ++n) sums.mr[n] += c.mr[n];
+    for (int n = 0; n < 4; ++n) sums.rhs[n] += c.rhs[n];
+    sums.rho[i] = c.rho;
+    sums.rhod[i] = c.rhod;
+  }
+  return Status::Ok;
+}
+
 }  // namespace pkm::leg_lanes_kernel

@@ -117,7 +117,7 @@ Status solve_reduced(const Model& m, const Wrench& we, const double mr[10], cons
 
 Status ReducedDynamics::platform_derivative(const Model& m, const PlatformConfig& pc, const Pose& pd,
                                             const Vec16& f, unsigned stops, Vec4* rho, Vec4* rhod, Pose& pdd,
-                                            LegLanes kind) {
+                                            lanes::Kernel kind) {
   LegSums sums;
   const Status s = leg_sums(m, pc, pd, f, stops, sums, kind);
   if (s != Status::Ok) return s;

@@ -47,7 +47,6 @@ class ReducedDynamics {
   /// for every leg).
   void reduced_system(const Model& m, const Wrench& we, Mat4& Mr, Vec4& rhs) const;
 
-  using LegLanes = pkm::LegLanes;  // leg_lanes.hpp
   /// The integrators' hot path (state_derivative): the platform's
   /// accelerations pdd without keeping the legs' terms (solve() needs them,
   /// solve_platform does not). The same arithmetic as prepare_leg,
@@ -58,10 +57,11 @@ class ReducedDynamics {
   /// forces (stops held as `stops`) are added here. rho and rhod (if given)
   /// receive the actuated joints and their rates, untouched on failure. On
   /// failure the status of the first failing leg (Unreachable, Singular),
-  /// as leg by leg; InvalidArgument for an unavailable variant.
+  /// as leg by leg; InvalidArgument for a copy this build or processor
+  /// does not have (lanes::Kernel).
   static Status platform_derivative(const Model& m, const PlatformConfig& pc, const Pose& pd, const Vec16& f,
                                     unsigned stops, Vec4* rho, Vec4* rhod, Pose& pdd,
-                                    LegLanes kind = LegLanes::Best);
+                                    lanes::Kernel kind = lanes::Kernel::Best);
 
   /// platform_derivative's solve: pdd from the legs' sums (leg_sums) with
   /// the platform, its payload and the external wrench; the same bits.

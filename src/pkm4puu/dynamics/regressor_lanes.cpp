@@ -143,58 +143,35 @@ PKM_LANES_INLINE Status legs_sliders(const Model& m, const PlatformConfig& pc, V
   return Status::Ok;
 }
 
-// One copy of each kernel for the baseline instruction set, one for AVX
-// (chosen by m.avx, as the inverse dynamics).
-template <bool kAvx>
-struct RegressorKernels;
-template <>
-struct RegressorKernels<false> {
-  static Status regressor(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd, const Wrench& we,
-                          RegressorSample& out) {
-    return legs_regressor(m, pc, pd, pdd, we, out);
-  }
-  static Status joint(const Model& m, const PlatformConfig& pc, const Vec4& rhod, const Vec4& rhodd, const Wrench& we,
-                      RegressorSample& out) {
-    return legs_joint_regressor(m, pc, rhod, rhodd, we, out);
-  }
-  static Status sliders(const Model& m, const PlatformConfig& pc, Vec4& rho, Mat4& Arho) {
-    return legs_sliders(m, pc, rho, Arho);
-  }
-};
-template <>
-struct RegressorKernels<true> {
-  PKM_LANES_AVX_TARGET static Status regressor(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd,
-                                         const Wrench& we, RegressorSample& out) {
-    return legs_regressor(m, pc, pd, pdd, we, out);
-  }
-  PKM_LANES_AVX_TARGET static Status joint(const Model& m, const PlatformConfig& pc, const Vec4& rhod, const Vec4& rhodd,
-                                     const Wrench& we, RegressorSample& out) {
-    return legs_joint_regressor(m, pc, rhod, rhodd, we, out);
-  }
-  PKM_LANES_AVX_TARGET static Status sliders(const Model& m, const PlatformConfig& pc, Vec4& rho, Mat4& Arho) {
-    return legs_sliders(m, pc, rho, Arho);
-  }
-};
-
-bool regressor_use_avx(const Model& m) { return PKM_LANES_AVX_DISPATCH && m.avx; }
+using RegressorCopies = lanes::Copies<decltype(legs_regressor), legs_regressor>;
+using JointCopies = lanes::Copies<decltype(legs_joint_regressor), legs_joint_regressor>;
+using SlidersCopies = lanes::Copies<decltype(legs_sliders), legs_sliders>;
 
 }  // namespace
 
 Status regressor_lanes(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd, const Wrench& we,
                        RegressorSample& out) {
-  return regressor_use_avx(m) ? RegressorKernels<true>::regressor(m, pc, pd, pdd, we, out)
-                              : RegressorKernels<false>::regressor(m, pc, pd, pdd, we, out);
+  return lanes::run<RegressorCopies>(lanes::Kernel::Best, m.avx, Status::InvalidArgument, m, pc, pd, pdd, we, out);
+}
+Status regressor_lanes(const Model& m, const PlatformConfig& pc, const Pose& pd, const Pose& pdd, const Wrench& we,
+                       RegressorSample& out, lanes::Kernel kind) {
+  return lanes::run<RegressorCopies>(kind, m.avx, Status::InvalidArgument, m, pc, pd, pdd, we, out);
 }
 
 Status joint_regressor_lanes(const Model& m, const PlatformConfig& pc, const Vec4& rhod, const Vec4& rhodd,
                              const Wrench& we, RegressorSample& out) {
-  return regressor_use_avx(m) ? RegressorKernels<true>::joint(m, pc, rhod, rhodd, we, out)
-                              : RegressorKernels<false>::joint(m, pc, rhod, rhodd, we, out);
+  return lanes::run<JointCopies>(lanes::Kernel::Best, m.avx, Status::InvalidArgument, m, pc, rhod, rhodd, we, out);
+}
+Status joint_regressor_lanes(const Model& m, const PlatformConfig& pc, const Vec4& rhod, const Vec4& rhodd,
+                             const Wrench& we, RegressorSample& out, lanes::Kernel kind) {
+  return lanes::run<JointCopies>(kind, m.avx, Status::InvalidArgument, m, pc, rhod, rhodd, we, out);
 }
 
 Status slider_positions_lanes(const Model& m, const PlatformConfig& pc, Vec4& rho, Mat4& Arho) {
-  return regressor_use_avx(m) ? RegressorKernels<true>::sliders(m, pc, rho, Arho)
-                              : RegressorKernels<false>::sliders(m, pc, rho, Arho);
+  return lanes::run<SlidersCopies>(lanes::Kernel::Best, m.avx, Status::InvalidArgument, m, pc, rho, Arho);
+}
+Status slider_positions_lanes(const Model& m, const PlatformConfig& pc, Vec4& rho, Mat4& Arho, lanes::Kernel kind) {
+  return lanes::run<SlidersCopies>(kind, m.avx, Status::InvalidArgument, m, pc, rho, Arho);
 }
 
 }  // namespace pkm

@@ -250,14 +250,10 @@ Status CvodeIntegrator::create(CvodeMethod method, double rtol, double atol, Rhs
   }
   flag |= CVodeSetUserData(mem_, this);
   // Every component under rtol and atol, the two running energy integrals
-  // (8, 9; atol in J) too. Kept out of the error test (as CVODES treats
-  // quadratures by default) they were not integrated to the motion's
-  // accuracy: a drop onto the end stops (F = 0, rtol 1e-10) dissipated
-  // 0.4823 J with 10 ms communication steps against 0.4709 J with RK4 or
-  // with 0.1 ms steps, K + U - W + D drifting by 1.1e-2 J, while the pose
-  // agreed with Model Exchange to 5e-9 m. Under the error test the drift is
-  // ~1e-9 J. The contacts themselves are located (root finding, a restart at
-  // each), so the integrand's jump there costs no step.
+  // (8, 9; atol in J) too: out of the error test (as CVODES treats
+  // quadratures by default) they drift from the motion's accuracy
+  // (docs/performance.md). The contacts are located (root finding, a restart
+  // at each), so the integrand's jump there costs no step.
   atol_ = N_VNew_Serial(10, ctx_);
   if (!atol_) return Status::SolverFailure;
   use_own_ops(atol_, &CvodeIntegrator::clone_or_spare);

@@ -59,7 +59,7 @@ class CvodeIntegrator {
   bool needs_reset() const { return needs_reset_; }
   const std::string& last_error() const { return error_; }
   /// Internal steps taken since init(), across restarts (the work per
-  /// communication step: pkm_bench). The derivative evaluations are the
+  /// communication step: pkm_bench ticks). The derivative evaluations are the
   /// caller's to count (Plant::rhs_evaluations).
   long steps() const;
 

@@ -29,9 +29,9 @@ struct Model {
   double platform_mass = 0;   // m_platform + payload_mass, kg
   double platform_Izz = 0;    // Izz_platform + payload_Izz + payload_mass |payload_com|^2, kg*m^2
   double payload_mx = 0, payload_my = 0;  // payload_mass * payload_com (platform frame), kg*m
-  // The processor runs AVX (asked by make_model): the state derivative's hot
-  // path then takes the AVX variant of its legs' lanes (reduced_dynamics.cpp,
-  // the same bits).
+  // The processor runs AVX (asked by make_model): the lane kernels (state
+  // derivative, its Jacobians, inverse dynamics, regressor) then run their
+  // AVX copies (lanes::resolve in base/lanes.hpp; the same bits).
   bool avx = false;
 };
 

@@ -1,23 +1,19 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* What the C harnesses share (pkm_fmu_bench's subcommands, and the C tests
- * tests/fmu_allocations.c and tests/fmu_alloc_faults.c):
- * loading a built FMU binary with dlopen, a logger that stays silent unless
- * the FMU reports an error, reading modelDescription.xml's attributes and
- * value references, the controller's output names, the
- * clock and the machine's description. Static functions, one copy per
- * file that includes this; define PKM_HARNESS_NAME (the program's name, for
- * messages) first. */
-#ifndef PKM_BENCH_FMU_HARNESS_H
-#define PKM_BENCH_FMU_HARNESS_H
+/* What the C programs that drive a built FMU binary share (the tests
+ * fmu_allocations and fmu_alloc_faults, and bench/fmu's pkm_fmu_bench):
+ * loading it with dlopen, a logger that stays silent unless the FMU reports
+ * an error, reading modelDescription.xml's attributes and value references,
+ * the controller's output names. Static functions, one copy per file that
+ * includes this; define PKM_HARNESS_NAME (the program's name, for messages)
+ * first. */
+#ifndef PKM_TESTS_FMU_HARNESS_H
+#define PKM_TESTS_FMU_HARNESS_H
 
 #include <dlfcn.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/utsname.h>
-#include <time.h>
-#include <unistd.h>
 
 #include "fmi2FunctionTypes.h"
 #include "fmi/fmi_functions.h"
@@ -187,77 +183,26 @@ PKM_HARNESS_FN int read_controller_interface(const char* text, char* guid, size_
   return ok;
 }
 
-/* A harness's exit status: 0, or 1 after saying that it failed. */
-PKM_HARNESS_FN int exit_status(int ok) {
-  if (ok) return 0;
-  fprintf(stderr, PKM_HARNESS_NAME ": FAILED\n");
-  return 1;
-}
-
-PKM_HARNESS_FN double now_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-PKM_HARNESS_FN int compare_double(const void* a, const void* b) {
-  const double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
-PKM_HARNESS_FN void print_machine(void) {
-  struct utsname u;
-  char line[512], cpu[256] = "unknown";
-  FILE* fp = fopen("/proc/cpuinfo", "r");
-  if (fp) {
-    while (fgets(line, sizeof line, fp)) {
-      if (strncmp(line, "model name", 10) == 0) {
-        const char* v = strchr(line, ':');
-        if (v) {
-          size_t n;
-          v += strspn(v + 1, " \t") + 1;
-          snprintf(cpu, sizeof cpu, "%s", v);
-          n = strlen(cpu);
-          while (n > 0 && (cpu[n - 1] == '\n' || cpu[n - 1] == '\r')) cpu[--n] = '\0';
-        }
-        break;
-      }
+/* The value references of every Real output of the model description
+ * `text` into vr (at most max); how many, 0 if there are more than max. */
+PKM_HARNESS_FN size_t real_outputs(const char* text, fmi2ValueReference* vr, size_t max) {
+  const char* p = text;
+  size_t n = 0;
+  char buf[64];
+  while ((p = strstr(p, "<ScalarVariable")) != NULL) {
+    const char* end = strstr(p, "</ScalarVariable>");
+    const char* real = strstr(p, "<Real");
+    if (!end) break;
+    if (attribute(p, end, "causality", buf, sizeof buf) && strcmp(buf, "output") == 0 && real && real < end &&
+        attribute(p, end, "valueReference", buf, sizeof buf)) {
+      if (n == max) return 0;
+      vr[n++] = (fmi2ValueReference)strtoul(buf, NULL, 10);
     }
-    fclose(fp);
+    p = end;
   }
-  if (uname(&u) == 0)
-    printf("machine: %s %s %s %s\n", u.sysname, u.release, u.version, u.machine);
-  printf("cpu:     %s; %ld cores online (%ld configured)\n", cpu, sysconf(_SC_NPROCESSORS_ONLN),
-         sysconf(_SC_NPROCESSORS_CONF));
-}
-
-/* The model description that goes with the binary `so`: for the build's own
- * plant binary (PKM_FMU_PLANT_SO) the copy staged beside it
- * (PKM_FMU_PLANT_XML), otherwise the FMU layout's
- * <stage>/binaries/<platform>/<id>.so -> <stage>/modelDescription.xml.
- * The caller frees the result. */
-PKM_HARNESS_FN char* default_xml_path(const char* so) {
-  const char* suffix = "modelDescription.xml";
-  size_t n = strlen(so);
-  int slashes = 0;
-  char* path;
-#if defined(PKM_FMU_PLANT_SO) && defined(PKM_FMU_PLANT_XML)
-  if (strcmp(so, PKM_FMU_PLANT_SO) == 0) {
-    path = malloc(strlen(PKM_FMU_PLANT_XML) + 1);
-    if (path) strcpy(path, PKM_FMU_PLANT_XML);
-    return path;
-  }
-#endif
-  while (n > 0 && slashes < 3)
-    if (so[--n] == '/') ++slashes;
-  if (slashes < 3) return NULL;
-  path = malloc(n + 1 + strlen(suffix) + 1);
-  if (!path) return NULL;
-  memcpy(path, so, n + 1);
-  strcpy(path + n + 1, suffix);
-  return path;
+  return n;
 }
 
 PKM_HARNESS_FN void* allocate_memory(size_t nobj, size_t size) { return calloc(nobj, size); }
 
-#endif /* PKM_BENCH_FMU_HARNESS_H */
+#endif /* PKM_TESTS_FMU_HARNESS_H */

@@ -1,26 +1,26 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-2-Clause
-"""One tick benchmark built for two platforms, run in one go: pkm_tick_bench
---ticks of the host build (linux64) and of the Windows build under wine
-(or the aarch64 build under qemu), alternately, so that both see the same
-machine at the same time. Prints, per run of the tick bench (RK4 and CVODE,
+"""The core bench's ticks built for two platforms, run in one go: pkm_bench
+ticks --parseable of the host build (linux64) and of the Windows build
+under wine (or the aarch64 build under qemu), alternately, so that both see
+the same machine at the same time. Prints, per run (RK4, ROS2 and CVODE,
 three kinds of inputs), each platform's time per 1-ms step (the smallest of
 the rounds' medians), their ratio against the target, and how far the
 other platform's pose after one simulated second is from the host's
-(relative to the pose's largest coordinate; the platform tests bound the
-traces at 1e-12).
+(relative to the pose's largest coordinate).
 
-    bench/platform_ticks.py --host build/bench/pkm_tick_bench \\
-        --other build/platforms/win64/bench/pkm_tick_bench.exe [--runner wine] [--rounds 3]
+    tests/platform_ticks.py --host build/bench/pkm_bench \\
+        --other build/platforms/win64/bench/pkm_bench.exe [--runner wine] [--rounds 3]
 
-Exit status 0 when every run worked and the poses agree within 1e-12; the
-timings are printed, never asserted.
+Exit status 0 when every run worked and the poses agree within 1e-12 (the
+test); the timings are printed, never asserted.
 """
 import argparse
 import os
 import subprocess
 import sys
 
+TICKS = ("ticks", "--parseable")  # pkm_bench's tick runs, one line each
 TARGET = 1.2  # other platform / host, per tick
 POSE_TOLERANCE = 1e-12
 # The runs the target applies to: the plant tick with RK4 and CVODE's ramp.
@@ -51,8 +51,8 @@ def run(cmd):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--host", required=True, help="the host build's pkm_tick_bench")
-    ap.add_argument("--other", required=True, help="the other platform's pkm_tick_bench")
+    ap.add_argument("--host", required=True, help="the host build's pkm_bench")
+    ap.add_argument("--other", required=True, help="the other platform's pkm_bench")
     ap.add_argument("--runner", default="wine", help="runs the other platform's binary (wine, qemu-aarch64 -L ...)")
     ap.add_argument("--name", default="win64", help="the other platform's name in the table")
     ap.add_argument("--rounds", type=int, default=3)
@@ -63,7 +63,7 @@ def main():
     best = {"host": {}, "other": {}}
     poses = {"host": {}, "other": {}}
     for _ in range(a.rounds):
-        for key, cmd in (("host", [a.host, "--ticks"]), ("other", runner + [a.other, "--ticks"])):
+        for key, cmd in (("host", [a.host, *TICKS]), ("other", runner + [a.other, *TICKS])):
             rows = run(cmd)
             if rows is None:
                 return 1
@@ -74,7 +74,7 @@ def main():
                 us, pose = value
                 best[key][name] = min(us, best[key].get(name, us))
                 poses[key][name] = pose
-    print(f"pkm_tick_bench --ticks, linux64 and {a.name} ({' '.join(runner) or 'native'}) alternately, "
+    print(f"pkm_bench ticks, linux64 and {a.name} ({' '.join(runner) or 'native'}) alternately, "
           f"{a.rounds} rounds; us per 1-ms step: the smallest of the rounds' medians (15 runs each)")
     print(f"{'run':44s} {'linux64':>9s} {a.name:>9s} {'ratio':>7s} {'target':>14s} {'pose diff':>10s}")
     worst = 0.0

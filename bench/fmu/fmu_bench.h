@@ -1,0 +1,71 @@
+/* SPDX-License-Identifier: BSD-2-Clause */
+/* pkm_fmu_bench: what its subcommands share (main.c defines it): the
+ * options, the loaded FMU, an instance set up for a solver, the one loop of
+ * a master's ticks. */
+#ifndef PKM_BENCH_FMU_BENCH_H
+#define PKM_BENCH_FMU_BENCH_H
+
+#define PKM_HARNESS_NAME "pkm_fmu_bench"
+#include "fmu_harness.h"
+#include "timer.h"
+
+#define STATIC_FORCE 2.655616050 /* N, the holding force at home (docs/model.md "Bodies") */
+#define PI 3.14159265358979323846
+
+typedef struct {
+  const char *so, *xml, *out, *mjcf, *state; /* --fmu, --xml, --out (compare), --mjcf, --state (inverse) */
+  int batches;
+  double seconds; /* --seconds (cost) */
+} Options;
+
+/* The FMU binary, loaded, its model description's text and guid; the plant's F[1..4], controller outputs, solver. */
+typedef struct {
+  Fmu fmu;
+  const char *so, *xml, *text;
+  char guid[128];
+  fmi2ValueReference F[4], control[12], solver;
+} Plant;
+
+typedef struct {
+  const char *name, *summary;
+  int (*run)(const Plant* plant, const Options* options);
+  int default_batches, max_batches;
+  const char* options; /* its own options beyond --fmu, --xml, --batches */
+  int inverse;         /* drives the inverse FMU (PKM4PUU_Inverse) */
+} Subcommand;
+
+extern const Subcommand compare_subcommand, cost_subcommand, latency_subcommand, jacobian_subcommand,
+    inverse_subcommand;
+
+/* A Co-Simulation instance with `solver` and n parameters set, initialised, its state then in *home (if given);
+ * NULL after a message on failure. */
+fmi2Component instantiate_plant(const Plant* plant, const char* name, int solver, size_t n,
+                                const fmi2ValueReference* vr, const fmi2Real* values, fmi2FMUstate* home);
+/* Frees *home (if any), terminates and frees the instance; 0 if a call failed. */
+int free_plant(const Plant* plant, fmi2Component c, fmi2FMUstate* home);
+/* The value references of names[0..n-1]; 0 after a message if one is missing. */
+int lookup_value_references(const Plant* plant, const char* const* names, size_t n, fmi2ValueReference* vr);
+
+/* A master's ticks: each sets F[k] (with dF, their slopes too), DoSteps h and gets the n_out outputs `out`,
+ * kept in record (n x n_out) if given; tick_s (if given) receives each tick's time. */
+typedef struct {
+  double h;
+  int n;
+  double (*F)[4], (*dF)[4];
+  const fmi2ValueReference* out;
+  size_t n_out;
+  double *record, *tick_s;
+} Ticks;
+/* The ticks from time t0: their wall time, or < 0 after a message when a call fails. */
+double run_ticks(const Plant* plant, fmi2Component c, const Ticks* ticks, double t0);
+
+/* Returns 0 from the calling function, after a message, when an FMI call (or an || of them) does not return OK. */
+#define FMI_CHECK(call)                                                \
+  do {                                                                 \
+    if ((call) != 0) {                                                 \
+      fprintf(stderr, "pkm_fmu_bench: %s did not return OK\n", #call); \
+      return 0;                                                        \
+    }                                                                  \
+  } while (0)
+
+#endif /* PKM_BENCH_FMU_BENCH_H */
