@@ -27,7 +27,25 @@ write_basic_package_version_file("${PROJECT_BINARY_DIR}/cmake/pkm4puuConfigVersi
 install(FILES "${PROJECT_BINARY_DIR}/cmake/pkm4puuConfig.cmake" "${PROJECT_BINARY_DIR}/cmake/pkm4puuConfigVersion.cmake"
         DESTINATION "${PKM_INSTALL_CMAKEDIR}" COMPONENT Development)
 # pkg-config: relative to the .pc file's own place, so the prefix can move.
-configure_file("${CMAKE_CURRENT_LIST_DIR}/pkm4puu.pc.in" "${PROJECT_BINARY_DIR}/pkm4puu.pc" @ONLY)
+# Libs.private (`pkg-config --static`): what the static library's users link
+# besides (pkm_static's link interface: SUNDIALS' static CVODE by its path,
+# the C++ runtime and libm by name).
+get_target_property(_pkm_static_libs pkm_static INTERFACE_LINK_LIBRARIES)
+set(PKM_PC_LIBS_PRIVATE)
+foreach(_l IN LISTS _pkm_static_libs)
+  if(_l MATCHES "^\\$<BUILD_INTERFACE:")  # the build tree's own (the version header)
+    continue()
+  elseif(TARGET ${_l})
+    list(APPEND PKM_PC_LIBS_PRIVATE "$<TARGET_LINKER_FILE:${_l}>")
+  elseif(IS_ABSOLUTE "${_l}" OR _l MATCHES "^-")
+    list(APPEND PKM_PC_LIBS_PRIVATE "${_l}")
+  else()
+    list(APPEND PKM_PC_LIBS_PRIVATE "-l${_l}")
+  endif()
+endforeach()
+list(JOIN PKM_PC_LIBS_PRIVATE " " PKM_PC_LIBS_PRIVATE)
+configure_file("${CMAKE_CURRENT_LIST_DIR}/pkm4puu.pc.in" "${PROJECT_BINARY_DIR}/cmake/pkm4puu.pc.in" @ONLY)
+file(GENERATE OUTPUT "${PROJECT_BINARY_DIR}/pkm4puu.pc" INPUT "${PROJECT_BINARY_DIR}/cmake/pkm4puu.pc.in")
 install(FILES "${PROJECT_BINARY_DIR}/pkm4puu.pc" DESTINATION "${CMAKE_INSTALL_LIBDIR}/pkgconfig"
         COMPONENT Development)
 
