@@ -117,7 +117,8 @@ function(pkm_add_fmu id)
 
   add_library(pkm_model_${id} STATIC ${F_SOURCES})
   target_link_libraries(pkm_model_${id} PUBLIC pkm_fmi pkm_core PRIVATE pkm::options)
-  set_target_properties(pkm_model_${id} PROPERTIES CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON)
+  set_target_properties(pkm_model_${id} PROPERTIES CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON
+                                                  UNITY_BUILD ON)  # its sources in one file: one parse of the core's headers
   pkm_fat_lto_objects(pkm_model_${id})  # cmake/Lto.cmake: the tests and the tools link it without LTO
 
   add_executable(${id}_files ${PROJECT_SOURCE_DIR}/src/fmi/fmu_files.cpp)

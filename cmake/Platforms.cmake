@@ -4,7 +4,8 @@
 # under ${PROJECT_BINARY_DIR}/platforms/<target> with the toolchain files of
 # cmake/toolchains/, against a static CVODE built for the target from
 # Debian's source package (scripts/cross_sundials.sh, cached in
-# platforms/sundials-<target>); the FMI tests run there under wine and
+# platforms/sundials-<target>, found through the SUNDIALSConfig.cmake it
+# installs there, as the host's); the FMI tests run there under wine and
 # qemu-user; and one archive per FMU and FMI version holding every platform
 # and the source code (cmake/merge_fmu.py):
 #
