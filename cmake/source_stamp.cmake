@@ -20,5 +20,5 @@ if(DEFINED ENV{SOURCE_DATE_EPOCH} AND "$ENV{SOURCE_DATE_EPOCH}" MATCHES "^[0-9]+
   set(_epoch "$ENV{SOURCE_DATE_EPOCH}")
 endif()
 file(WRITE "${OUT}.tmp" "{\"epoch\": ${_epoch}, \"commit\": \"${_commit}\"}\n")
-file(COPY_FILE "${OUT}.tmp" "${OUT}" ONLY_IF_DIFFERENT)
+execute_process(COMMAND ${CMAKE_COMMAND} -E copy_if_different "${OUT}.tmp" "${OUT}")
 file(REMOVE "${OUT}.tmp")

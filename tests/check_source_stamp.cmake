@@ -5,9 +5,9 @@
 # 1. the build's rule that reruns CMake depends on no file under .git/;
 # 2. cmake/source_stamp.cmake, run on a throw-away repository, writes the
 #    commit and the commit's date (set through GIT_COMMITTER_DATE), leaves
-#    the file alone (same modification time) when nothing changed, rewrites
-#    it for a new commit, takes $SOURCE_DATE_EPOCH over the commit's date,
-#    and writes 1980-01-01 and no commit outside git.
+#    the file alone (same modification time) when nothing changed, follows a
+#    new commit, takes $SOURCE_DATE_EPOCH over the commit's date, and writes
+#    1980-01-01 and no commit outside git.
 #   cmake -DBUILD=<build tree> -DSCRIPT=<cmake/source_stamp.cmake> -DWORK=<scratch folder> -P check_source_stamp.cmake
 foreach(_rules "${BUILD}/build.ninja" "${BUILD}/CMakeFiles/Makefile.cmake")
   if(EXISTS "${_rules}")
@@ -47,11 +47,12 @@ function(stamp)
     message(FATAL_ERROR "${SCRIPT} failed: ${_rc}")
   endif()
   file(READ "${_stamp}" _json)
-  string(JSON _epoch GET "${_json}" epoch)
-  string(JSON _commit GET "${_json}" commit)
-  file(TIMESTAMP "${_stamp}" _mtime "%s.%f")
-  set(epoch "${_epoch}" PARENT_SCOPE)
-  set(commit "${_commit}" PARENT_SCOPE)
+  if(NOT _json MATCHES "^{\"epoch\": ([0-9]+), \"commit\": \"([0-9a-f]*)\"}\n$")
+    message(FATAL_ERROR "${_stamp}: not a source stamp: ${_json}")
+  endif()
+  set(epoch "${CMAKE_MATCH_1}" PARENT_SCOPE)
+  set(commit "${CMAKE_MATCH_2}" PARENT_SCOPE)
+  file(TIMESTAMP "${_stamp}" _mtime "%s")
   set(mtime "${_mtime}" PARENT_SCOPE)
 endfunction()
 function(expect what value wanted)
@@ -75,7 +76,7 @@ stamp()
 expect("epoch of the first commit" "${epoch}" 1700000000)
 expect("commit" "${commit}" "${_first}")
 set(_mtime "${mtime}")
-execute_process(COMMAND ${CMAKE_COMMAND} -E sleep 1.1)
+execute_process(COMMAND ${CMAKE_COMMAND} -E sleep 1)  # a rewritten file would have a later time
 stamp()
 expect("modification time when nothing changed" "${mtime}" "${_mtime}")
 
@@ -86,9 +87,6 @@ git(rev-parse --short=12 HEAD)
 stamp()
 expect("epoch of the second commit" "${epoch}" 1700086400)
 expect("commit" "${commit}" "${git_out}")
-if(mtime STREQUAL _mtime)
-  message(FATAL_ERROR "the stamp was not rewritten for a new commit")
-endif()
 stamp(1234567890)
 expect("epoch under SOURCE_DATE_EPOCH" "${epoch}" 1234567890)
 file(REMOVE_RECURSE "${WORK}")
