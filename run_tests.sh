@@ -16,9 +16,10 @@ cd "$(dirname "${BASH_SOURCE[0]}")"
 # ...) install beside the build, which does not need them.
 # Every platform: the Windows and aarch64 FMUs, built and tested under wine
 # and qemu-user (cmake/Platforms.cmake). The tests and benchmarks are turned
-# on by name: a build/ that the main job configured has them off.
+# on by name, and link-time optimisation: a build/ that the main job
+# configured has them off.
 PKM_SETUP=for-build ./scripts/build.sh --configure-only -DPKM_PLATFORMS=ON -DPKM_BUILD_TESTS=ON \
-  -DPKM_BUILD_BENCHMARKS=ON
+  -DPKM_BUILD_BENCHMARKS=ON -DPKM_LTO=ON
 setup_log=build/setup.log
 ./scripts/setup.sh >"$setup_log" 2>&1 &
 setup_pid=$!

@@ -2,11 +2,13 @@
 # The FMUs: the FMI 2.0 and 3.0 headers, the FMU shared objects and their
 # .fmu archives.
 #
-#   PKM_FMU_PYTHON    (cache) the Python that has fmpy (tests: fmpy validate);
-#                     default: the project's .venv, else python3.
+#   Python3_EXECUTABLE  find_package(Python3): packs the archives (its standard
+#                       library), and runs the FMU tests (fmpy); scripts/build.sh
+#                       passes the project's .venv/bin/python when there is one.
 #
 #   pkm_add_fmu(<modelIdentifier> DEFINITION <function in namespace pkm_fmi>
 #               SOURCES <the model's sources...>)
+#   pkm_fmu_paths(<target> <modelIdentifier> <prefix>)
 include_guard(GLOBAL)
 
 # The FMI standard's headers, vendored (third_party/fmi, BSD-2-Clause).
@@ -16,16 +18,7 @@ if(NOT TARGET pkm_fmi_headers)
   add_library(pkm::fmi_headers ALIAS pkm_fmi_headers)
 endif()
 
-set(PKM_FMU_PYTHON "" CACHE FILEPATH "Python interpreter with fmpy installed (FMU tests)")
-if(NOT PKM_FMU_PYTHON)
-  if(EXISTS "${PROJECT_SOURCE_DIR}/.venv/bin/python")
-    set(PKM_FMU_PYTHON "${PROJECT_SOURCE_DIR}/.venv/bin/python" CACHE FILEPATH "Python interpreter with fmpy installed (FMU tests)" FORCE)
-  else()
-    find_program(PKM_PYTHON3_EXECUTABLE NAMES python3)
-    mark_as_advanced(PKM_PYTHON3_EXECUTABLE)
-    set(PKM_FMU_PYTHON "${PKM_PYTHON3_EXECUTABLE}" CACHE FILEPATH "Python interpreter with fmpy installed (FMU tests)" FORCE)
-  endif()
-endif()
+find_package(Python3 COMPONENTS Interpreter)
 
 # FMI platform directories of the binaries: FMI 2.0 (linux64, win64, ...)
 # and FMI 3.0 (x86_64-linux, aarch64-linux, x86_64-windows, ...).
@@ -54,40 +47,21 @@ elseif(_pkm_cpu MATCHES "^(aarch64|arm64)$")
 endif()
 set(PKM_FMU3_PLATFORM "${_pkm_cpu}-${_pkm_fmi3_os}")
 
-# The archives' entry dates: $SOURCE_DATE_EPOCH if set, else the date of the
-# commit being built (read at configure time), else 1980-01-01; with
-# cmake/pack_fmu.py writing nothing else that varies, the same commit builds
-# bit-identical .fmu files (reproducible-builds.org's convention).
-if(DEFINED ENV{SOURCE_DATE_EPOCH})
-  set(PKM_SOURCE_DATE_EPOCH "$ENV{SOURCE_DATE_EPOCH}")
-else()
-  execute_process(COMMAND git -C "${PROJECT_SOURCE_DIR}" log -1 --format=%ct
-                  OUTPUT_VARIABLE PKM_SOURCE_DATE_EPOCH OUTPUT_STRIP_TRAILING_WHITESPACE
-                  RESULT_VARIABLE _pkm_git_rc ERROR_QUIET)
-  if(NOT _pkm_git_rc EQUAL 0 OR NOT PKM_SOURCE_DATE_EPOCH MATCHES "^[0-9]+$")
-    set(PKM_SOURCE_DATE_EPOCH 315532800)
-  endif()
-endif()
-# The commit being built, appended to generationTool in the archives' model
-# descriptions (cmake/pack_fmu.py), with generationDateAndTime from
-# PKM_SOURCE_DATE_EPOCH. Both are read at configure time, and the build
-# configures again when HEAD or its branch moves (a new commit). Empty
-# outside git.
-execute_process(COMMAND git -C "${PROJECT_SOURCE_DIR}" rev-parse --short=12 HEAD
-                OUTPUT_VARIABLE PKM_GIT_COMMIT OUTPUT_STRIP_TRAILING_WHITESPACE
-                RESULT_VARIABLE _pkm_git_rc ERROR_QUIET)
-if(NOT _pkm_git_rc EQUAL 0)
-  set(PKM_GIT_COMMIT "")
-else()
-  execute_process(COMMAND git -C "${PROJECT_SOURCE_DIR}" symbolic-ref -q HEAD
-                  OUTPUT_VARIABLE _pkm_branch OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
-  foreach(_ref HEAD ${_pkm_branch})
-    execute_process(COMMAND git -C "${PROJECT_SOURCE_DIR}" rev-parse --path-format=absolute --git-path ${_ref}
-                    OUTPUT_VARIABLE _pkm_ref_file OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
-    if(EXISTS "${_pkm_ref_file}")
-      set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${_pkm_ref_file}")
-    endif()
-  endforeach()
+# What changes from commit to commit, read when the build runs (a commit
+# does not make CMake configure again): the commit (appended to
+# generationTool in the archives' model descriptions) and the archives'
+# entry dates ($SOURCE_DATE_EPOCH if set, else the commit's date, else
+# 1980-01-01; generationDateAndTime too), reproducible-builds.org's
+# convention. cmake/source_stamp.cmake writes them to PKM_SOURCE_STAMP
+# (JSON), rewritten only when they change; with cmake/pack_fmu.py writing
+# nothing else that varies, the same commit builds bit-identical .fmu files.
+set(PKM_SOURCE_STAMP "${PROJECT_BINARY_DIR}/source_stamp.json")
+if(NOT TARGET pkm_source_stamp)
+  add_custom_target(pkm_source_stamp
+    COMMAND ${CMAKE_COMMAND} -DSOURCE=${PROJECT_SOURCE_DIR} -DOUT=${PKM_SOURCE_STAMP}
+            -P ${CMAKE_CURRENT_LIST_DIR}/source_stamp.cmake
+    BYPRODUCTS "${PKM_SOURCE_STAMP}"
+    COMMENT "The commit and its date (${PKM_SOURCE_STAMP})" VERBATIM)
 endif()
 
 # The licences in every archive's documentation/licenses/: the project's
@@ -113,12 +87,7 @@ list(SORT _pkm_license_names)  # the order check_reproducible_fmu.cmake packs th
 
 # Packing an archive takes Python's standard library (cmake/pack_fmu.py);
 # without any Python the binaries are still built.
-if(PKM_FMU_PYTHON)
-  set(_pkm_pack_python "${PKM_FMU_PYTHON}")
-else()
-  find_program(_pkm_pack_python NAMES python3)
-endif()
-if(NOT _pkm_pack_python)
+if(NOT Python3_Interpreter_FOUND)
   message(WARNING "python3 not found: the FMU binaries are built, their .fmu archives are not")
 endif()
 set(PKM_PACK_FMU "${CMAKE_CURRENT_LIST_DIR}/pack_fmu.py")
@@ -135,24 +104,26 @@ set(PKM_PACK_FMU "${CMAKE_CURRENT_LIST_DIR}/pack_fmu.py")
 #   ${PROJECT_BINARY_DIR}/<id>.fmu       FMI 2.0 (Co-Simulation and Model Exchange)
 #   ${PROJECT_BINARY_DIR}/fmi3/<id>.fmu  FMI 3.0 (Co-Simulation and Model Exchange)
 # Each archive ships the committed model description <id>/fmi<v>/modelDescription.xml.
-# Targets <id>_fmu and <id>_fmu3 (part of ALL). Sets <id>_FMU_DIR,
-# <id>_FMU_FILE, <id>_FMU3_DIR and <id>_FMU3_FILE in the caller's scope and
-# appends <id> to the global property PKM_FMU_MODELS.
+# Targets <id>_fmu and <id>_fmu3 (part of ALL). The binary's target <id>
+# carries what other folders need to know (pkm_fmu_paths, cmake/Platforms.cmake,
+# cmake/Install.cmake): PKM_FMI_DEFINITION, and with the archives
+# PKM_FMU_ARCHIVE_FMI<v> and PKM_FMU_STAGE_FMI<v> (the folder packed). <id>
+# is appended to the global property PKM_FMU_MODELS.
 function(pkm_add_fmu id)
   cmake_parse_arguments(F "" "DEFINITION" "SOURCES" ${ARGN})
   set(model_dir "${CMAKE_CURRENT_SOURCE_DIR}/${id}")
   set(binary_name "${id}${CMAKE_SHARED_LIBRARY_SUFFIX}")
   set_property(GLOBAL APPEND PROPERTY PKM_FMU_MODELS ${id})
-  set_property(GLOBAL PROPERTY PKM_FMU_DEFINITION_${id} ${F_DEFINITION})
 
   add_library(pkm_model_${id} STATIC ${F_SOURCES})
-  target_link_libraries(pkm_model_${id} PUBLIC pkm_fmi pkm_core PRIVATE pkm::sundials pkm::options)
-  set_target_properties(pkm_model_${id} PROPERTIES CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON)
+  target_link_libraries(pkm_model_${id} PUBLIC pkm_fmi pkm_core PRIVATE pkm::options)
+  set_target_properties(pkm_model_${id} PROPERTIES CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON
+                                                  UNITY_BUILD ON)  # its sources in one file: one parse of the core's headers
   pkm_fat_lto_objects(pkm_model_${id})  # cmake/Lto.cmake: the tests and the tools link it without LTO
 
   add_executable(${id}_files ${PROJECT_SOURCE_DIR}/src/fmi/fmu_files.cpp)
   target_compile_definitions(${id}_files PRIVATE PKM_FMI_DEFINITION=${F_DEFINITION})
-  target_link_libraries(${id}_files PRIVATE pkm_model_${id} pkm_version pkm::sundials pkm::options)
+  target_link_libraries(${id}_files PRIVATE pkm_model_${id} pkm_version pkm::options)
   pkm_without_lto(${id}_files)
   set(generated_md "${PROJECT_BINARY_DIR}/modelDescription")
   # ... and the documentation site's reference page of the model (docs/fmus.md
@@ -183,18 +154,19 @@ function(pkm_add_fmu id)
   endif()
   add_dependencies(update_model_descriptions ${id}_update_model_descriptions)
 
-  add_library(${id} SHARED ${PKM_FMI_FRONT_ENDS})
+  # The FMI front ends (pkm_fmi_binary's sources) compiled for this model.
+  add_library(${id} SHARED)
   target_compile_definitions(${id} PRIVATE PKM_FMI_DEFINITION=${F_DEFINITION})
-  target_link_libraries(${id} PRIVATE pkm_model_${id} pkm::sundials pkm::fmi_headers pkm::options)
+  target_link_libraries(${id} PRIVATE pkm_fmi_binary pkm_model_${id} pkm::options)
   set_target_properties(${id} PROPERTIES
+    PKM_FMI_DEFINITION ${F_DEFINITION}
     PREFIX ""
     OUTPUT_NAME "${id}"
     LIBRARY_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/fmu-binaries"
     RUNTIME_OUTPUT_DIRECTORY "${PROJECT_BINARY_DIR}/fmu-binaries"
     C_VISIBILITY_PRESET hidden
     CXX_VISIBILITY_PRESET hidden
-    VISIBILITY_INLINES_HIDDEN ON
-    LINK_DEPENDS "${PKM_FMI_EXPORTS_MAP}")
+    VISIBILITY_INLINES_HIDDEN ON)
   if(CMAKE_SYSTEM_NAME STREQUAL "Linux")
     # Portable binary: nothing but libc/libm/ld-linux needed at run time.
     # Except under clang's sanitizers (PKM_FUZZ): the binary then takes the
@@ -203,9 +175,7 @@ function(pkm_add_fmu id)
     if(PKM_FUZZ)
       set(_no_undefined)
     endif()
-    target_link_options(${id} PRIVATE
-      "LINKER:--version-script=${PKM_FMI_EXPORTS_MAP}" ${_no_undefined} "LINKER:--exclude-libs,ALL"
-      -static-libstdc++ -static-libgcc)
+    target_link_options(${id} PRIVATE ${_no_undefined} "LINKER:--exclude-libs,ALL" -static-libstdc++ -static-libgcc)
     if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
       # Linked with -static-libstdc++: free its private exception pool on unload (fmu_binary.cpp).
       target_compile_definitions(${id} PRIVATE PKM_FMI_FREE_EH_POOL=1)
@@ -215,7 +185,7 @@ function(pkm_add_fmu id)
   endif()
 
   foreach(version 2 3)
-    if(NOT _pkm_pack_python)
+    if(NOT Python3_Interpreter_FOUND)
       break()
     endif()
     if(version EQUAL 2)
@@ -240,30 +210,40 @@ function(pkm_add_fmu id)
       COMMAND ${CMAKE_COMMAND} -E copy "${md}" "${stage}/modelDescription.xml"
       COMMAND ${CMAKE_COMMAND} -E copy "$<TARGET_FILE:${id}>" "${stage}/binaries/${platform}/${binary_name}"
       COMMAND ${id}_files ${id} "${stage}/documentation/index.html"
-      COMMAND ${CMAKE_COMMAND} -E env SOURCE_DATE_EPOCH=${PKM_SOURCE_DATE_EPOCH}
-              "${_pkm_pack_python}" "${PKM_PACK_FMU}" --commit "${PKM_GIT_COMMIT}" "${fmu}" "${stage}"
+      COMMAND Python3::Interpreter "${PKM_PACK_FMU}" --stamp "${PKM_SOURCE_STAMP}" "${fmu}" "${stage}"
               modelDescription.xml "binaries/${platform}/${binary_name}" documentation/index.html
               ${_pkm_license_names}
-      DEPENDS ${id} "${md}" ${id}_files "${PKM_PACK_FMU}" "${PROJECT_SOURCE_DIR}/LICENSE" ${PKM_FMU_LICENSES}
+      DEPENDS ${id} "${md}" ${id}_files "${PKM_PACK_FMU}" pkm_source_stamp "${PKM_SOURCE_STAMP}"
+              "${PROJECT_SOURCE_DIR}/LICENSE" ${PKM_FMU_LICENSES}
       COMMENT "Packaging ${fmu} (FMI ${version}.0)"
       VERBATIM)
     add_custom_target(${target} ALL DEPENDS "${fmu}")
     if(PKM_BUILD_TESTS AND NOT CMAKE_CROSSCOMPILING)
       add_test(NAME fmu_archive_reproducible_fmi${version}_${id}
                COMMAND ${CMAKE_COMMAND} -DFMU=${fmu} -DSTAGE=${stage} -DID=${id} -DDOC_TOOL=$<TARGET_FILE:${id}_files>
-                       -DPYTHON=${_pkm_pack_python} -DPACK=${PKM_PACK_FMU} -DEPOCH=${PKM_SOURCE_DATE_EPOCH}
-                       -DCOMMIT=${PKM_GIT_COMMIT}
+                       -DPYTHON=${Python3_EXECUTABLE} -DPACK=${PKM_PACK_FMU} -DSTAMP=${PKM_SOURCE_STAMP}
                        -DWORK=${PROJECT_BINARY_DIR}/reproducible/fmi${version}_${id}
                        -P ${CMAKE_CURRENT_FUNCTION_LIST_DIR}/check_reproducible_fmu.cmake)
       add_test(NAME model_descriptions_up_to_date_fmi${version}_${id}
                COMMAND ${CMAKE_COMMAND} -E compare_files "${generated_md}/fmi${version}/${id}.xml" "${md}")
     endif()
-    if(version EQUAL 2)
-      set(${id}_FMU_DIR "${stage}" PARENT_SCOPE)
-      set(${id}_FMU_FILE "${fmu}" PARENT_SCOPE)
-    else()
-      set(${id}_FMU3_DIR "${stage}" PARENT_SCOPE)
-      set(${id}_FMU3_FILE "${fmu}" PARENT_SCOPE)
-    endif()
+    set_target_properties(${id} PROPERTIES PKM_FMU_ARCHIVE_FMI${version} "${fmu}" PKM_FMU_STAGE_FMI${version} "${stage}")
   endforeach()
+endfunction()
+
+# pkm_fmu_paths(<target> <id> <prefix>): <target> compiled with where the
+# build puts the FMU <id>'s files, as string macros, and built after them:
+#   <prefix>_SO    the binary             <prefix>_FMU   the FMI 2.0 archive
+#   <prefix>_XML   its staged model       <prefix>_FMU3  the FMI 3.0 archive
+#                  description (FMI 2.0)
+function(pkm_fmu_paths target id prefix)
+  target_compile_definitions(${target} PRIVATE ${prefix}_SO="$<TARGET_FILE:${id}>")
+  add_dependencies(${target} ${id})
+  if(TARGET ${id}_fmu)
+    target_compile_definitions(${target} PRIVATE
+      ${prefix}_XML="$<TARGET_PROPERTY:${id},PKM_FMU_STAGE_FMI2>/modelDescription.xml"
+      ${prefix}_FMU="$<TARGET_PROPERTY:${id},PKM_FMU_ARCHIVE_FMI2>"
+      ${prefix}_FMU3="$<TARGET_PROPERTY:${id},PKM_FMU_ARCHIVE_FMI3>")
+    add_dependencies(${target} ${id}_fmu ${id}_fmu3)
+  endif()
 endfunction()

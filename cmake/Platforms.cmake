@@ -4,7 +4,8 @@
 # under ${PROJECT_BINARY_DIR}/platforms/<target> with the toolchain files of
 # cmake/toolchains/, against a static CVODE built for the target from
 # Debian's source package (scripts/cross_sundials.sh, cached in
-# platforms/sundials-<target>); the FMI tests run there under wine and
+# platforms/sundials-<target>, found through the SUNDIALSConfig.cmake it
+# installs there, as the host's); the FMI tests run there under wine and
 # qemu-user; and one archive per FMU and FMI version holding every platform
 # and the source code (cmake/merge_fmu.py):
 #
@@ -66,7 +67,7 @@ foreach(_t IN ITEMS win64 aarch64)
     CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/cmake/toolchains/${_toolchain}.cmake
                -DCMAKE_BUILD_TYPE=Release -DPKM_BUILD_BENCHMARKS=ON -DPKM_PLATFORMS=OFF
                -DPKM_CROSS_PREFIX=${_prefix}
-               -DPKM_FMU_PYTHON=${PKM_FMU_PYTHON} -DPKM_TRACE_REFERENCE=${PKM_TRACE_DIR}
+               -DPython3_EXECUTABLE=${Python3_EXECUTABLE} -DPKM_TRACE_REFERENCE=${PKM_TRACE_DIR}
     BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR> -j2
                   --target PKM4PUU PKM4PUU_Inverse fmi_state_machine fmi_variables fmi_fmu_state fmi_stepping
                           fmi_logging fmi_autotest_chain ${_extra_targets}
@@ -87,7 +88,7 @@ foreach(_t IN ITEMS win64 aarch64)
       # the ratio to linux64 against its 1.2x target (printed, not asserted)
       # and the poses after 1 s within 1e-12 (tests/platform_ticks.py).
       add_test(NAME platform_win64_tick_ratio
-               COMMAND ${PKM_FMU_PYTHON} ${PROJECT_SOURCE_DIR}/tests/platform_ticks.py
+               COMMAND Python3::Interpreter ${PROJECT_SOURCE_DIR}/tests/platform_ticks.py
                        --host $<TARGET_FILE:pkm_bench> --other ${_bin}/bench/pkm_bench.exe
                        --runner wine --name win64 --rounds 1)
       set_tests_properties(platform_win64_tick_ratio PROPERTIES TIMEOUT 300)
@@ -134,14 +135,14 @@ foreach(_f IN LISTS _headers)
 endforeach()
 # The notices beyond the host's (cmake/Fmu.cmake): mingw-w64's runtime in the
 # Windows binaries, Eigen in sources/.
-list(APPEND _header_args --eigen "${_eigen_inc}" --commit "${PKM_GIT_COMMIT}"
+list(APPEND _header_args --eigen "${_eigen_inc}" --stamp "${PKM_SOURCE_STAMP}"
      --license "${PKM_LICENSES_DIR}/mingw-w64.txt" --license "${PKM_LICENSES_DIR}/Eigen.txt")
 
 set(_merged)
 get_property(_models GLOBAL PROPERTY PKM_FMU_MODELS)
 foreach(_id IN LISTS _models)
   # The model's table and sources, as pkm_add_fmu compiled the binary with them.
-  get_property(_def GLOBAL PROPERTY PKM_FMU_DEFINITION_${_id})
+  get_target_property(_def ${_id} PKM_FMI_DEFINITION)
   get_target_property(_model_src pkm_model_${_id} SOURCES)
   set(_sources ${_common_sources})
   foreach(_f IN LISTS _model_src)
@@ -165,22 +166,16 @@ foreach(_id IN LISTS _models)
       endif()
     endforeach()
     # The host's staged FMU and its archive (cmake/Fmu.cmake).
-    if(_v EQUAL 2)
-      set(_native "${PROJECT_BINARY_DIR}/fmu/${_id}")
-      set(_native_fmu "${PROJECT_BINARY_DIR}/${_id}.fmu")
-    else()
-      set(_native "${PROJECT_BINARY_DIR}/fmu3/${_id}")
-      set(_native_fmu "${PROJECT_BINARY_DIR}/fmi3/${_id}.fmu")
-    endif()
+    get_target_property(_native ${_id} PKM_FMU_STAGE_FMI${_v})
+    get_target_property(_native_fmu ${_id} PKM_FMU_ARCHIVE_FMI${_v})
     set(_out "${PROJECT_BINARY_DIR}/dist/fmi${_v}/${_id}.fmu")
     add_custom_command(
       OUTPUT "${_out}"
       COMMAND ${CMAKE_COMMAND} -E make_directory "${PROJECT_BINARY_DIR}/dist/fmi${_v}"
-      COMMAND ${CMAKE_COMMAND} -E env SOURCE_DATE_EPOCH=${PKM_SOURCE_DATE_EPOCH}
-              "${PKM_FMU_PYTHON}" "${PROJECT_SOURCE_DIR}/cmake/merge_fmu.py" --out "${_out}"
+      COMMAND Python3::Interpreter "${PROJECT_SOURCE_DIR}/cmake/merge_fmu.py" --out "${_out}"
               --stage "${PROJECT_BINARY_DIR}/dist/stage/fmi${_v}/${_id}" --native-stage "${_native}"
               --fmi-version ${_v} --id ${_id} --definition ${_def} ${_bins} ${_src_args}
-      DEPENDS "${_native_fmu}" ${PKM_win64_BINARIES} ${PKM_aarch64_BINARIES} ${_sources} ${_headers}
+      DEPENDS "${_native_fmu}" pkm_source_stamp "${PKM_SOURCE_STAMP}" ${PKM_win64_BINARIES} ${PKM_aarch64_BINARIES} ${_sources} ${_headers}
               "${PROJECT_SOURCE_DIR}/cmake/merge_fmu.py" "${PKM_PACK_FMU}"
       COMMENT "Merging every platform and the sources into ${_out}"
       VERBATIM)

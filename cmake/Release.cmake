@@ -6,7 +6,7 @@
 include_guard(GLOBAL)
 # Only in this project's own build: a project that adds this one
 # (add_subdirectory, FetchContent) keeps the target name `release` for itself.
-if(NOT _pkm_pack_python OR CMAKE_CROSSCOMPILING OR NOT _pkm_top_level)
+if(NOT Python3_Interpreter_FOUND OR CMAKE_CROSSCOMPILING OR NOT _pkm_top_level)
   return()
 endif()
 set(_pkm_release_fmus pkm_fmus)
@@ -14,11 +14,11 @@ if(PKM_PLATFORMS)
   list(APPEND _pkm_release_fmus pkm_dist_fmus)
 endif()
 set(PKM_RELEASE_COMMAND
-    ${_pkm_pack_python} ${PROJECT_SOURCE_DIR}/cmake/make_release.py --build ${PROJECT_BINARY_DIR}
+    Python3::Interpreter ${PROJECT_SOURCE_DIR}/cmake/make_release.py --build ${PROJECT_BINARY_DIR}
     --source ${PROJECT_SOURCE_DIR} --version ${PROJECT_VERSION} --platforms $<IF:$<BOOL:${PKM_PLATFORMS}>,ON,OFF>
-    --epoch ${PKM_SOURCE_DATE_EPOCH} --commit "${PKM_GIT_COMMIT}")
+    --stamp ${PKM_SOURCE_STAMP})
 add_custom_target(release
   COMMAND ${PKM_RELEASE_COMMAND} --out ${PROJECT_BINARY_DIR}/release
-  DEPENDS pkm pkm_static ${_pkm_release_fmus}
+  DEPENDS pkm pkm_static ${_pkm_release_fmus} pkm_source_stamp
   COMMENT "Writing the release into ${PROJECT_BINARY_DIR}/release/pkm4puu-${PROJECT_VERSION}"
   USES_TERMINAL VERBATIM)

@@ -1,25 +1,14 @@
 # SPDX-License-Identifier: BSD-2-Clause
-# SUNDIALS from Debian's libsundials-dev, linked statically so that nothing
-# built here (in particular the FMU binaries) needs SUNDIALS at run time.
-# Defines the imported target pkm::sundials.
-set(_pkm_sundials_parts
-    cvode sunnonlinsolfixedpoint sunnonlinsolnewton sunlinsoldense sunmatrixdense nvecserial)
-find_path(SUNDIALS_INCLUDE_DIR cvode/cvode.h REQUIRED)
-set(_pkm_sundials_libs)
-foreach(part IN LISTS _pkm_sundials_parts)
-  find_library(SUNDIALS_${part}_STATIC NAMES libsundials_${part}.a)
-  if(NOT SUNDIALS_${part}_STATIC)
-    message(FATAL_ERROR "libsundials_${part}.a not found: install Debian's libsundials-dev "
-                        "(./scripts/setup.sh does it)")
-  endif()
-  list(APPEND _pkm_sundials_libs ${SUNDIALS_${part}_STATIC})
-endforeach()
-# libsundials_generic holds SUNContext and the shared helpers in 6.x when present.
-find_library(SUNDIALS_generic_STATIC NAMES libsundials_generic.a)
-if(SUNDIALS_generic_STATIC)
-  list(APPEND _pkm_sundials_libs ${SUNDIALS_generic_STATIC})
+# SUNDIALS' CVODE through SUNDIALS' own CMake package (SUNDIALSConfig.cmake:
+# Debian's libsundials-dev ships it; scripts/cross_sundials.sh installs it
+# for the cross targets), linked statically so that nothing built here (in
+# particular the FMU binaries) needs SUNDIALS at run time. The static CVODE
+# library holds what the core uses (the serial vector, the dense matrix and
+# linear solver, the nonlinear solvers). Defines SUNDIALS::cvode_static.
+include_guard(GLOBAL)
+find_package(SUNDIALS 6 CONFIG COMPONENTS cvode)
+if(NOT SUNDIALS_FOUND OR NOT TARGET SUNDIALS::cvode_static)
+  message(FATAL_ERROR "SUNDIALS 6 with a static CVODE (SUNDIALS::cvode_static from SUNDIALSConfig.cmake) not found: "
+                      "install Debian's libsundials-dev (./scripts/setup.sh does it), or point SUNDIALS_DIR at "
+                      "the folder holding SUNDIALSConfig.cmake")
 endif()
-add_library(pkm_sundials INTERFACE)
-target_include_directories(pkm_sundials SYSTEM INTERFACE ${SUNDIALS_INCLUDE_DIR})
-target_link_libraries(pkm_sundials INTERFACE ${_pkm_sundials_libs} m)
-add_library(pkm::sundials ALIAS pkm_sundials)

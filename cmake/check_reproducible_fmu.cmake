@@ -6,7 +6,7 @@
 # one the build wrote. Together with deterministic compiling and linking
 # (no dates or paths in the binary), the same commit builds the same .fmu.
 #   cmake -DFMU=... -DSTAGE=... -DID=... -DDOC_TOOL=... -DPYTHON=... -DPACK=...
-#         -DEPOCH=... -DCOMMIT=... -DWORK=... -P check_reproducible_fmu.cmake
+#         -DSTAMP=... -DWORK=... -P check_reproducible_fmu.cmake
 file(REMOVE_RECURSE "${WORK}")
 file(GLOB_RECURSE _files RELATIVE "${STAGE}" "${STAGE}/*")
 list(SORT _files)
@@ -35,8 +35,7 @@ execute_process(COMMAND "${DOC_TOOL}" "${ID}" "${WORK}/documentation/index.html"
 if(NOT _rc EQUAL 0)
   message(FATAL_ERROR "${DOC_TOOL} failed: ${_rc}")
 endif()
-execute_process(COMMAND ${CMAKE_COMMAND} -E env SOURCE_DATE_EPOCH=${EPOCH}
-                        "${PYTHON}" "${PACK}" --commit "${COMMIT}" "${WORK}.fmu" "${WORK}"
+execute_process(COMMAND "${PYTHON}" "${PACK}" --stamp "${STAMP}" "${WORK}.fmu" "${WORK}"
                         modelDescription.xml "${_binary}" documentation/index.html ${_licenses}
                 RESULT_VARIABLE _rc)
 if(NOT _rc EQUAL 0)

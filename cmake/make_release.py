@@ -15,9 +15,11 @@
     SHA256SUMS                           `sha256sum -c SHA256SUMS` checks every file
 
 usage: make_release.py --build DIR --source DIR --version X.Y.Z --platforms ON|OFF
-                       --out DIR [--no-wheel] [--epoch SECONDS] [--commit HASH]
-The archives written here are dated --epoch (the commit's date, as the FMUs
-are), with owners and order fixed: the same inputs give the same bytes.
+                       --out DIR [--no-wheel] [--stamp STAMP.json]
+The archives written here are dated the build's source stamp's epoch (the
+commit's date, as the FMUs are: cmake/source_stamp.cmake), with owners and
+order fixed: the same inputs give the same bytes; the manifest names the
+stamp's commit.
 """
 import argparse
 import gzip
@@ -30,6 +32,8 @@ import sys
 import tarfile
 import tempfile
 from pathlib import Path
+
+from pack_fmu import read_stamp  # beside this script, which Python puts first on the import path
 
 MODELS = ["PKM4PUU", "PKM4PUU_Inverse"]
 
@@ -86,9 +90,9 @@ def main():
     ap.add_argument("--platforms", required=True, choices=["ON", "OFF", "1", "0"])
     ap.add_argument("--out", required=True, type=Path)
     ap.add_argument("--no-wheel", action="store_true", help="leave the wheel out (its CMake build takes minutes)")
-    ap.add_argument("--epoch", type=int, default=315532800, help="the archives' date (the commit's, as the FMUs')")
-    ap.add_argument("--commit", default="", help="the commit built, for the manifest")
+    ap.add_argument("--stamp", help="the build's source stamp: the archives' date and the commit for the manifest")
     args = ap.parse_args()
+    epoch, commit = read_stamp(args.stamp)
     build, source = args.build.resolve(), args.source.resolve()
     merged = args.platforms in ("ON", "1")
     name = f"pkm4puu-{args.version}"
@@ -117,7 +121,7 @@ def main():
     with tempfile.TemporaryDirectory(prefix="pkm-release-") as tmp:
         staging = Path(tmp) / "prefix"
         run(["cmake", "--install", build, "--prefix", staging])
-        reproducible_tar_gz(staging, folder / "c" / f"{c_name}.tar.gz", c_name, args.epoch)
+        reproducible_tar_gz(staging, folder / "c" / f"{c_name}.tar.gz", c_name, epoch)
 
         # 3. The sdist and the wheel.
         (folder / "python").mkdir()
@@ -139,7 +143,7 @@ def main():
             "for the merged archives")
     manifest = [
         f"PKM4PUU {args.version}",
-        f"commit: {args.commit or 'unknown'}",
+        f"commit: {commit or 'unknown'}",
         f"FMUs (fmi2/, fmi3/): {fmus}",
         f"wheel (python/): {wheel_note}",
         f"sdist (python/): {name}.tar.gz",

@@ -6,7 +6,7 @@ binaries/<platform>/ folder per platform, sources/ to build for any other).
 usage: merge_fmu.py --out FMU --stage DIR --native-stage DIR --fmi-version {2,3}
                     --id ID --definition FUNC [--binary PLATFORM=FILE]...
                     [--source-root DIR] [--source FILE]... [--header FILE]...
-                    [--eigen DIR] [--license FILE]... [--commit COMMIT]
+                    [--eigen DIR] [--license FILE]... [--stamp STAMP.json]
 
 --native-stage  the host build's staged FMU (modelDescription.xml,
                 binaries/<host platform>/, documentation/): taken as it is.
@@ -22,7 +22,7 @@ usage: merge_fmu.py --out FMU --stage DIR --native-stage DIR --fmi-version {2,3}
 --license       a notice for documentation/licenses/ that the added binaries
                 or sources need beyond the native stage's (mingw-w64's
                 runtime for the Windows binaries, Eigen for sources/).
---commit        the commit, for the model description's stamp (pack_fmu.py).
+--stamp         the build's source stamp: the commit and the entries' date (pack_fmu.py).
 
 The source build compiles the listed files plus two generated wrappers,
 <ID>_fmi2_functions.cpp and <ID>_fmi3_functions.cpp, which define
@@ -86,7 +86,7 @@ def main():
     ap.add_argument("--header", action="append", default=[])
     ap.add_argument("--eigen")
     ap.add_argument("--license", action="append", default=[])
-    ap.add_argument("--commit", default="")
+    ap.add_argument("--stamp")
     a = ap.parse_args()
 
     stage, native = Path(a.stage), Path(a.native_stage)
@@ -132,7 +132,8 @@ def main():
 
     names = sorted(str(p.relative_to(stage)).replace(os.sep, "/") for p in stage.rglob("*") if p.is_file())
     names.remove("modelDescription.xml")
-    pack_fmu.main(["pack_fmu.py", "--commit", a.commit, a.out, str(stage), "modelDescription.xml", *names])
+    stamp = ["--stamp", a.stamp] if a.stamp else []
+    pack_fmu.main(["pack_fmu.py", *stamp, a.out, str(stage), "modelDescription.xml", *names])
 
 
 if __name__ == "__main__":

@@ -1,17 +1,19 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Writes an FMU archive (zip) that depends only on the files' contents:
-entries in the order given, each dated SOURCE_DATE_EPOCH (the commit's date
-when the build passes it; 1980-01-01 otherwise), permissions 0644 (0755 for
-binaries), no extra fields (no atime, ctime, uid or gid), deflated.
-The same commit therefore builds bit-identical archives.
+entries in the order given, each dated the stamp's epoch (the commit's date
+or $SOURCE_DATE_EPOCH: cmake/source_stamp.cmake; 1980-01-01 without a
+stamp), permissions 0644 (0755 for binaries), no extra fields (no atime,
+ctime, uid or gid), deflated. The same commit therefore builds
+bit-identical archives.
 
 The archive's modelDescription.xml is the committed one stamped with what
 changes from commit to commit, which the committed file cannot hold:
 generationTool gets " (commit COMMIT)" appended and generationDateAndTime is
-added, the commit's date (SOURCE_DATE_EPOCH), so the stamp is reproducible.
+added, the stamp's epoch, so the stamp is reproducible.
 
-usage: pack_fmu.py [--commit COMMIT] OUTPUT STAGE_DIR FILE...   (FILEs relative to STAGE_DIR)
+usage: pack_fmu.py [--stamp STAMP.json] OUTPUT STAGE_DIR FILE...   (FILEs relative to STAGE_DIR)
 """
+import json
 import os
 import re
 import sys
@@ -33,14 +35,27 @@ def stamp(xml, commit, epoch):
             xml[m.end():])
 
 
+EARLIEST = 315532800  # 1980-01-01, zip's earliest date
+
+
+def read_stamp(path):
+    """(epoch, commit) from the build's source stamp (cmake/source_stamp.cmake);
+    1980-01-01 and no commit without one."""
+    if not path:
+        return EARLIEST, ""
+    with open(path, encoding="utf-8") as f:
+        data = json.load(f)
+    return max(int(data["epoch"]), EARLIEST), data["commit"]
+
+
 def main(argv):
-    commit = ""
-    if len(argv) > 2 and argv[1] == "--commit":
-        commit, argv = argv[2], argv[:1] + argv[3:]
+    stamp_file = None
+    if len(argv) > 2 and argv[1] == "--stamp":
+        stamp_file, argv = argv[2], argv[:1] + argv[3:]
     if len(argv) < 4:
         sys.exit(__doc__)
     out, stage, files = argv[1], argv[2], argv[3:]
-    epoch = max(int(os.environ.get("SOURCE_DATE_EPOCH", "315532800")), 315532800)  # 1980-01-01, zip's earliest
+    epoch, commit = read_stamp(stamp_file)
     date_time = time.gmtime(epoch)[:6]
     tmp = out + ".tmp"
     with zipfile.ZipFile(tmp, "w") as z:

@@ -20,6 +20,11 @@ if [ -f build/CMakeCache.txt ] && ! grep -q '^CMAKE_GENERATOR:INTERNAL=Ninja$' b
 fi
 configure_only=0
 if [ "${1:-}" = "--configure-only" ]; then configure_only=1; shift; fi
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release "$@"
+# The FMU tests, the documentation's build and the benchmarks run Python
+# with fmpy, Sphinx, ... from the project's .venv (CMake's find_package(Python3)
+# would otherwise take the first python3 on the PATH).
+python=()
+if [ -x .venv/bin/python ]; then python=(-DPython3_EXECUTABLE="$PWD/.venv/bin/python"); fi
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release "${python[@]}" "$@"
 if [ "$configure_only" -eq 1 ]; then exit 0; fi
 cmake --build build -j2

@@ -7,7 +7,10 @@
 #
 #   scripts/cross_sundials.sh <win64|aarch64> PREFIX
 #
-# Installs into PREFIX (include/, lib/libsundials_*.a). The cache key (this
+# Installs into PREFIX (include/, lib/libsundials_*.a and SUNDIALS' CMake
+# package lib/cmake/sundials/SUNDIALSConfig.cmake, through which the cross
+# build finds SUNDIALS::cvode_static: the toolchain files put PREFIX on
+# CMAKE_FIND_ROOT_PATH, cmake/Sundials.cmake). The cache key (this
 # script and the toolchain files) is written to PREFIX/.pkm-key; when it
 # matches, nothing is done, so a rerun costs nothing. The source is fetched
 # once into PREFIX/../src. Needs a deb-src entry (scripts/setup.sh adds one).
@@ -32,15 +35,13 @@ esac
 mkdir -p "$prefix"
 prefix=$(cd "$prefix" && pwd)
 work=$(dirname "$prefix")
-parts=(cvode nvecserial sunmatrixdense sunlinsoldense sunnonlinsolnewton sunnonlinsolfixedpoint generic)
 
 key=$(cat "${BASH_SOURCE[0]}" "$toolchain" "$toolchains/cross_common.cmake" | sha256sum | cut -c1-16)
+# What the build uses: the package and the static CVODE it names (which
+# holds the serial vector, the dense solvers and the nonlinear solvers too).
 complete() {
-  [ "$(cat "$prefix/.pkm-key" 2>/dev/null)" = "$key" ] && [ -f "$prefix/include/cvode/cvode.h" ] || return 1
-  local p
-  for p in "${parts[@]}"; do
-    [ -f "$prefix/lib/libsundials_$p.a" ] || return 1
-  done
+  [ "$(cat "$prefix/.pkm-key" 2>/dev/null)" = "$key" ] && [ -f "$prefix/include/cvode/cvode.h" ] &&
+    [ -f "$prefix/lib/cmake/sundials/SUNDIALSConfig.cmake" ] && [ -f "$prefix/lib/libsundials_cvode.a" ]
 }
 if complete; then
   log "$target: static CVODE cached in $prefix"
@@ -86,5 +87,5 @@ cmake --install "$bdir" >"$work/install-$target.log" 2>&1 \
   || { tail -n 20 "$work/install-$target.log" >&2; log "ERROR: install failed"; exit 1; }
 rm -rf "$bdir"
 echo "$key" >"$prefix/.pkm-key"
-complete || { log "ERROR: install incomplete in $prefix (expected ${parts[*]})"; exit 1; }
+complete || { log "ERROR: install incomplete in $prefix (expected SUNDIALSConfig.cmake and libsundials_cvode.a)"; exit 1; }
 log "$target: static CVODE installed in $prefix"

@@ -18,10 +18,11 @@ The wheel is left out (--no-wheel): its CMake build takes minutes, and
 ctest distribution_wheel builds and checks it.
 
 usage: check_release.py --make-release PY --build DIR --source DIR --version X.Y.Z
-                        --platforms ON|OFF --work DIR --epoch N [--commit HASH]
+                        --platforms ON|OFF --work DIR --stamp STAMP.json
 """
 import argparse
 import hashlib
+import json
 import re
 import shutil
 import subprocess
@@ -63,8 +64,7 @@ def sum_problems(folder):
 
 def make(args, out):
     cmd = [sys.executable, args.make_release, "--build", args.build, "--source", args.source, "--version",
-           args.version, "--platforms", args.platforms, "--out", out, "--no-wheel", "--epoch", str(args.epoch),
-           "--commit", args.commit]
+           args.version, "--platforms", args.platforms, "--out", out, "--no-wheel", "--stamp", args.stamp]
     r = subprocess.run([str(c) for c in cmd], capture_output=True, text=True)
     print(r.stdout, r.stderr, sep="", flush=True)
     if r.returncode != 0:
@@ -122,8 +122,9 @@ def check_contents(folder, args):
                 data = t.extractfile(members[f"{top}/share/pkm4puu/fmi{fmi}/{m}.fmu"]).read()
                 if hashlib.sha256(data).hexdigest() != sha256(folder / f"fmi{fmi}/{m}.fmu"):
                     fail(f"{c_pkgs[0].name}: share/pkm4puu/fmi{fmi}/{m}.fmu is not the release's")
-        if any(m.mtime != args.epoch for m in members.values()):
-            fail(f"{c_pkgs[0].name}: an entry not dated {args.epoch} (the commit's date)")
+        epoch = json.loads(Path(args.stamp).read_text())["epoch"]
+        if any(m.mtime != epoch for m in members.values()):
+            fail(f"{c_pkgs[0].name}: an entry not dated {epoch} (the commit's date)")
 
     sdist = folder / "python" / f"pkm4puu-{v}.tar.gz"
     if not sdist.is_file():
@@ -145,10 +146,8 @@ def check_contents(folder, args):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    for a in ("--make-release", "--build", "--source", "--version", "--platforms", "--work"):
+    for a in ("--make-release", "--build", "--source", "--version", "--platforms", "--work", "--stamp"):
         ap.add_argument(a, required=True)
-    ap.add_argument("--epoch", required=True, type=int)
-    ap.add_argument("--commit", default="")
     args = ap.parse_args()
     work = Path(args.work)
     shutil.rmtree(work, ignore_errors=True)
