@@ -137,7 +137,7 @@ def plot(ideal, real, motor, path, lead):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="pick_and_place", description=__doc__.split("\n\n")[0])
-    add_common_args(ap)
+    add_common_args(ap, "pick_and_place.csv and pick_and_place.png")
     ap.add_argument("--payload", type=float, default=pkm4puu.spec.CYCLE_PAYLOAD,
                     help="mass carried from A to B, kg (default %(default)g)")
 

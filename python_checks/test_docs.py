@@ -213,6 +213,8 @@ def indexed_claim(token, names):
     1..n must be the whole array."""
     m = INDEXED.match(token)
     base, index = m.groups()
+    if re.fullmatch(r"[A-Z][A-Z0-9_]*", index):
+        return ""  # sized by a C macro (u[PKM_PLANT_INPUTS]): a C array, no FMU variable
     have = sorted(int(re.match(rf"{re.escape(base)}\[(\d+)\]$", n).group(1))
                   for n in names if re.match(rf"{re.escape(base)}\[\d+\]$", n))
     if not have:

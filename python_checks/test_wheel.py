@@ -99,7 +99,7 @@ def one_line_error(proc):
 
 
 PROBE = """
-import ctypes, importlib.util, sys
+import importlib.util, sys
 from pathlib import Path
 from pkm4puu import *
 import pkm4puu, pkm4puu.capi as capi
@@ -109,8 +109,7 @@ paths = [find_fmu(m, v) for m in ("PKM4PUU", "PKM4PUU_Inverse") for v in (2, 3)]
 outside = [p for p in paths if root not in p.resolve().parents]
 assert not outside, f"not inside the venv {root}: {outside}"
 lib = capi.load()
-lib.pkm_version.restype = ctypes.c_char_p
-print(__version__, lib.pkm_version().decode())
+print(__version__, lib.ffi.string(lib.pkm_version()).decode())
 print(*(m for m in sys.argv[1:] if importlib.util.find_spec(m)))
 try:
     identify([0.0, 1.0], [[0.0] * 4] * 2, [[0.0] * 4] * 2)

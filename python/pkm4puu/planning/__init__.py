@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: BSD-2-Clause
-"""Time-optimal pick-and-place (needs the `planning` extra: toppra).
+"""Time-optimal pick-and-place (planning needs the extra `planning`: toppra,
+imported when a plan is made).
 
     cycle = pkm4puu.plan_cycle()             # the standard cycle
     cycle.duration                           # s

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import topp
+from .. import extras
 from .capi_adapter import InverseDynamics, PoseError
 from .limits import BadValue, Infeasible, Limits, OutsideWorkspace, PlanningError, SingularPath, check_value
 
@@ -186,11 +186,13 @@ def plan_segment(path, payload_mass=0.0, limits=None, machine=None, params=None,
                  build=None, check_workspace=True):
     """The fastest rest-to-rest traversal of `path` (p(s), s in [0, 1]; see
     paths.Arch) carrying `payload_mass` kg at P, within `limits` (a
-    limits.Limits), for the machine `machine` (pkm_machine_params fields,
-    e.g. rotor_inertia, screw_lead, friction_viscous) and model `params`
-    (pkm_params fields), on `grid` intervals of s, sampled every `dt` s.
-    PlanningError (its subclasses) when it cannot be planned, saying why
-    and where."""
+    limits.Limits), for the machine `machine` and model `params` (the FMUs'
+    parameter names, e.g. rotor_inertia, screw_lead, friction_viscous, g),
+    on `grid` intervals of s, sampled every `dt` s. PlanningError (its
+    subclasses) when it cannot be planned, saying why and where;
+    extras.MissingExtra without toppra (the extra `planning`)."""
+    extras.require("pkm4puu.plan_cycle", "toppra")
+    from . import topp  # toppra's classes at its module level
     limits = limits or Limits()
     payload_mass = check_value("payload_mass", payload_mass, unit=" kg")
     s = grid_points(grid)
