@@ -10,8 +10,8 @@
 // any FMI function, in any state, with value references from the model's
 // table or arbitrary ones, values from a list of awkward numbers (NaN, +-Inf,
 // 0, -0, denormals, 1e300, DBL_MAX, ...) or raw bytes, NULL pointers,
-// foreign pointers, FMU states (saved, freed, serialised, corrupted, taken
-// to another instance), and two macro operations that bring an instance
+// foreign pointers, FMU states (saved, freed, serialised, corrupted, forged
+// with the checksum recomputed, taken to another instance), and two macro operations that bring an instance
 // into its stepping state and run it, so that deep states are reached fast.
 //
 // Besides the sanitizers, the harness checks the FMU's promises (a
@@ -49,6 +49,7 @@
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
 #include "fmi/fmi_functions.h"
+#include "fmi/fnv1a.hpp"
 #include "models/models.hpp"
 #include "pkm4puu/kinematics/workspace_guard.hpp"
 
@@ -225,6 +226,16 @@ double step_size(FuzzedDataProvider& in) {
 
 constexpr int kSlots = 3;
 constexpr int kMaxOps = 48;
+
+/// A mutated serialised state with its checksum recomputed (the last 8
+/// bytes, fnv1a.hpp), so that the mutation passes the header's checks and
+/// reaches those of the content: a forged state.
+template <class Byte>
+void reseal(std::vector<Byte>& b) {
+  if (b.size() < 8) return;
+  const std::uint64_t h = pkm_fmi::fnv1a(reinterpret_cast<const unsigned char*>(b.data()), b.size() - 8);
+  for (int k = 0; k < 8; ++k) b[b.size() - 8 + k] = static_cast<Byte>((h >> (8 * k)) & 0xff);
+}
 
 /// The instances and FMU states of one input, for either FMI version V
 /// (Fmi2, Fmi3 below: its Api, instance, state and byte types, and how to
@@ -642,6 +653,7 @@ void one_op(FuzzedDataProvider& in, World& w) {
         for (int f = 0; f < flips && !bytes.empty(); ++f)
           bytes[in.ConsumeIntegralInRange<std::size_t>(0, bytes.size() - 1)] ^= static_cast<fmi2Byte>(
               1u << in.ConsumeIntegralInRange<int>(0, 7));
+        if (flips > 0 && in.ConsumeBool()) reseal(bytes);
         if (in.ConsumeIntegralInRange<int>(0, 7) == 0) bytes.resize(in.ConsumeIntegralInRange<std::size_t>(0, bytes.size()));
       } else {
         const std::string raw = in.ConsumeRandomLengthString(200);
@@ -1151,9 +1163,11 @@ void one_op3(FuzzedDataProvider& in, World3& w) {
       std::vector<fmi3Byte> bytes;
       if (!w.blobs.empty() && in.ConsumeBool()) {
         bytes = w.blobs[in.ConsumeIntegralInRange<std::size_t>(0, w.blobs.size() - 1)];
-        if (!bytes.empty() && in.ConsumeBool())
+        if (!bytes.empty() && in.ConsumeBool()) {
           bytes[in.ConsumeIntegralInRange<std::size_t>(0, bytes.size() - 1)] ^=
               static_cast<fmi3Byte>(1u << in.ConsumeIntegralInRange<int>(0, 7));
+          if (in.ConsumeBool()) reseal(bytes);
+        }
       } else {
         const std::string raw = in.ConsumeRandomLengthString(200);
         bytes.assign(raw.begin(), raw.end());
