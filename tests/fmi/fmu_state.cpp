@@ -353,8 +353,8 @@ std::string first_difference(const std::vector<double>& a, const std::vector<dou
   for (std::size_t i = 0; i < a.size(); ++i) {
     if (std::memcmp(&a[i], &b[i], sizeof(double)) == 0) continue;
     char buf[200];
-    std::snprintf(buf, sizeof buf, "first difference after step %zu of the run, %s: %.17g vs %.17g", i / names.size(),
-                  names[i % names.size()], a[i], b[i]);
+    std::snprintf(buf, sizeof buf, "first difference after step %lu of the run, %s: %.17g vs %.17g",
+                  static_cast<unsigned long>(i / names.size()), names[i % names.size()], a[i], b[i]);
     return buf;
   }
   return "";
