@@ -52,6 +52,7 @@
 #include "fmi/fnv1a.hpp"
 #include "models/models.hpp"
 #include "pkm4puu/kinematics/workspace_guard.hpp"
+#include "pkm4puu/sim/solver_memory.hpp"
 
 // The two in-process FMUs' exported FMI 2.0 functions: fmi_functions.h.
 #define PKM_FUZZ_FMI2_FUNCTIONS PKM_FMI2_FUNCTIONS
@@ -227,14 +228,26 @@ double step_size(FuzzedDataProvider& in) {
 constexpr int kSlots = 3;
 constexpr int kMaxOps = 48;
 
-/// A mutated serialised state with its checksum recomputed (the last 8
-/// bytes, fnv1a.hpp), so that the mutation passes the header's checks and
-/// reaches those of the content: a forged state.
+/// A forged serialised state: one bit flipped in a field the loader checks
+/// against the instance -- the mode and flags (bytes 32..38,
+/// fmu_state.hpp), the plant's contact mode and the integrators' memory at
+/// its end (plant_data.cpp) -- or anywhere, and the checksum recomputed (the
+/// last 8 bytes, fnv1a.hpp), so that the forgery passes the header's checks
+/// and reaches those of the content.
 template <class Byte>
-void reseal(std::vector<Byte>& b) {
-  if (b.size() < 8) return;
-  const std::uint64_t h = pkm_fmi::fnv1a(reinterpret_cast<const unsigned char*>(b.data()), b.size() - 8);
-  for (int k = 0; k < 8; ++k) b[b.size() - 8 + k] = static_cast<Byte>((h >> (8 * k)) & 0xff);
+void forge_field(std::vector<Byte>& b, FuzzedDataProvider& in) {
+  constexpr std::size_t kTail = 8 + sizeof(pkm::SolverMemory) + 4 + 4;  // contact mode, memory size, memory, checksum
+  if (b.size() < 40 + kTail) return;
+  const std::size_t end = b.size() - 8;
+  std::size_t at = 0;
+  switch (in.ConsumeIntegralInRange<int>(0, 2)) {
+    case 0: at = in.ConsumeIntegralInRange<std::size_t>(32, 38); break;
+    case 1: at = in.ConsumeIntegralInRange<std::size_t>(b.size() - kTail, end - 1); break;
+    default: at = in.ConsumeIntegralInRange<std::size_t>(0, end - 1); break;
+  }
+  b[at] = static_cast<Byte>(b[at] ^ (1u << in.ConsumeIntegralInRange<int>(0, 7)));
+  const std::uint64_t h = pkm_fmi::fnv1a(reinterpret_cast<const unsigned char*>(b.data()), end);
+  for (int k = 0; k < 8; ++k) b[end + k] = static_cast<Byte>((h >> (8 * k)) & 0xff);
 }
 
 /// The instances and FMU states of one input, for either FMI version V
@@ -434,6 +447,19 @@ void run(FuzzedDataProvider& in, World& w, int i) {
   }
 }
 
+/// fmi2SetFMUstate on a slot; on success the harness takes the time the
+/// instance now has. Whether it succeeded.
+bool set_state(const Api& a, Slot& sl, fmi2FMUstate s) {
+  ++g_calls;
+  if (a.fmi2SetFMUstate(sl.c, s) != fmi2OK) return false;
+  double t = 0.0;
+  ++g_calls;
+  if (a.fmi2GetRealStatus(sl.c, fmi2LastSuccessfulTime, &t) == fmi2OK) sl.time = t;
+  else sl.time = 0.0;  // instantiated or initialisation mode: the experiment's start, not tracked
+  // (the harness re-reads the time when it can; a wrong guess only makes fmi2DoStep refuse)
+  return true;
+}
+
 void one_op(FuzzedDataProvider& in, World& w) {
   const int i = in.ConsumeIntegralInRange<int>(0, kSlots - 1);
   Slot& sl = w.slots[i];
@@ -598,14 +624,7 @@ void one_op(FuzzedDataProvider& in, World& w) {
       if (how == 0) s = g_foreign;
       else if (how > 1 && !w.states.empty())
         s = w.states[in.ConsumeIntegralInRange<std::size_t>(0, w.states.size() - 1)].s;
-      ++g_calls;
-      if (a.fmi2SetFMUstate(sl.c, s) == fmi2OK) {
-        double t = 0.0;
-        ++g_calls;
-        if (a.fmi2GetRealStatus(sl.c, fmi2LastSuccessfulTime, &t) == fmi2OK) sl.time = t;
-        else sl.time = 0.0;  // instantiated or initialisation mode: the experiment's start, not tracked
-        // (the harness re-reads the time when it can; a wrong guess only makes fmi2DoStep refuse)
-      }
+      set_state(a, sl, s);
       break;
     }
     case 24: {  // fmi2FreeFMUstate, through any live instance of the same FMU
@@ -642,6 +661,17 @@ void one_op(FuzzedDataProvider& in, World& w) {
       const fmi2Status s = a.fmi2SerializeFMUstate(sl.c, st.s, blob.data() + 1, given);
       require(blob.front() == 0x5a && blob.back() == 0x5a, "fmi2SerializeFMUstate wrote outside its buffer");
       if (s == fmi2OK && w.blobs.size() < 8) w.blobs.emplace_back(blob.begin() + 1, blob.end() - 1);
+      if (s == fmi2OK && given == size && in.ConsumeBool()) {  // forged from it and set at once
+        std::vector<fmi2Byte> forged(blob.begin() + 1, blob.end() - 1);
+        forge_field(forged, in);
+        fmi2FMUstate f = nullptr;
+        ++g_calls;
+        if (a.fmi2DeSerializeFMUstate(sl.c, forged.data(), forged.size(), &f) == fmi2OK) {
+          set_state(a, sl, f);
+          ++g_calls;
+          a.fmi2FreeFMUstate(sl.c, &f);
+        }
+      }
       break;
     }
     case 26: {  // deserialise: a stored blob, mutated or truncated, or raw fuzz bytes
@@ -653,7 +683,7 @@ void one_op(FuzzedDataProvider& in, World& w) {
         for (int f = 0; f < flips && !bytes.empty(); ++f)
           bytes[in.ConsumeIntegralInRange<std::size_t>(0, bytes.size() - 1)] ^= static_cast<fmi2Byte>(
               1u << in.ConsumeIntegralInRange<int>(0, 7));
-        if (flips > 0 && in.ConsumeBool()) reseal(bytes);
+        if (in.ConsumeBool()) forge_field(bytes, in);
         if (in.ConsumeIntegralInRange<int>(0, 7) == 0) bytes.resize(in.ConsumeIntegralInRange<std::size_t>(0, bytes.size()));
       } else {
         const std::string raw = in.ConsumeRandomLengthString(200);
@@ -927,6 +957,18 @@ void run3(FuzzedDataProvider& in, World3& w, int i) {
   }
 }
 
+/// fmi3SetFMUState on a slot; on success the harness takes the time the
+/// instance now has. Whether it succeeded.
+bool set_state3(const Api3& a, Slot3& sl, fmi3FMUState s) {
+  ++g_calls;
+  if (a.fmi3SetFMUState(sl.c, s) != fmi3OK) return false;
+  double t = kGuard;  // the time a get of the independent variable reads
+  const fmi3ValueReference time_vr = 0;
+  ++g_calls;
+  sl.time = a.fmi3GetFloat64(sl.c, &time_vr, 1, &t, 1) == fmi3OK ? t : 0.0;
+  return true;
+}
+
 void one_op3(FuzzedDataProvider& in, World3& w) {
   const int i = in.ConsumeIntegralInRange<int>(0, kSlots - 1);
   Slot3& sl = w.slots[i];
@@ -1119,13 +1161,7 @@ void one_op3(FuzzedDataProvider& in, World3& w) {
       if (how == 0) s = g_foreign;
       else if (how > 1 && !w.states.empty())
         s = w.states[in.ConsumeIntegralInRange<std::size_t>(0, w.states.size() - 1)].s;
-      ++g_calls;
-      if (a.fmi3SetFMUState(sl.c, s) == fmi3OK) {
-        double t = kGuard;  // the time a get of the independent variable reads
-        const fmi3ValueReference time_vr = 0;
-        ++g_calls;
-        sl.time = a.fmi3GetFloat64(sl.c, &time_vr, 1, &t, 1) == fmi3OK ? t : 0.0;
-      }
+      set_state3(a, sl, s);
       break;
     }
     case 22: {  // free an FMU state through a live instance of the same FMU
@@ -1158,16 +1194,26 @@ void one_op3(FuzzedDataProvider& in, World3& w) {
         const fmi3Status s = a.fmi3SerializeFMUState(sl.c, st.s, blob.data() + 1, given);
         require(blob.front() == 0x5a && blob.back() == 0x5a, "fmi3SerializeFMUState wrote outside its buffer");
         if (s == fmi3OK && w.blobs.size() < 8) w.blobs.emplace_back(blob.begin() + 1, blob.end() - 1);
+        if (s == fmi3OK && given == size && in.ConsumeBool()) {  // forged from it and set at once
+          std::vector<fmi3Byte> forged(blob.begin() + 1, blob.end() - 1);
+          forge_field(forged, in);
+          fmi3FMUState f = nullptr;
+          ++g_calls;
+          if (a.fmi3DeserializeFMUState(sl.c, forged.data(), forged.size(), &f) == fmi3OK) {
+            set_state3(a, sl, f);
+            ++g_calls;
+            a.fmi3FreeFMUState(sl.c, &f);
+          }
+        }
         break;
       }
       std::vector<fmi3Byte> bytes;
       if (!w.blobs.empty() && in.ConsumeBool()) {
         bytes = w.blobs[in.ConsumeIntegralInRange<std::size_t>(0, w.blobs.size() - 1)];
-        if (!bytes.empty() && in.ConsumeBool()) {
+        if (!bytes.empty() && in.ConsumeBool())
           bytes[in.ConsumeIntegralInRange<std::size_t>(0, bytes.size() - 1)] ^=
               static_cast<fmi3Byte>(1u << in.ConsumeIntegralInRange<int>(0, 7));
-          if (in.ConsumeBool()) reseal(bytes);
-        }
+        if (in.ConsumeBool()) forge_field(bytes, in);
       } else {
         const std::string raw = in.ConsumeRandomLengthString(200);
         bytes.assign(raw.begin(), raw.end());
