@@ -292,6 +292,21 @@ struct WorldOf {
   }
 };
 
+/// A state just serialised (`blob`), forged (forge_field), deserialised and
+/// handed to `set` at once, then freed: the loader's checks of the content
+/// in one operation.
+template <class V, class Set>
+void forge_and_set(const typename V::Api& a, typename V::Instance c, std::vector<typename V::Byte> blob,
+                   FuzzedDataProvider& in, Set&& set) {
+  forge_field(blob, in);
+  typename V::FmuState f = nullptr;
+  ++g_calls;
+  if (!V::deserialize(a, c, blob, &f)) return;
+  set(f);
+  ++g_calls;
+  V::free_state(a, c, &f);
+}
+
 struct Fmi2 {
   using Api = ::Api;
   using Instance = fmi2Component;
@@ -300,6 +315,9 @@ struct Fmi2 {
   static constexpr const Api* apis = kApis;
   static void free_instance(const Api& a, Instance c) { a.fmi2FreeInstance(c); }
   static void free_state(const Api& a, Instance c, FmuState* s) { a.fmi2FreeFMUstate(c, s); }
+  static bool deserialize(const Api& a, Instance c, const std::vector<Byte>& b, FmuState* s) {
+    return a.fmi2DeSerializeFMUstate(c, b.data(), b.size(), s) == fmi2OK;
+  }
 };
 using World = WorldOf<Fmi2>;
 using State = World::State;
@@ -661,17 +679,9 @@ void one_op(FuzzedDataProvider& in, World& w) {
       const fmi2Status s = a.fmi2SerializeFMUstate(sl.c, st.s, blob.data() + 1, given);
       require(blob.front() == 0x5a && blob.back() == 0x5a, "fmi2SerializeFMUstate wrote outside its buffer");
       if (s == fmi2OK && w.blobs.size() < 8) w.blobs.emplace_back(blob.begin() + 1, blob.end() - 1);
-      if (s == fmi2OK && given == size && in.ConsumeBool()) {  // forged from it and set at once
-        std::vector<fmi2Byte> forged(blob.begin() + 1, blob.end() - 1);
-        forge_field(forged, in);
-        fmi2FMUstate f = nullptr;
-        ++g_calls;
-        if (a.fmi2DeSerializeFMUstate(sl.c, forged.data(), forged.size(), &f) == fmi2OK) {
-          set_state(a, sl, f);
-          ++g_calls;
-          a.fmi2FreeFMUstate(sl.c, &f);
-        }
-      }
+      if (s == fmi2OK && given == size && in.ConsumeBool())
+        forge_and_set<Fmi2>(a, sl.c, {blob.begin() + 1, blob.end() - 1}, in,
+                            [&](fmi2FMUstate f) { set_state(a, sl, f); });
       break;
     }
     case 26: {  // deserialise: a stored blob, mutated or truncated, or raw fuzz bytes
@@ -751,6 +761,9 @@ struct Fmi3 {
   static constexpr const Api* apis = kApis3;
   static void free_instance(const Api& a, Instance c) { a.fmi3FreeInstance(c); }
   static void free_state(const Api& a, Instance c, FmuState* s) { a.fmi3FreeFMUState(c, s); }
+  static bool deserialize(const Api& a, Instance c, const std::vector<Byte>& b, FmuState* s) {
+    return a.fmi3DeserializeFMUState(c, b.data(), b.size(), s) == fmi3OK;
+  }
 };
 using World3 = WorldOf<Fmi3>;
 using Slot3 = World3::Slot;
@@ -1194,17 +1207,9 @@ void one_op3(FuzzedDataProvider& in, World3& w) {
         const fmi3Status s = a.fmi3SerializeFMUState(sl.c, st.s, blob.data() + 1, given);
         require(blob.front() == 0x5a && blob.back() == 0x5a, "fmi3SerializeFMUState wrote outside its buffer");
         if (s == fmi3OK && w.blobs.size() < 8) w.blobs.emplace_back(blob.begin() + 1, blob.end() - 1);
-        if (s == fmi3OK && given == size && in.ConsumeBool()) {  // forged from it and set at once
-          std::vector<fmi3Byte> forged(blob.begin() + 1, blob.end() - 1);
-          forge_field(forged, in);
-          fmi3FMUState f = nullptr;
-          ++g_calls;
-          if (a.fmi3DeserializeFMUState(sl.c, forged.data(), forged.size(), &f) == fmi3OK) {
-            set_state3(a, sl, f);
-            ++g_calls;
-            a.fmi3FreeFMUState(sl.c, &f);
-          }
-        }
+        if (s == fmi3OK && given == size && in.ConsumeBool())
+          forge_and_set<Fmi3>(a, sl.c, {blob.begin() + 1, blob.end() - 1}, in,
+                              [&](fmi3FMUState f) { set_state3(a, sl, f); });
         break;
       }
       std::vector<fmi3Byte> bytes;
