@@ -10,8 +10,8 @@
 // any FMI function, in any state, with value references from the model's
 // table or arbitrary ones, values from a list of awkward numbers (NaN, +-Inf,
 // 0, -0, denormals, 1e300, DBL_MAX, ...) or raw bytes, NULL pointers,
-// foreign pointers, FMU states (saved, freed, serialised, corrupted, taken
-// to another instance), and two macro operations that bring an instance
+// foreign pointers, FMU states (saved, freed, serialised, corrupted, forged
+// with the checksum recomputed, taken to another instance), and two macro operations that bring an instance
 // into its stepping state and run it, so that deep states are reached fast.
 //
 // Besides the sanitizers, the harness checks the FMU's promises (a
@@ -49,8 +49,10 @@
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
 #include "fmi/fmi_functions.h"
+#include "fmi/fnv1a.hpp"
 #include "models/models.hpp"
 #include "pkm4puu/kinematics/workspace_guard.hpp"
+#include "pkm4puu/sim/solver_memory.hpp"
 
 // The two in-process FMUs' exported FMI 2.0 functions: fmi_functions.h.
 #define PKM_FUZZ_FMI2_FUNCTIONS PKM_FMI2_FUNCTIONS
@@ -226,6 +228,28 @@ double step_size(FuzzedDataProvider& in) {
 constexpr int kSlots = 3;
 constexpr int kMaxOps = 48;
 
+/// A forged serialised state: one bit flipped in a field the loader checks
+/// against the instance -- the mode and flags (bytes 32..38,
+/// fmu_state.hpp), the plant's contact mode and the integrators' memory at
+/// its end (plant_data.cpp) -- or anywhere, and the checksum recomputed (the
+/// last 8 bytes, fnv1a.hpp), so that the forgery passes the header's checks
+/// and reaches those of the content.
+template <class Byte>
+void forge_field(std::vector<Byte>& b, FuzzedDataProvider& in) {
+  constexpr std::size_t kTail = 8 + sizeof(pkm::SolverMemory) + 4 + 4;  // contact mode, memory size, memory, checksum
+  if (b.size() < 40 + kTail) return;
+  const std::size_t end = b.size() - 8;
+  std::size_t at = 0;
+  switch (in.ConsumeIntegralInRange<int>(0, 2)) {
+    case 0: at = in.ConsumeIntegralInRange<std::size_t>(32, 38); break;
+    case 1: at = in.ConsumeIntegralInRange<std::size_t>(b.size() - kTail, end - 1); break;
+    default: at = in.ConsumeIntegralInRange<std::size_t>(0, end - 1); break;
+  }
+  b[at] = static_cast<Byte>(b[at] ^ (1u << in.ConsumeIntegralInRange<int>(0, 7)));
+  const std::uint64_t h = pkm_fmi::fnv1a(reinterpret_cast<const unsigned char*>(b.data()), end);
+  for (int k = 0; k < 8; ++k) b[end + k] = static_cast<Byte>((h >> (8 * k)) & 0xff);
+}
+
 /// The instances and FMU states of one input, for either FMI version V
 /// (Fmi2, Fmi3 below: its Api, instance, state and byte types, and how to
 /// free an instance and a state).
@@ -268,6 +292,21 @@ struct WorldOf {
   }
 };
 
+/// A state just serialised (`blob`), forged (forge_field), deserialised and
+/// handed to `set` at once, then freed: the loader's checks of the content
+/// in one operation.
+template <class V, class Set>
+void forge_and_set(const typename V::Api& a, typename V::Instance c, std::vector<typename V::Byte> blob,
+                   FuzzedDataProvider& in, Set&& set) {
+  forge_field(blob, in);
+  typename V::FmuState f = nullptr;
+  ++g_calls;
+  if (!V::deserialize(a, c, blob, &f)) return;
+  set(f);
+  ++g_calls;
+  V::free_state(a, c, &f);
+}
+
 struct Fmi2 {
   using Api = ::Api;
   using Instance = fmi2Component;
@@ -276,6 +315,9 @@ struct Fmi2 {
   static constexpr const Api* apis = kApis;
   static void free_instance(const Api& a, Instance c) { a.fmi2FreeInstance(c); }
   static void free_state(const Api& a, Instance c, FmuState* s) { a.fmi2FreeFMUstate(c, s); }
+  static bool deserialize(const Api& a, Instance c, const std::vector<Byte>& b, FmuState* s) {
+    return a.fmi2DeSerializeFMUstate(c, b.data(), b.size(), s) == fmi2OK;
+  }
 };
 using World = WorldOf<Fmi2>;
 using State = World::State;
@@ -421,6 +463,19 @@ void run(FuzzedDataProvider& in, World& w, int i) {
     }
     do_step(in, w, i, h);
   }
+}
+
+/// fmi2SetFMUstate on a slot; on success the harness takes the time the
+/// instance now has. Whether it succeeded.
+bool set_state(const Api& a, Slot& sl, fmi2FMUstate s) {
+  ++g_calls;
+  if (a.fmi2SetFMUstate(sl.c, s) != fmi2OK) return false;
+  double t = 0.0;
+  ++g_calls;
+  if (a.fmi2GetRealStatus(sl.c, fmi2LastSuccessfulTime, &t) == fmi2OK) sl.time = t;
+  else sl.time = 0.0;  // instantiated or initialisation mode: the experiment's start, not tracked
+  // (the harness re-reads the time when it can; a wrong guess only makes fmi2DoStep refuse)
+  return true;
 }
 
 void one_op(FuzzedDataProvider& in, World& w) {
@@ -587,14 +642,7 @@ void one_op(FuzzedDataProvider& in, World& w) {
       if (how == 0) s = g_foreign;
       else if (how > 1 && !w.states.empty())
         s = w.states[in.ConsumeIntegralInRange<std::size_t>(0, w.states.size() - 1)].s;
-      ++g_calls;
-      if (a.fmi2SetFMUstate(sl.c, s) == fmi2OK) {
-        double t = 0.0;
-        ++g_calls;
-        if (a.fmi2GetRealStatus(sl.c, fmi2LastSuccessfulTime, &t) == fmi2OK) sl.time = t;
-        else sl.time = 0.0;  // instantiated or initialisation mode: the experiment's start, not tracked
-        // (the harness re-reads the time when it can; a wrong guess only makes fmi2DoStep refuse)
-      }
+      set_state(a, sl, s);
       break;
     }
     case 24: {  // fmi2FreeFMUstate, through any live instance of the same FMU
@@ -631,6 +679,9 @@ void one_op(FuzzedDataProvider& in, World& w) {
       const fmi2Status s = a.fmi2SerializeFMUstate(sl.c, st.s, blob.data() + 1, given);
       require(blob.front() == 0x5a && blob.back() == 0x5a, "fmi2SerializeFMUstate wrote outside its buffer");
       if (s == fmi2OK && w.blobs.size() < 8) w.blobs.emplace_back(blob.begin() + 1, blob.end() - 1);
+      if (s == fmi2OK && given == size && in.ConsumeBool())
+        forge_and_set<Fmi2>(a, sl.c, {blob.begin() + 1, blob.end() - 1}, in,
+                            [&](fmi2FMUstate f) { set_state(a, sl, f); });
       break;
     }
     case 26: {  // deserialise: a stored blob, mutated or truncated, or raw fuzz bytes
@@ -642,6 +693,7 @@ void one_op(FuzzedDataProvider& in, World& w) {
         for (int f = 0; f < flips && !bytes.empty(); ++f)
           bytes[in.ConsumeIntegralInRange<std::size_t>(0, bytes.size() - 1)] ^= static_cast<fmi2Byte>(
               1u << in.ConsumeIntegralInRange<int>(0, 7));
+        if (in.ConsumeBool()) forge_field(bytes, in);
         if (in.ConsumeIntegralInRange<int>(0, 7) == 0) bytes.resize(in.ConsumeIntegralInRange<std::size_t>(0, bytes.size()));
       } else {
         const std::string raw = in.ConsumeRandomLengthString(200);
@@ -709,6 +761,9 @@ struct Fmi3 {
   static constexpr const Api* apis = kApis3;
   static void free_instance(const Api& a, Instance c) { a.fmi3FreeInstance(c); }
   static void free_state(const Api& a, Instance c, FmuState* s) { a.fmi3FreeFMUState(c, s); }
+  static bool deserialize(const Api& a, Instance c, const std::vector<Byte>& b, FmuState* s) {
+    return a.fmi3DeserializeFMUState(c, b.data(), b.size(), s) == fmi3OK;
+  }
 };
 using World3 = WorldOf<Fmi3>;
 using Slot3 = World3::Slot;
@@ -915,6 +970,18 @@ void run3(FuzzedDataProvider& in, World3& w, int i) {
   }
 }
 
+/// fmi3SetFMUState on a slot; on success the harness takes the time the
+/// instance now has. Whether it succeeded.
+bool set_state3(const Api3& a, Slot3& sl, fmi3FMUState s) {
+  ++g_calls;
+  if (a.fmi3SetFMUState(sl.c, s) != fmi3OK) return false;
+  double t = kGuard;  // the time a get of the independent variable reads
+  const fmi3ValueReference time_vr = 0;
+  ++g_calls;
+  sl.time = a.fmi3GetFloat64(sl.c, &time_vr, 1, &t, 1) == fmi3OK ? t : 0.0;
+  return true;
+}
+
 void one_op3(FuzzedDataProvider& in, World3& w) {
   const int i = in.ConsumeIntegralInRange<int>(0, kSlots - 1);
   Slot3& sl = w.slots[i];
@@ -1107,13 +1174,7 @@ void one_op3(FuzzedDataProvider& in, World3& w) {
       if (how == 0) s = g_foreign;
       else if (how > 1 && !w.states.empty())
         s = w.states[in.ConsumeIntegralInRange<std::size_t>(0, w.states.size() - 1)].s;
-      ++g_calls;
-      if (a.fmi3SetFMUState(sl.c, s) == fmi3OK) {
-        double t = kGuard;  // the time a get of the independent variable reads
-        const fmi3ValueReference time_vr = 0;
-        ++g_calls;
-        sl.time = a.fmi3GetFloat64(sl.c, &time_vr, 1, &t, 1) == fmi3OK ? t : 0.0;
-      }
+      set_state3(a, sl, s);
       break;
     }
     case 22: {  // free an FMU state through a live instance of the same FMU
@@ -1146,6 +1207,9 @@ void one_op3(FuzzedDataProvider& in, World3& w) {
         const fmi3Status s = a.fmi3SerializeFMUState(sl.c, st.s, blob.data() + 1, given);
         require(blob.front() == 0x5a && blob.back() == 0x5a, "fmi3SerializeFMUState wrote outside its buffer");
         if (s == fmi3OK && w.blobs.size() < 8) w.blobs.emplace_back(blob.begin() + 1, blob.end() - 1);
+        if (s == fmi3OK && given == size && in.ConsumeBool())
+          forge_and_set<Fmi3>(a, sl.c, {blob.begin() + 1, blob.end() - 1}, in,
+                              [&](fmi3FMUState f) { set_state3(a, sl, f); });
         break;
       }
       std::vector<fmi3Byte> bytes;
@@ -1154,6 +1218,7 @@ void one_op3(FuzzedDataProvider& in, World3& w) {
         if (!bytes.empty() && in.ConsumeBool())
           bytes[in.ConsumeIntegralInRange<std::size_t>(0, bytes.size() - 1)] ^=
               static_cast<fmi3Byte>(1u << in.ConsumeIntegralInRange<int>(0, 7));
+        if (in.ConsumeBool()) forge_field(bytes, in);
       } else {
         const std::string raw = in.ConsumeRandomLengthString(200);
         bytes.assign(raw.begin(), raw.end());

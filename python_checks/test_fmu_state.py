@@ -2,11 +2,14 @@
 """FMU state save/restore is exact: a state taken at t = 1 s and restored
 replays 1 s .. 1.5 s bit for bit, in the same instance (get/setFMUstate) and
 in a fresh one (serialize / deSerialize), for the FMI 2.0 and the FMI 3.0
-Co-Simulation FMU.
+Co-Simulation FMU. So does a ROS2 run restored where its step ladder after
+a switch of the contact mode is pending: after initialisation and right
+after an impact on the end stops.
 
 An FMU state holds everything the FMU needs, parameters included (FMI 2.0,
-section 2.1.8), so the run uses non-default solver settings and the fresh
-instance is left at its defaults: the restored state must bring them along."""
+section 2.1.8; FMI 3.0, section 2.2.6), so the runs use non-default solver
+settings and the fresh instance is left at its defaults: the restored state
+must bring them along."""
 import math
 
 import numpy as np
@@ -79,3 +82,58 @@ def test_state_restore_is_exact(archive, solver, request):
         _assert_identical(fresh.get(OUT)[None], at_save[None], f"{solver}: outputs after deSerializeFMUstate")
         _assert_identical(advance(fresh, k_save, k_end), first, f"{solver}: replay in a fresh instance")
     print(f"\n{archive}, {solver}: state at t = {T_SAVE} s, {len(blob)} bytes serialized, replay bit-identical")
+
+
+DROP = ["z", "dz", "stop_force[1]", "der(dissipated_energy)", "dissipated_energy"]
+
+
+def drop_steps(fmu, k0, k1):
+    """Steps k0 .. k1-1 of a drop (inputs as started); outputs after each."""
+    rows = []
+    for k in range(k0, k1):
+        fmu.do_step(k * H, H)
+        rows.append(fmu.get(DROP))
+    return np.array(rows)
+
+
+@pytest.mark.parametrize("saved", ["after initialisation", "after the impact"])
+@pytest.mark.parametrize("archive", ["plant_fmu", "plant_fmu3"])
+def test_rosenbrock_restore_is_exact_where_its_steps_grow(archive, saved, request):
+    """ROS2 (solver = 2) starts with short steps after initialisation and
+    after every switch of the contact mode and lengthens them as the
+    transient decays: a drop onto the end stops (F = 0), with strong viscous
+    friction when saved after initialisation, restored there replays bit
+    for bit (the state carries the ladder)."""
+    start = {"solver": 2, **{name: 0.0 for name in F}}
+    if saved == "after initialisation":
+        start["friction_viscous"] = 1000.0
+    with Fmu(request.getfixturevalue(archive), start=start) as fmu:
+        k = 0
+        if saved == "after the impact":
+            while fmu.get(["stop_force[1]"])[0] == 0.0:
+                assert k < 200, "no impact within 0.2 s"
+                drop_steps(fmu, k, k + 1)
+                k += 1
+        state = fmu.get_state()
+        try:
+            first = drop_steps(fmu, k, k + 40)
+            fmu.set_state(state)
+            _assert_identical_rows(drop_steps(fmu, k, k + 40), first, f"ROS2, restored {saved}")
+            blob = fmu.serialize(state)
+        finally:
+            fmu.free_state(state)
+    with Fmu(request.getfixturevalue(archive), instance_name="fresh") as fresh:
+        restored = fresh.deserialize(blob)
+        try:
+            fresh.set_state(restored)
+        finally:
+            fresh.free_state(restored)
+        _assert_identical_rows(drop_steps(fresh, k, k + 40), first, f"ROS2, restored {saved} in a fresh instance")
+
+
+def _assert_identical_rows(a, b, what):
+    same = a == b
+    if not same.all():
+        i, j = np.argwhere(~same)[0]
+        raise AssertionError(f"{what}: {(~same).sum()} values differ; first at step {i}, {DROP[j]}: "
+                             f"{a[i, j]!r} vs {b[i, j]!r} (diff {a[i, j] - b[i, j]:.3e})")

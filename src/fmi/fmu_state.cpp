@@ -15,8 +15,9 @@ namespace {
 
 constexpr std::uint64_t kStateTag = 0x53324d464d4b5002ull;  // marks a live SavedState
 constexpr unsigned char kMagic[8] = {'P', 'K', 'M', 'F', 'M', 'U', 'S', 'T'};
-constexpr std::uint32_t kFormatVersion = 5;  // 3: the plant's energy integrals and end-stop contacts; 4: elapsed
-// time; 5: the plant's end-stop record is its contact mode (held between events, hysteresis)
+constexpr std::uint32_t kFormatVersion = 6;  // 3: the plant's energy integrals and end-stop contacts; 4: elapsed
+// time; 5: the plant's end-stop record is its contact mode (held between events, hysteresis); 6: the FMI version
+// in the header, the plant's integrators' memory
 constexpr std::size_t kHeaderSize = 32;
 constexpr std::size_t kTrailerSize = 8;
 
@@ -74,7 +75,7 @@ void Instance::save(std::vector<unsigned char>& out) const {
   StateWriter w(out);
   for (unsigned char c : kMagic) w.u8(c);
   w.u32(kFormatVersion);
-  w.u32(0);
+  w.u32(static_cast<std::uint32_t>(version_));
   w.u64(0);  // total size, patched below
   w.u64(fnv1a(token_.c_str()));
   // Generic part.
@@ -123,6 +124,15 @@ bool Instance::check_header(const unsigned char* bytes, std::size_t size, const 
     log_.error("%s: FMU state format version %u, this FMU reads version %u", function, version, kFormatVersion);
     return false;
   }
+  // FMI 2.0.4 section 2.1.8, FMI 3.0.2 section 2.2.6: a state of this FMU,
+  // and an FMI 2.0 and an FMI 3.0 FMU are two, with states of their own.
+  const std::uint32_t fmi_version = read_le32(bytes + 12);
+  if (fmi_version != static_cast<std::uint32_t>(version_)) {
+    log_.error("%s: the FMU state was saved by an FMI %u.0 instance, this one is FMI %d.0 (each version's FMU "
+               "takes its own states only)",
+               function, fmi_version, version_);
+    return false;
+  }
   if (read_le64(bytes + 16) != size) {
     log_.error("%s: FMU state of %llu bytes says it has %llu", function, static_cast<unsigned long long>(size),
                static_cast<unsigned long long>(read_le64(bytes + 16)));
@@ -140,8 +150,8 @@ bool Instance::check_header(const unsigned char* bytes, std::size_t size, const 
   return true;
 }
 
-bool Instance::times_consistent(double start, bool stop_defined, double stop, double time, double last_successful,
-                                double elapsed, const char* function) {
+bool Instance::times_consistent(std::uint32_t mode, double start, bool stop_defined, double stop, double time,
+                                double last_successful, double elapsed, const char* function) {
   const char* why = nullptr;
   if (!std::isfinite(start) || !std::isfinite(stop) || !std::isfinite(time) || !std::isfinite(last_successful) ||
       !std::isfinite(elapsed))
@@ -156,10 +166,27 @@ bool Instance::times_consistent(double start, bool stop_defined, double stop, do
   else if (interface_ == Interface::CoSimulation &&
            !(std::abs(start + elapsed - time) <= 1e-9 * std::max(1.0, std::abs(time))))
     why = "the time since startTime does not match the time";
+  else if (interface_ == Interface::CoSimulation && mode != kError && last_successful != time)
+    why = "the last successful time differs from the time, as only an Error leaves it";
   if (!why) return true;
   log_.error("%s: malformed FMU state (%s: startTime = %.17g, stopTime = %.17g%s, time = %.17g, last successful "
              "time = %.17g); nothing changed",
              function, why, start, stop, stop_defined ? "" : " (undefined)", time, last_successful);
+  return false;
+}
+
+bool Instance::modes_consistent(std::uint32_t mode, bool terminated, const char* function) {
+  const bool cs2 = interface_ == Interface::CoSimulation && version_ == 2;
+  const char* why = nullptr;
+  if (!(mode & reachable_modes(version_, interface_)))
+    why = "a state no instance of this FMI version and interface enters";
+  else if (terminated && !(cs2 && (mode & kAfterDiscard)))
+    why = "fmi2Terminated set where no Discard can have set it";
+  else if (!terminated && (mode & kStepFailed))
+    why = "stepFailed without fmi2Terminated, which its Discard sets";
+  if (!why) return true;
+  log_.error("%s: malformed FMU state (%s: %s in an FMI %d.0 %s instance); nothing changed", function, why,
+             mode_name(mode), version_, interface_name(interface_));
   return false;
 }
 
@@ -177,7 +204,7 @@ bool Instance::load(const unsigned char* bytes, std::size_t size, const char* fu
   const double elapsed = r.f64();
   const std::uint32_t count = r.u32();
   const std::uint32_t expected = stored_count(def_);
-  if (!r.ok() || count != expected || !(mode & kRestorableModes) || (mode & (mode - 1)) != 0) {
+  if (!r.ok() || count != expected || !(mode & kAlive) || (mode & (mode - 1)) != 0) {
     log_.error("%s: malformed FMU state (mode %u, %u values where %u expected)", function, mode, count, expected);
     return false;
   }
@@ -186,6 +213,7 @@ bool Instance::load(const unsigned char* bytes, std::size_t size, const char* fu
                interface == 0 ? "Model Exchange" : "Co-Simulation", interface_name(interface_));
     return false;
   }
+  if (!modes_consistent(mode, terminated, function)) return false;
   // Read every value before changing anything (into a buffer reserved at
   // instantiation: restoring a state allocates nothing).
   std::size_t k = 0;
@@ -214,7 +242,7 @@ bool Instance::load(const unsigned char* bytes, std::size_t size, const char* fu
   }
   // Every field as a setter or a step would have checked it: a state with a
   // valid checksum may still have been forged.
-  if (!times_consistent(start_time, stop_defined, stop_time, time, last_time, elapsed, function)) return false;
+  if (!times_consistent(mode, start_time, stop_defined, stop_time, time, last_time, elapsed, function)) return false;
   k = 0;
   for (std::size_t i = 0; i < def_.n_variables; ++i) {
     const Variable& v = def_.variables[i];
@@ -284,8 +312,7 @@ Status Instance::get_fmu_state(void** state) {
     s = new_state();
     *state = s;
   }
-  save(s->bytes);
-  data_->state_saved();
+  save(s->bytes);  // an observation: the run goes on as without it
   log_.event("%s: state saved at t = %.17g (%llu bytes)", fn, time_,
              static_cast<unsigned long long>(s->bytes.size()));
   return Status::OK;

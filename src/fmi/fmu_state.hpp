@@ -5,7 +5,8 @@
 // Serialised FMU state (all fields little-endian):
 //   [0, 8)    magic "PKMFMUST"
 //   [8, 12)   format version
-//   [12, 16)  reserved, 0
+//   [12, 16)  the FMI version of the instance that saved it (2 or 3: an FMI
+//             2.0 and an FMI 3.0 FMU are two FMUs, whose states differ)
 //   [16, 24)  total size in bytes, this header and the checksum included
 //   [24, 32)  FNV-1a 64 of the model's instantiation token (a state of another FMU is rejected)
 //   [32, n-8) the body: the generic part (Instance::save), then the model's

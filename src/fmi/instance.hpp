@@ -57,6 +57,8 @@ enum Mode : std::uint32_t {
   kFatal = 1u << 8,
 };
 const char* mode_name(std::uint32_t mode);
+/// The states past a successful ExitInitializationMode, Error aside: the model is built.
+constexpr std::uint32_t kInitializedModes = kEventMode | kContinuousTimeMode | kStepMode | kStepFailed | kTerminated;
 
 struct SavedState;  // fmu_state.cpp
 enum class Call : unsigned;  // state_machine.hpp
@@ -190,7 +192,8 @@ class Instance {
   /// calls that advance the simulation (instance.cpp says which and why).
   bool past_stop_time(const char* fn, double t, const char* what);
   Context context() {
-    return Context{log_, interface_, mode_ == kInitializationMode, start_time_};
+    return Context{log_, interface_, mode_ == kInitializationMode, start_time_, (mode_ & kInitializedModes) != 0,
+                   elapsed_};
   }
   void apply_start_values();
   /// Brings the output groups `needed` up to date (those not already).
@@ -216,9 +219,12 @@ class Instance {
                              const char* out_name = nullptr);
   void save(std::vector<unsigned char>& out) const;
   bool check_header(const unsigned char* bytes, std::size_t size, const char* function);
+  /// The mode and fmi2Terminated of a state being loaded: ones this
+  /// instance's version and interface can be in together (else logged).
+  bool modes_consistent(std::uint32_t mode, bool terminated, const char* function);
   /// The times of a state being loaded: finite and in order (else logged).
-  bool times_consistent(double start, bool stop_defined, double stop, double time, double last_successful,
-                        double elapsed, const char* function);
+  bool times_consistent(std::uint32_t mode, double start, bool stop_defined, double stop, double time,
+                        double last_successful, double elapsed, const char* function);
   /// Restores a serialised state; keep_backup: on failure return to the
   /// current state (saved into load_backup_ first).
   bool load(const unsigned char* bytes, std::size_t size, const char* function, bool keep_backup);

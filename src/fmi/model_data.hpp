@@ -22,6 +22,8 @@ struct Context {
   Interface interface;
   bool initialization_mode;  // between Enter- and ExitInitializationMode
   double start_time;  // the model's time is the time since this
+  bool initialized = false;  // past a successful ExitInitializationMode (not in Error): the model is built
+  double model_time = 0.0;   // Co-Simulation: the time since start_time, summed from the steps taken
 };
 
 /// Per-instance data of a model. Start values are written through the
@@ -45,10 +47,12 @@ class ModelData {
   /// (reason logged): the inputs lie outside the model's domain, the
   /// computed variables are left as they were and the get hands those out.
   virtual Status update_outputs(Context& ctx, unsigned groups) = 0;
-  /// The model's state beyond the table's values.
+  /// The model's state beyond the table's values. Saving is an observation:
+  /// a run with GetFMUState before every step is the run without.
   virtual void save(StateWriter& w) const = 0;
-  /// Reads what save() wrote, after the table's values were restored; false
-  /// (with a logged message) if the state cannot be used.
+  /// Reads what save() wrote, after the table's values and the instance's
+  /// mode and times were restored (ctx tells them); false (with a logged
+  /// message) if the state cannot be used or is none the instance can be in.
   virtual bool load(StateReader& r, Context& ctx) = 0;
 
   // ---- Co-Simulation
@@ -59,11 +63,6 @@ class ModelData {
   /// not (an algebraic model), FMI 3.0's DoStep need not save the state at
   /// the call to go back to.
   virtual bool step_has_effects() const { return true; }
-  /// GetFMUState: the state was saved here. A model whose integrator carries
-  /// history across steps that the saved state does not hold restarts it at
-  /// the next step, as a run restored from the state will: both continue
-  /// bit for bit alike.
-  virtual void state_saved() {}
   /// Before do_step, nothing changed yet: Error (reason logged) if a step of
   /// h would exceed the model's work budget or is too short for its
   /// integrator to start. The instance stays usable.

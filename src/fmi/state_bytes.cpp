@@ -36,6 +36,16 @@ void StateWriter::f64(double v) {
   u64(bits);
 }
 
+// StateWriter::bytes keeps the host's byte order: the format says little-endian.
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "serialised FMU states are little-endian: StateWriter::bytes needs a byte swap on this platform"
+#endif
+
+void StateWriter::bytes(const void* p, std::size_t n) {
+  const auto* b = static_cast<const unsigned char*>(p);
+  out_.insert(out_.end(), b, b + n);
+}
+
 bool StateReader::take(std::size_t n) {
   if (!ok_ || static_cast<std::size_t>(end_ - p_) < n) {
     ok_ = false;
@@ -68,6 +78,12 @@ double StateReader::f64() {
   double v;
   std::memcpy(&v, &bits, 8);
   return v;
+}
+
+void StateReader::bytes(void* p, std::size_t n) {
+  if (!take(n)) return;
+  std::memcpy(p, p_, n);
+  p_ += n;
 }
 
 }  // namespace pkm_fmi

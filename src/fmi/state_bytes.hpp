@@ -21,6 +21,9 @@ class StateWriter {
   void f64s(It first, It last) {
     for (; first != last; ++first) f64(*first);
   }
+  /// n bytes as they are (an object serialised whole: the host's
+  /// representation, little-endian on every platform the FMUs are built for).
+  void bytes(const void* p, std::size_t n);
 
  private:
   std::vector<unsigned char>& out_;
@@ -39,6 +42,8 @@ class StateReader {
   void f64s(It first, It last) {
     for (; first != last; ++first) *first = f64();
   }
+  /// What StateWriter::bytes wrote, into p (left unchanged when short).
+  void bytes(void* p, std::size_t n);
   bool ok() const { return ok_; }
   bool at_end() const { return p_ == end_; }
 

@@ -157,7 +157,20 @@ constexpr std::uint32_t allowed_states(Call c, int fmi_version) {
 /// 3.2.1 and 2.3.5).
 constexpr std::uint32_t kSetStatesByReference = kEventMode | kContinuousTimeMode;
 
-// States an FMU state may carry (the others are unrecoverable).
-constexpr std::uint32_t kRestorableModes = kAlive;
+/// The states an instance of an FMI version and interface can be in, Error
+/// included (Fatal is unrecoverable): the FMI 2.0.4 state tables (section
+/// 3.2.3 Model Exchange, section 4.2.4 Co-Simulation: stepFailed after a
+/// Discard) and the FMI 3.0.2 state machines (section 2.3, 3.2: Event and
+/// Continuous-Time Mode; 4.2: Step Mode, a Discard leaves the FMU in it).
+/// An FMU state saved in any other is none this instance can be in.
+constexpr std::uint32_t reachable_modes(int fmi_version, Interface interface) {
+  return kInstantiated | kInitializationMode | kTerminated | kError |
+         (interface == Interface::ModelExchange ? kEventMode | kContinuousTimeMode
+                                                : kStepMode | (fmi_version == 2 ? kStepFailed : 0u));
+}
+/// The states an FMI 2.0 Co-Simulation instance can hold fmi2Terminated in:
+/// stepFailed, where the Discard that sets it leaves the instance (FMI 2.0.4
+/// section 4.2.3), and Terminated or Error, which may follow.
+constexpr std::uint32_t kAfterDiscard = kStepFailed | kTerminated | kError;
 
 }  // namespace pkm_fmi

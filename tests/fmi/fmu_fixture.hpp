@@ -11,6 +11,7 @@
 #include <cstring>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -127,16 +128,26 @@ inline std::vector<fmi2Byte> serialized_state(FmuInstance& p) {
   return bytes;
 }
 
-/// A serialized state with the bytes at `at` replaced by `value` (a double,
-/// or the low 4 bytes of an integer when `u32`) and the checksum recomputed
-/// (fnv1a.hpp): a forgery that passes the header checks.
-inline std::vector<fmi2Byte> forge(std::vector<fmi2Byte> b, std::size_t at, double value, bool u32 = false) {
+/// A serialized state with the n bytes at `at` replaced by those at `p` and
+/// the checksum recomputed (fnv1a.hpp): a forgery that passes the header
+/// checks. Byte: fmi2Byte or unsigned char.
+template <class Byte>
+std::vector<Byte> forge_bytes(std::vector<Byte> b, std::size_t at, const void* p, std::size_t n) {
+  std::memcpy(b.data() + at, p, n);
+  const std::uint64_t h = pkm_fmi::fnv1a(reinterpret_cast<const unsigned char*>(b.data()), b.size() - 8);
+  for (int k = 0; k < 8; ++k) b[b.size() - 8 + k] = static_cast<Byte>((h >> (8 * k)) & 0xff);  // little-endian
+  return b;
+}
+
+/// forge_bytes of a value: a double, or the low 4 bytes of an integer when
+/// `u32` (little-endian, as the format and every platform of the FMUs).
+template <class Byte>
+std::vector<Byte> forge(std::vector<Byte> b, std::size_t at, double value, bool u32 = false) {
   std::uint64_t bits = static_cast<std::uint64_t>(value);
   if (!u32) std::memcpy(&bits, &value, 8);
-  for (int k = 0; k < (u32 ? 4 : 8); ++k) b[at + k] = static_cast<fmi2Byte>((bits >> (8 * k)) & 0xff);  // little-endian
-  const std::uint64_t h = pkm_fmi::fnv1a(reinterpret_cast<const unsigned char*>(b.data()), b.size() - 8);
-  for (int k = 0; k < 8; ++k) b[b.size() - 8 + k] = static_cast<fmi2Byte>((h >> (8 * k)) & 0xff);
-  return b;
+  unsigned char le[8];
+  for (int k = 0; k < 8; ++k) le[k] = static_cast<unsigned char>((bits >> (8 * k)) & 0xff);
+  return forge_bytes(std::move(b), at, le, u32 ? 4 : 8);
 }
 
 }  // namespace pkm_test

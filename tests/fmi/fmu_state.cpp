@@ -1,21 +1,29 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// FMU states of the binaries through the raw FMI 2.0 functions: get/set and
-// serialised states continue bit-identically (CVODE and RK4), in the same
-// and in a fresh instance, for both FMUs; foreign, broken and forged states
-// (valid checksum, impossible content) are refused with the instance
-// unchanged; states left behind are freed with their instance.
+// FMU states of the binaries through the raw FMI 2.0 and 3.0 functions:
+// get/set and serialised states continue bit-identically (RK4 and ROS2
+// wherever saved; CVODE where its history restarts anyway), in the same and
+// in a fresh instance, for both FMUs; taking a state changes no run;
+// foreign, broken and forged states (valid checksum, impossible content, a
+// mode or contact mode the instance cannot be in) are refused with the
+// instance unchanged; states left behind are freed with their instance.
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "any_version.hpp"
+#include "fmi/instance.hpp"
 #include "fmi2FunctionTypes.h"
 #include "fmu_fixture.hpp"
 #include "models/models.hpp"
+#include "pkm4puu/model/params.hpp"
+#include "pkm4puu/sim/solver_memory.hpp"
 
 namespace {
 
@@ -186,9 +194,19 @@ TEST_F(FmuState, ForeignOrBrokenFmuStates) {
 // (fmu_state.cpp): a 32-byte header; mode (4), three flags (3), startTime,
 // stopTime, time, last successful time, time since start (8 each) from byte
 // 39; the count (4) and the stored variables (8 each) from byte 83; then the input
-// derivatives and the plant's part, which ends (before the 8-byte checksum)
-// with time (8), [pose; velocity] (64), the theta1 references (32), the
-// energy integrals (16) and the end-stop record (4).
+// derivatives and the plant's part (PlantPart).
+/// Where the fields of the plant's part lie in a serialised state of `size`
+/// bytes (plant_data.cpp): it ends, before the 8-byte checksum, with the
+/// plant's time (8), [pose; velocity] (64), the theta1 references (32),
+/// the energy integrals (16), the contact mode (4), the size of the
+/// integrators' memory (4) and that memory.
+struct PlantPart {
+  std::size_t t, y, theta1, energy, stops, memory_size, memory;
+  explicit PlantPart(std::size_t size)
+      : t(size - 8 - sizeof(pkm::SolverMemory) - 128), y(t + 8), theta1(y + 64), energy(theta1 + 32),
+        stops(energy + 16), memory_size(stops + 4), memory(memory_size + 4) {}
+};
+
 TEST_F(FmuState, ForgedFmuStatesWithAValidChecksumAreRefused) {
   on_stepping_instance(
       "fmi2DeSerializeFMUstate + fmi2SetFMUstate of states forged with a recomputed checksum: time = NaN, startTime "
@@ -200,15 +218,16 @@ TEST_F(FmuState, ForgedFmuStatesWithAValidChecksumAreRefused) {
       [&](PlantFmu& p, double) {
         std::vector<fmi2Status> s;
         const std::vector<fmi2Byte> bytes = serialized_state(p);
-        const std::size_t size = bytes.size(), end = size - 8;
+        const std::size_t size = bytes.size();
         std::size_t m_platform = 83;
         for (std::size_t i = 0; i < p.def.n_variables; ++i) {
           const pkm_fmi::Variable& v = p.def.variables[i];
           if (std::string(v.name) == "m_platform") break;
           if (v.stored_in_state()) m_platform += 8;
         }
+        const PlantPart plant(size);
         double theta1_2 = 0.0;
-        std::memcpy(&theta1_2, &bytes[end - 52 + 8], 8);
+        std::memcpy(&theta1_2, &bytes[plant.theta1 + 8], 8);
         const double nan = std::numeric_limits<double>::quiet_NaN();
         const struct {
           std::size_t at;
@@ -220,11 +239,12 @@ TEST_F(FmuState, ForgedFmuStatesWithAValidChecksumAreRefused) {
             {39, 1.0, "the time lies before startTime"},
             {71, 5.0, "the time since startTime does not match the time"},
             {m_platform, -1.0, "m_platform = -1, outside its range"},
-            {end - 124, nan, "not finite"},
-            {end - 84, 1e200, "beyond the physical bound"},
-            {end - 52 + 8, 1e16, "theta1 reference 10000000000000000 rad of leg 2"},
-            {end - 52 + 8, theta1_2 + 1.0, "of leg 2 is not the pose's theta1"},
-            {end - 4, 0xffff, "end-stop record", true},
+            {plant.t, nan, "the plant's time nan s differs from the time since startTime"},
+            {plant.y + 32, 1e200, "beyond the physical bound"},
+            {plant.theta1 + 8, 1e16, "theta1 reference 10000000000000000 rad of leg 2"},
+            {plant.theta1 + 8, theta1_2 + 1.0, "of leg 2 is not the pose's theta1"},
+            {plant.energy + 8, nan, "energy integrals are not finite"},
+            {plant.stops, 0xffff, "end-stop record", true},
         };
         // The control: the same bytes with the checksum recomputed restore.
         {
@@ -271,6 +291,400 @@ TEST_F(FmuState, StatesLeftBehindAreFreedWithTheInstance) {
             "fmi2FreeInstance); a state freed or used through another instance of the FMU",
             "fmi2FreeInstance frees them (FMI 2.0: all memory of the instance); fmi2OK for the others",
             "no leak (valgrind: 0 bytes definitely lost)");
+}
+
+// ---------------------------------------------------------------- both versions
+
+/// The machines of the runs below: the default, the stiffest end stops
+/// the parameters declare, and strong viscous friction (a stiff term out of
+/// contact).
+struct Setting {
+  const char* name;
+  double value;
+};
+struct Machine {
+  const char* name;
+  std::vector<Setting> settings;
+};
+const std::vector<Machine>& machines() {
+  static const std::vector<Machine> m = {
+      {"default", {}},
+      {"stiffest_stops", {{"stop_stiffness", pkm::kMaxStiffness}, {"stop_damping", pkm::kMaxDamping}}},
+      {"viscous_friction", {{"friction_viscous", 1000.0}}},
+  };
+  return m;
+}
+
+constexpr int kCvode = 0, kRk4 = 1, kRos2 = 2;
+const char* solver_name(int solver) { return solver == kCvode ? "CVODE" : solver == kRk4 ? "RK4" : "ROS2"; }
+
+/// Initialised for a drop onto the lower end stops (F = 0: nothing holds
+/// the platform; it falls from the home pose and bounces) with `solver`
+/// and the machine's settings.
+void start_drop(Any& a, int solver, const Machine& m) {
+  ASSERT_NE(a.c, nullptr);
+  ASSERT_EQ(a.set_int("solver", solver), fmi2OK) << a.log.dump();
+  for (const Setting& s : m.settings) ASSERT_EQ(a.set(s.name, s.value), fmi2OK) << s.name << a.log.dump();
+  for (int i = 1; i <= 4; ++i) ASSERT_EQ(a.set(force_name(i).c_str(), 0.0), fmi2OK);
+  ASSERT_EQ(a.enter(), fmi2OK) << a.log.dump();
+  ASSERT_EQ(a.exit(), fmi2OK) << a.log.dump();
+}
+
+constexpr double kH = 1e-3;  // the communication step (s)
+
+/// Steps k0 .. k1-1 of kH from t = k kH: every Real after each, in one vector.
+std::vector<double> steps(Any& a, int k0, int k1) {
+  std::vector<double> trace;
+  for (int k = k0; k < k1; ++k) {
+    EXPECT_EQ(a.step(k * kH, kH), fmi2OK) << "step " << k << "\n" << a.log.dump();
+    const std::vector<double> r = a.reals();
+    trace.insert(trace.end(), r.begin(), r.end());
+  }
+  return trace;
+}
+
+/// Where two traces of steps() first differ ("" if bit-identical).
+std::string first_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) return "the traces differ in length";
+  const std::size_t n = plant().n_variables;
+  std::vector<const char*> names;
+  for (std::size_t k = 0; k < n; ++k)
+    if (plant().variables[k].type == pkm_fmi::VarType::Real) names.push_back(plant().variables[k].name);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (std::memcmp(&a[i], &b[i], sizeof(double)) == 0) continue;
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "first difference after step %lu of the run, %s: %.17g vs %.17g",
+                  static_cast<unsigned long>(i / names.size()), names[i % names.size()], a[i], b[i]);
+    return buf;
+  }
+  return "";
+}
+
+// ---------------------------------------------------------------- restored runs: RK4 and ROS2 bit for bit
+
+// FMI 2.0 section 2.1.8 and FMI 3.0 section 2.2.6, "Getting and Setting the
+// Complete FMU State": SetFMUState makes the saved state the FMU's actual
+// state again. The state carries everything the fixed-step solvers keep
+// between steps (ROS2's step ladder after a switch of the contact mode,
+// pending after initialisation; its step in a contact; its energy
+// balance), so a restored run continues bit for bit as the original,
+// wherever it was saved -- after initialisation, right after an impact, in
+// contact -- in the same instance and in a fresh one.
+class RestoredRuns : public FmuTest, public ::testing::WithParamInterface<std::tuple<int, int, int>> {};
+
+TEST_P(RestoredRuns, ContinueBitForBitWhereverTheStateWasSaved) {
+  const int version = std::get<0>(GetParam()), solver = std::get<1>(GetParam());
+  const Machine& machine = machines()[static_cast<std::size_t>(std::get<2>(GetParam()))];
+  constexpr int kSteps = 130;  // past the impact at about 95 ms, into the rebound
+  Any a(version, false);
+  start_drop(a, solver, machine);
+  if (HasFatalFailure()) return;
+  struct Saved {
+    int k;  // after step k (0: at initialisation)
+    const char* where;
+    void* state;
+    std::vector<unsigned char> bytes;
+  };
+  std::vector<Saved> saved;
+  auto save = [&](int k, const char* where) {
+    Saved s{k, where, nullptr, {}};
+    ASSERT_EQ(a.get_state(&s.state), fmi2OK) << a.log.dump();
+    s.bytes = a.serialize(s.state);
+    ASSERT_FALSE(s.bytes.empty()) << a.log.dump();
+    saved.push_back(std::move(s));
+  };
+  std::vector<std::vector<double>> after = {a.reals()};  // every Real after each step (0: at initialisation)
+  save(0, "after initialisation");
+  int impact = -1;
+  for (int k = 0; k < kSteps && !HasFatalFailure(); ++k) {
+    ASSERT_EQ(a.step(k * kH, kH), fmi2OK) << "step " << k << "\n" << a.log.dump();
+    after.push_back(a.reals());
+    double f = 0.0;
+    ASSERT_EQ(a.get("stop_force[1]", f), fmi2OK);
+    if (impact < 0 && f != 0.0) {
+      impact = k + 1;
+      save(impact, "right after the impact");
+    }
+    if (impact > 0 && k + 1 == impact + 5) save(k + 1, "in contact");
+  }
+  if (std::string(machine.name) != "viscous_friction") {
+    ASSERT_GT(impact, 0) << "no impact within " << kSteps << " steps: the checks after it would be missing";
+  }
+  for (const Saved& s : saved) {
+    SCOPED_TRACE(std::string("state saved ") + s.where + " (after step " + std::to_string(s.k) + ")");
+    std::vector<double> original;
+    for (int k = s.k + 1; k <= kSteps; ++k) original.insert(original.end(), after[k].begin(), after[k].end());
+    ASSERT_EQ(a.set_state(s.state), fmi2OK) << a.log.dump();
+    EXPECT_EQ(first_difference(a.reals(), after[static_cast<std::size_t>(s.k)]), "") << "right after SetFMUState";
+    EXPECT_EQ(first_difference(steps(a, s.k, kSteps), original), "") << "restored in the same instance";
+    Any fresh(version, false);  // only instantiated: default parameters
+    ASSERT_EQ(fresh.restore(s.bytes), fmi2OK) << fresh.log.dump();
+    EXPECT_EQ(first_difference(fresh.reals(), after[static_cast<std::size_t>(s.k)]), "") << "right after restoring";
+    EXPECT_EQ(first_difference(steps(fresh, s.k, kSteps), original), "") << "restored in a fresh instance";
+  }
+  for (Saved& s : saved) EXPECT_EQ(a.free_state(&s.state), fmi2OK);
+}
+
+std::string run_name(const ::testing::TestParamInfo<std::tuple<int, int, int>>& i) {
+  return std::string("FMI") + std::to_string(std::get<0>(i.param)) + "_" + solver_name(std::get<1>(i.param)) + "_" +
+         machines()[static_cast<std::size_t>(std::get<2>(i.param))].name;
+}
+
+// RK4 at the stiffest stops runs out of its work budget in contact (the
+// stops need ~1e5 sub-steps per millisecond): ROS2's case.
+INSTANTIATE_TEST_SUITE_P(Rk4, RestoredRuns,
+                         ::testing::Combine(::testing::Values(2, 3), ::testing::Values(kRk4), ::testing::Values(0, 2)),
+                         run_name);
+INSTANTIATE_TEST_SUITE_P(Ros2, RestoredRuns,
+                         ::testing::Combine(::testing::Values(2, 3), ::testing::Values(kRos2),
+                                            ::testing::Values(0, 1, 2)),
+                         run_name);
+
+// ---------------------------------------------------------------- taking a state is an observation
+
+// FMI 2.0 section 2.1.8 and FMI 3.0 section 2.2.6: GetFMUState copies the
+// FMU's state, SerializeFMUState copies that into bytes; neither changes the
+// FMU. A master that saves the state before every step, for a rollback it
+// may never take, gets the run it gets without: bit for bit, with every
+// solver (CVODE keeps its history across the communication points of this
+// drop, whose inputs are held). And every state a run saves is one the
+// loader takes (a third instance restores each).
+class ObservedRuns : public FmuTest, public ::testing::WithParamInterface<std::tuple<int, int, int>> {};
+
+TEST_P(ObservedRuns, SavingTheStateBeforeEveryStepChangesNothing) {
+  const int version = std::get<0>(GetParam()), solver = std::get<1>(GetParam());
+  const Machine& machine = machines()[static_cast<std::size_t>(std::get<2>(GetParam()))];
+  constexpr int kSteps = 200;  // the impact at about 95 ms and the rebound
+  Any plain(version, false), saving(version, false), loader(version, false);
+  start_drop(plain, solver, machine);
+  start_drop(saving, solver, machine);
+  if (HasFatalFailure()) return;
+  void* s = nullptr;
+  std::vector<double> a, b;
+  bool impact = false;
+  for (int k = 0; k < kSteps; ++k) {
+    ASSERT_EQ(saving.get_state(&s), fmi2OK) << saving.log.dump();  // the same state overwritten
+    ASSERT_FALSE(saving.serialize(s).empty()) << saving.log.dump();
+    ASSERT_EQ(loader.set_state(s), fmi2OK) << "step " << k << "\n" << loader.log.dump();
+    const std::vector<double> x = steps(plain, k, k + 1), y = steps(saving, k, k + 1);
+    a.insert(a.end(), x.begin(), x.end());
+    b.insert(b.end(), y.begin(), y.end());
+    double f = 0.0;
+    ASSERT_EQ(plain.get("stop_force[1]", f), fmi2OK);
+    impact = impact || f != 0.0;
+  }
+  EXPECT_EQ(saving.free_state(&s), fmi2OK);
+  EXPECT_TRUE(impact) << "the run reaches the end stops";
+  EXPECT_EQ(first_difference(b, a), "") << "the run with GetFMUState and SerializeFMUState before every step";
+}
+
+// CVODE at the stiffest stops takes seconds a run (the solvers' page): the
+// default machine for it and RK4, the stiffest stops too for ROS2.
+INSTANTIATE_TEST_SUITE_P(CvodeAndRk4, ObservedRuns,
+                         ::testing::Combine(::testing::Values(2, 3), ::testing::Values(kCvode, kRk4),
+                                            ::testing::Values(0)),
+                         run_name);
+INSTANTIATE_TEST_SUITE_P(Ros2, ObservedRuns,
+                         ::testing::Combine(::testing::Values(2, 3), ::testing::Values(kRos2), ::testing::Values(0, 1)),
+                         run_name);
+
+// ---------------------------------------------------------------- states the instance cannot be in
+
+/// `a` refused `status` with a logged message naming `reason`, and is as
+/// before: every Real bit-identical, and its next step bit-identical to
+/// `twin`'s (both at step k of a run).
+void refused_unchanged(Any& a, Any& twin, int status, const std::string& reason, const std::vector<double>& before,
+                       int k) {
+  EXPECT_EQ(status, fmi2Error) << a.log.dump();
+  EXPECT_TRUE(a.log.contains(reason)) << "the reason \"" << reason << "\" logged?\n" << a.log.dump();
+  EXPECT_EQ(first_difference(a.reals(), before), "") << "every variable as before";
+  EXPECT_EQ(first_difference(steps(a, k, k + 1), steps(twin, k, k + 1)), "") << "the next step as an untouched twin's";
+}
+
+// FMI 2.0 section 2.1.8 and FMI 3.0 section 2.2.6: a state of this FMU; an
+// FMI 2.0 and an FMI 3.0 FMU are two, whose state machines differ (FMI 2.0.4
+// section 4.2.4: stepFailed after a Discard; FMI 3.0.2 section 4.2.3: a
+// Discard leaves the FMU in Step Mode, there is no stepFailed). An FMI 2.0
+// state taken after a Discard would leave an FMI 3.0 instance in a state it
+// has no way out of but Reset.
+TEST_F(FmuState, AStateOfTheOtherFmiVersionIsRefused) {
+  Any failed(2, false);
+  start_drop(failed, kCvode, machines()[0]);
+  ASSERT_EQ(failed.set("F[3]", 1e300), fmi2OK);
+  ASSERT_EQ(failed.step(0.0, kH), fmi2Discard) << failed.log.dump();
+  const std::vector<unsigned char> after_discard = failed.serialized_state();
+  ASSERT_FALSE(after_discard.empty()) << failed.log.dump();
+  for (int version : {3, 2}) {
+    SCOPED_TRACE("into an FMI " + std::to_string(version) + ".0 instance");
+    Any from(5 - version, false), into(version, false), twin(version, false);
+    for (Any* x : {&from, &into, &twin}) start_drop(*x, kCvode, machines()[0]);
+    if (HasFatalFailure()) return;
+    steps(from, 0, 3);
+    steps(into, 0, 2);
+    steps(twin, 0, 2);
+    const std::vector<double> before = into.reals();
+    const std::string reason = "saved by an FMI " + std::to_string(5 - version) + ".0 instance, this one is FMI " +
+                               std::to_string(version) + ".0";
+    // Serialised, and as a state object handed over in memory.
+    refused_unchanged(into, twin, into.restore(from.serialized_state()), reason, before, 2);
+    void* s = nullptr;
+    ASSERT_EQ(from.get_state(&s), fmi2OK);
+    into.log.messages.clear();
+    const std::vector<double> now = into.reals();
+    refused_unchanged(into, twin, into.set_state(s), reason, now, 3);
+    EXPECT_EQ(from.free_state(&s), fmi2OK);
+    if (version == 3) {
+      into.log.messages.clear();
+      const std::vector<double> later = into.reals();
+      refused_unchanged(into, twin, into.restore(after_discard), "saved by an FMI 2.0 instance", later, 4);
+    }
+  }
+}
+
+// FMI 2.0 section 2.1.8, FMI 3.0 section 2.2.6 and the state tables (FMI
+// 2.0.4 sections 3.2.3, 4.2.4; FMI 3.0.2 sections 2.3, 3.2, 4.2): states
+// whose mode or flags (checksum recomputed) no instance of this version and
+// interface can be in are refused, the instance as it was.
+TEST_F(FmuState, ForgedModesTheInstanceCannotBeInAreRefused) {
+  constexpr std::size_t kMode = 32, kTerminated = 37;  // the layout: ForgedFmuStatesWithAValidChecksumAreRefused
+  for (int version : {2, 3}) {
+    for (bool me : {false, true}) {
+      SCOPED_TRACE(std::string("FMI ") + std::to_string(version) + ".0 " + (me ? "Model Exchange" : "Co-Simulation"));
+      Any a(version, me);
+      ASSERT_EQ(a.enter(), fmi2OK);
+      ASSERT_EQ(a.exit(), fmi2OK);
+      const std::vector<unsigned char> good = a.serialized_state();
+      ASSERT_FALSE(good.empty());
+      struct Forgery {
+        std::uint32_t mode;
+        unsigned char terminated;
+        const char* reason;
+      };
+      std::vector<Forgery> forgeries = {
+          {me ? pkm_fmi::kStepMode : pkm_fmi::kEventMode, 0, "a state no instance of this FMI version and interface"},
+          {me ? pkm_fmi::kStepFailed : pkm_fmi::kContinuousTimeMode, 0, "a state no instance"},
+          {pkm_fmi::kFatal, 0, "malformed FMU state (mode 256"},
+          {me ? pkm_fmi::kEventMode : pkm_fmi::kStepMode, 1, "fmi2Terminated set where no Discard can have set it"},
+      };
+      if (!me) forgeries.push_back({pkm_fmi::kStepFailed, 0, version == 2 ? "stepFailed without fmi2Terminated"
+                                                                          : "a state no instance"});
+      if (!me && version == 3) forgeries.push_back({pkm_fmi::kStepFailed, 1, "a state no instance"});
+      for (const Forgery& f : forgeries) {
+        SCOPED_TRACE(f.reason);
+        std::vector<unsigned char> forged = forge(good, kMode, f.mode, true);
+        forged = forge_bytes(forged, kTerminated, &f.terminated, 1);
+        a.log.messages.clear();
+        EXPECT_EQ(a.restore(forged), fmi2Error);
+        EXPECT_TRUE(a.log.contains(f.reason)) << a.log.dump();
+      }
+      // The control: the same bytes with the checksum recomputed restore.
+      const unsigned char zero = 0;
+      EXPECT_EQ(a.restore(forge_bytes(good, kTerminated, &zero, 1)), fmi2OK) << a.log.dump();
+    }
+  }
+}
+
+// A Co-Simulation state after initialisation holds the plant (the instance
+// made it at ExitInitializationMode), at the time the instance counts: a
+// state from before initialisation forged into Step Mode, or with the
+// plant's time off the instance's, is refused.
+TEST_F(FmuState, ForgedPlantsTheInstanceCannotHaveAreRefused) {
+  for (int version : {2, 3}) {
+    SCOPED_TRACE(version);
+    Any a(version, false), twin(version, false);
+    const std::vector<unsigned char> instantiated = a.serialized_state();
+    ASSERT_FALSE(instantiated.empty()) << a.log.dump();
+    start_drop(a, kRos2, machines()[0]);
+    start_drop(twin, kRos2, machines()[0]);
+    steps(a, 0, 3);
+    steps(twin, 0, 3);
+    const std::vector<double> before = a.reals();
+    refused_unchanged(a, twin, a.restore(forge(instantiated, 32, pkm_fmi::kStepMode, true)),
+                      "no plant in a state after initialisation", before, 3);
+    const std::vector<unsigned char> good = a.serialized_state();
+    double t = 0.0;
+    std::memcpy(&t, &good[PlantPart(good.size()).t], 8);
+    a.log.messages.clear();
+    const std::vector<double> now = a.reals();
+    refused_unchanged(a, twin, a.restore(forge(good, PlantPart(good.size()).t, t + kH)),
+                      "differs from the time since startTime", now, 4);
+  }
+}
+
+// The contact mode is part of the hybrid state (docs/model.md): in
+// Co-Simulation the plant switches it at every event it locates, so every
+// state it saves holds the mode the event rule keeps there. A forged "lower
+// stop of leg 1 held" at the home pose, 5 cm above the stop, would pull the
+// slider down with the stop's spring: refused, the reason logged. In Model
+// Exchange the mode changes only in Event Mode (FMI 2.0.4 section 3.2.2,
+// FMI 3.0.2 section 3.1.1), and between events the importer's integrator may
+// carry the state past a switch: the mode may lag the state there.
+TEST_F(FmuState, AHeldStopClearOfItsSliderIsRefusedInCoSimulation) {
+  for (int version : {2, 3}) {
+    SCOPED_TRACE(version);
+    Any a(version, false), twin(version, false);
+    for (Any* x : {&a, &twin}) {
+      ASSERT_EQ(x->enter(), fmi2OK);
+      ASSERT_EQ(x->exit(), fmi2OK);
+    }
+    const std::vector<unsigned char> good = a.serialized_state();
+    const PlantPart plant(good.size());
+    const std::vector<double> before = a.reals();
+    refused_unchanged(a, twin, a.restore(forge(good, plant.stops, 1, true)),
+                      "the lower stop of leg 1 is held while its slider is", before, 0);
+    double f = NAN;
+    ASSERT_EQ(a.get("stop_force[1]", f), fmi2OK);
+    EXPECT_EQ(f, 0.0) << "no stop acts at the home pose";
+    a.log.messages.clear();
+    EXPECT_EQ(a.restore(forge(good, plant.stops, 0x11, true)), fmi2Error)
+        << "both stops of leg 1";
+    Any me(version, true);
+    ASSERT_EQ(me.enter(), fmi2OK);
+    ASSERT_EQ(me.exit(), fmi2OK);
+    const std::vector<unsigned char> me_good = me.serialized_state();
+    EXPECT_EQ(me.restore(forge(me_good, PlantPart(me_good.size()).stops, 1, true)), fmi2OK) << me.log.dump();
+  }
+}
+
+// The integrators' memory (pkm::SolverMemory) travels whole: each of its
+// bytes, perturbed in a serialised state with the checksum recomputed, is
+// either refused (a memory no run can have, the reason logged) or restored
+// exactly -- the state serialised again carries the perturbed byte. A
+// member restored by a list of fields that forgot one would fail here.
+TEST_F(FmuState, EveryByteOfTheIntegratorsMemoryIsRestored) {
+  Any a(2, false);
+  start_drop(a, kRos2, machines()[0]);
+  int k = 0;
+  double f = 0.0;
+  for (; k < 200 && f == 0.0; ++k) {
+    ASSERT_EQ(a.step(k * kH, kH), fmi2OK) << a.log.dump();
+    ASSERT_EQ(a.get("stop_force[1]", f), fmi2OK);
+  }
+  ASSERT_NE(f, 0.0) << "right after the impact: ROS2's layer and contact step are set";
+  const std::vector<unsigned char> good = a.serialized_state();
+  const PlantPart plant(good.size());
+  std::uint32_t size = 0;
+  std::memcpy(&size, &good[plant.memory_size], 4);
+  ASSERT_EQ(size, sizeof(pkm::SolverMemory));
+  std::size_t restored = 0;
+  for (std::size_t i = 0; i < sizeof(pkm::SolverMemory); ++i) {
+    SCOPED_TRACE("byte " + std::to_string(i));
+    const unsigned char byte = static_cast<unsigned char>(good[plant.memory + i] ^ 0x01u);
+    const std::vector<unsigned char> forged = forge_bytes(good, plant.memory + i, &byte, 1);
+    a.log.messages.clear();
+    if (a.restore(forged) == fmi2OK) {
+      ++restored;
+      const std::vector<unsigned char> again = a.serialized_state();
+      ASSERT_EQ(again.size(), forged.size());
+      EXPECT_EQ(std::memcmp(&again[plant.memory], &forged[plant.memory], sizeof(pkm::SolverMemory)), 0);
+    } else {
+      EXPECT_TRUE(a.log.contains("the integrators' memory is none a run can have")) << a.log.dump();
+    }
+  }
+  EXPECT_GE(restored, sizeof(pkm::SolverMemory) / 2) << "most perturbations are memories a run can have";
+  a.log.messages.clear();
+  EXPECT_EQ(a.restore(forge(good, plant.memory_size, sizeof(pkm::SolverMemory) + 8, true)), fmi2Error);
+  EXPECT_TRUE(a.log.contains("integrators' memory of")) << a.log.dump();
 }
 
 }  // namespace

@@ -23,10 +23,14 @@
 // A value that differs is a jump, and CVODE restarts at the step start:
 // integrating across a jump from the old history costs accuracy (the
 // docs' "CVODE across communication points" measures how much).
-// FMU states: CVODE's history is not part of a saved state. The next step
-// after a GetFMUState restarts, as the first step after a SetFMUState does
-// (PlantData::state_saved), so a restored run continues bit for bit like
-// the original one (RK4 keeps no history: nothing changes for it).
+// FMU states: the Plant's snapshot with everything RK4 and ROS2 carry
+// between steps (pkm::SolverMemory, whole), so that a restored run
+// continues bit for bit like the original. CVODE's multistep history is not
+// part of it (SUNDIALS has no way to set it): the first step after a
+// SetFMUState restarts CVODE, so a restored CVODE run agrees with the
+// original within CVODE's tolerance (bit for bit where the original
+// restarted there too, at a jump of the inputs). Taking a state changes
+// nothing: the run goes on as without it.
 //
 // Outputs are computed lazily by group (the state's copies, the legs, the
 // dynamics, the machine, the health measures: kGroup* below), each on the
@@ -104,7 +108,7 @@ struct PlantData final : MechanismData {
   // Co-Simulation: end-stop events located so far (logged per step).
   long contact_events = 0;
   // Co-Simulation: the inputs at the end of the last step and whether CVODE
-  // may continue from there (no restart, failure or saved state since).
+  // may continue from there (no restart, failure or restored state since).
   double u_end[kInputs] = {};
   bool may_continue = false;
   // The simulated machine (nullptr before initialisation).
@@ -132,7 +136,6 @@ struct PlantData final : MechanismData {
     jacobian_cache.valid = false;
     may_continue = false;
   }
-  void state_saved() override { may_continue = false; }
   /// Whether every input continues its value at the end of the last step (kInputJump).
   bool inputs_continue() const;
   Status exit_initialization(Context& ctx) override;

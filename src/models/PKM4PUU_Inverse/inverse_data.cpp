@@ -176,6 +176,10 @@ void InverseData::save(StateWriter& w) const { w.u8(model ? 1 : 0); }
 bool InverseData::load(StateReader& r, Context& ctx) {
   const bool has_model = r.u8() != 0;
   if (!r.ok()) return false;
+  if (!has_model && ctx.initialized) {  // ExitInitializationMode built it
+    ctx.log.error("SetFMUState: malformed FMU state (no model in a state after initialisation)");
+    return false;
+  }
   model.reset();
   if (has_model) {
     auto m = std::make_unique<pkm::Model>();

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cmath>
+#include <string>
 
 #include "pkm4puu/model/model.hpp"
 
@@ -197,6 +198,12 @@ inline unsigned stops_after_event(const Params& p, const Vec4& rho, const Vec4& 
   }
   return stops & kContactModeBits;
 }
+
+/// Why the contact mode `stops` is not the one the event rule keeps at rho
+/// and rhod (stops_after_event(p, rho, rhod, stops) != stops): the first
+/// stop or clamp it gets wrong, with the distances and forces that say so
+/// (a state no run reaches: a held stop with its slider clear of it pulls).
+std::string describe_unsettled_mode(const Params& p, const Vec4& rho, const Vec4& rhod, unsigned stops);
 
 /// The contact mode after located crossings: dirs[k] < 0 where indicator k
 /// (contact_indicators) fell through zero (its bit set), > 0 where it rose

@@ -73,72 +73,101 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
   stops_ = stops_after_event(model_.p, rho, rhod, 0u);
   t_ = t0;
   energy_ = EnergyIntegrals{};
-  balance_pending_ = false;
+  memory_ = SolverMemory{};
   for (int i = 0; i < kLegs; ++i) theta1_.ref[i] = q[leg_offset(i) + 1];
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
-  layer_pending_ = true;
-  contact_step_ = -1.0;
   initialized_ = true;
   return Status::Ok;
 }
 
-Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
-  return restore(t, y, theta1_ref, ~0u);
+PlantSnapshot Plant::snapshot() const {
+  PlantSnapshot s;
+  s.t = t_;
+  s.y = y_;
+  s.theta1_ref = theta1_ref();
+  s.energy = energy_;
+  s.stops = stops_;
+  s.memory = memory_;
+  return s;
 }
 
-Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned stops) {
+Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
   settle_energy();  // the integrals keep their values: at the state they belong to
+  PlantSnapshot s;
+  s.t = t;
+  s.y = y;
+  s.theta1_ref = theta1_ref;
+  s.energy = energy_;
+  s.stops = kStopsFromState;
+  s.memory = restarted_solver_memory();  // a restored run goes on as it would have (no new transient)
+  return restore(s);
+}
+
+Status Plant::restore(const PlantSnapshot& snap, bool settled) {
+  const unsigned stops = snap.stops;
   const unsigned legs_held = (stops | (stops >> kLegs)) & ((1u << kLegs) - 1u);
-  if (stops != ~0u && ((stops & ~kContactModeBits) != 0u || (stops & (stops >> kLegs) & ((1u << kLegs) - 1u)) != 0u ||
-                       ((stops >> (2 * kLegs)) & ~legs_held) != 0u)) {
+  if (stops != kStopsFromState &&
+      ((stops & ~kContactModeBits) != 0u || (stops & (stops >> kLegs) & ((1u << kLegs) - 1u)) != 0u ||
+       ((stops >> (2 * kLegs)) & ~legs_held) != 0u)) {
     char buf[140];
     std::snprintf(buf, sizeof buf,
                   "the contact mode %#x names no stop, both stops of one leg or the clamp of a stop not held", stops);
     error_ = buf;
     return Status::InvalidArgument;
   }
-  if (!std::isfinite(t) || !y.allFinite() || !theta1_ref.allFinite()) {
-    error_ = "the time, state or theta1 references are not finite";
+  if (!std::isfinite(snap.t) || !snap.y.allFinite() || !snap.theta1_ref.allFinite() ||
+      !std::isfinite(snap.energy.actuator_work) || !std::isfinite(snap.energy.dissipated)) {
+    error_ = "the time, state, theta1 references or energy integrals are not finite";
     return Status::NonFinite;
   }
-  Status s = guard(y, t);
+  const std::string memory_fault = solver_memory_fault(snap.memory);
+  if (!memory_fault.empty()) {
+    error_ = "the integrators' memory is none a run can have: " + memory_fault;
+    return Status::InvalidArgument;
+  }
+  Status s = guard(snap.y, snap.t);
   if (s != Status::Ok) return s;
   Vec16 q, qd;
-  s = expand_state(model_, y, q, qd);
+  s = expand_state(model_, snap.y, q, qd);
   if (s != Status::Ok) return s;
   // theta1 is continuous, never wrapped, but cannot wind: the references
   // are the pose's closed-form angles up to whole turns, within a few turns.
   for (int i = 0; i < kLegs; ++i) {
     const double th1 = q[leg_offset(i) + 1];
-    const bool near = std::fabs(unwrap_near(th1, theta1_ref[i]) - theta1_ref[i]) <= 1e-9;
-    if (!(std::fabs(theta1_ref[i]) <= kMaxTheta1) || !near) {
+    const double ref = snap.theta1_ref[i];
+    const bool near = std::fabs(unwrap_near(th1, ref) - ref) <= 1e-9;
+    if (!(std::fabs(ref) <= kMaxTheta1) || !near) {
       char buf[240];
       std::snprintf(buf, sizeof buf,
                     "the theta1 reference %.17g rad of leg %d is not the pose's theta1 = %.17g rad modulo 2 pi "
                     "(within %g rad)",
-                    theta1_ref[i], i + 1, th1, kMaxTheta1);
+                    ref, i + 1, th1, kMaxTheta1);
       error_ = buf;
       return Status::InvalidArgument;
     }
   }
-  const Status prepared = prepare_cvode();
-  if (prepared != Status::Ok) return prepared;
-  t_ = t;
-  y_ = y;
-  rho_valid_ = false;
   Vec4 rho, rhod;
   for (int i = 0; i < kLegs; ++i) {
     rho[i] = q[leg_offset(i)];
     rhod[i] = qd[leg_offset(i)];
   }
-  stops_ = stops != ~0u ? stops : stops_after_event(model_.p, rho, rhod, 0u);
-  theta1_.ref = theta1_ref;
+  const unsigned mode = stops != kStopsFromState ? stops : stops_after_event(model_.p, rho, rhod, 0u);
+  if (settled && stops_after_event(model_.p, rho, rhod, mode) != mode) {
+    error_ = describe_unsettled_mode(model_.p, rho, rhod, mode);
+    return Status::InvalidArgument;
+  }
+  const Status prepared = prepare_cvode();
+  if (prepared != Status::Ok) return prepared;
+  t_ = snap.t;
+  y_ = snap.y;
+  rho_valid_ = false;
+  stops_ = mode;
+  energy_ = snap.energy;
+  memory_ = snap.memory;
+  theta1_.ref = snap.theta1_ref;
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
-  layer_pending_ = false;  // a restored run goes on as it would have (no new transient)
-  layer_ = std::numeric_limits<double>::infinity();
-  contact_step_ = -1.0;
   initialized_ = true;
   return Status::Ok;
 }
@@ -183,20 +212,6 @@ Status Plant::update_stops(unsigned& switched) {
   return Status::Ok;
 }
 
-Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e) {
-  return restore(t, y, theta1_ref, e, ~0u);
-}
-
-Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e, unsigned stops) {
-  if (!std::isfinite(e.actuator_work) || !std::isfinite(e.dissipated)) return Status::NonFinite;
-  settle_energy();
-  const EnergyIntegrals keep = energy_;
-  energy_ = e;
-  const Status s = restore(t, y, theta1_ref, stops);
-  if (s != Status::Ok) energy_ = keep;
-  return s;
-}
-
 Status Plant::joint_motion(const Vec8& y, Vec4& rho, Vec4& rhod) const {
   Vec16 q, qd;
   const Status s = expand_state(model_, y, q, qd);
@@ -217,11 +232,12 @@ Status Plant::contact_indicators(double z[kContactIndicators]) const {
 }
 
 void Plant::settle_energy() const {
-  if (!balance_pending_) return;
+  SolverMemory& m = memory_;
+  if (!m.balance_pending) return;
   double e = 0.0;
   if (mechanical_energy(y_, e) != Status::Ok) return;  // y_ is always assembled: not reached
-  energy_.dissipated = balance_dissipated_ + (energy_.actuator_work - balance_work_) - (e - balance_mech_);
-  balance_pending_ = false;
+  energy_.dissipated = m.balance_dissipated + (energy_.actuator_work - m.balance_work) - (e - m.balance_mech);
+  m.balance_pending = 0;
 }
 
 Vec10 Plant::packed(bool settle) const {

@@ -11,6 +11,7 @@
 #include "pkm4puu/kinematics/theta1_continuity.hpp"
 #include "pkm4puu/machine/end_stops.hpp"
 #include "pkm4puu/sim/input_signal.hpp"
+#include "pkm4puu/sim/solver_memory.hpp"
 #include "pkm4puu/sim/solver_settings.hpp"
 
 namespace pkm {
@@ -28,6 +29,18 @@ constexpr double kMaxSpeed = 1e3;
 struct EnergyIntegrals {
   double actuator_work = 0;  // of (F_i + (2 pi/p) tau_i) rhod_i plus the external wrench's power
   double dissipated = 0;     // friction plus the end stops' damping
+};
+
+/// Everything a run continues from (Plant::snapshot, Plant::restore): with
+/// RK4 and ROS2 a restored run is the original's bit for bit; CVODE
+/// restarts its history there (its multistep history is not part of it).
+struct PlantSnapshot {
+  double t = 0;
+  Vec8 y = Vec8::Zero();  // [pose; velocity]
+  Vec4 theta1_ref = Vec4::Zero();
+  EnergyIntegrals energy;  // as held (memory.balance_pending: the dissipated energy is brought up to date when read)
+  unsigned stops = 0;      // the contact mode (end_stops.hpp)
+  SolverMemory memory;
 };
 
 /// The machine's outputs at the current time (docs/model.md "The machine
@@ -82,18 +95,27 @@ class Plant {
   double time() const { return t_; }
   /// The integrated state [pose; velocity].
   const Vec8& state() const { return y_; }
-  /// Restores a state saved earlier (time, y, theta1 continuity); refused
-  /// (nothing changes, last_error() says why) if y lies beyond the
-  /// singularity limits or kMaxSpeed, or theta1_ref is not the pose's
-  /// closed-form theta1 (modulo 2 pi). The energy integrals keep their
-  /// values unless given.
-  /// The contact mode is the one that the event rule gives at y
-  /// (stops_after_event from none) unless given (`stops`, end_stops.hpp's
-  /// bits; InvalidArgument if it names no stop or both of one leg's).
+  /// The current state with everything the integrators carry between
+  /// advances (reading changes nothing the run depends on).
+  PlantSnapshot snapshot() const;
+  /// Continues from a snapshot: RK4 and ROS2 bit for bit as the run it was
+  /// taken from, CVODE restarted there. Refused (nothing changes,
+  /// last_error() says why: InvalidArgument, NonFinite, or the guard's
+  /// status) if y lies beyond the singularity limits or kMaxSpeed,
+  /// theta1_ref is not the pose's closed-form theta1 (modulo 2 pi), an
+  /// energy is not finite, the memory is none a run can have
+  /// (solver_memory_fault), or the contact mode names no stop, both stops of
+  /// one leg or the clamp of a stop not held. `settled`: the contact mode
+  /// must also be the one the event rule keeps at y (stops_after_event),
+  /// as it is wherever advance() and update_stops() leave it; without it
+  /// the mode may lag the state (Model Exchange between events).
+  /// snapshot.stops = kStopsFromState: the mode the event rule gives at y
+  /// from none.
+  Status restore(const PlantSnapshot& snapshot, bool settled = true);
+  /// restore() of a time and state from outside (time, y, theta1
+  /// continuity): the energy integrals keep their values, the contact mode
+  /// is the event rule's at y, and no transient is pending.
   Status restore(double t, const Vec8& y, const Vec4& theta1_ref);
-  Status restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e);
-  Status restore(double t, const Vec8& y, const Vec4& theta1_ref, const EnergyIntegrals& e, unsigned stops);
-  Status restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned stops);
 
   /// The contact mode (end_stops.hpp): which end stops act. Set at
   /// initialize() and restore() by the event rule, switched at every event
@@ -135,7 +157,7 @@ class Plant {
   /// Sets the running energy integrals (the importer integrates them too).
   void set_energy_integrals(const EnergyIntegrals& e) {
     energy_ = e;
-    balance_pending_ = false;
+    memory_.balance_pending = 0;
   }
   /// d/dt of [y; actuator_work; dissipated] at the current time and state
   /// for the given inputs, under the contact mode stops().
@@ -222,11 +244,11 @@ class Plant {
   double t_ = 0;
   Vec8 y_ = Vec8::Zero();
   mutable EnergyIntegrals energy_;
-  // ROS2's dissipated energy, the audit's balance, brought up to date when
-  // read (settle_energy): the mechanical energy costs a third of a ROS2 step.
-  // balance_* hold the energies where it was last exact.
-  mutable bool balance_pending_ = false;
-  double balance_mech_ = 0, balance_work_ = 0, balance_dissipated_ = 0;
+  // What the integrators carry between advances (solver_memory.hpp), ROS2's
+  // energy balance included: its dissipated energy, the audit's balance, is
+  // brought up to date when read (settle_energy), since the mechanical
+  // energy costs a third of a ROS2 step.
+  mutable SolverMemory memory_;
   long contact_events_ = 0;
   unsigned stops_ = 0;  // the contact mode (stops()): never kStopsFromState
   // actuator_positions at y_, when rho_valid_ (every change of y_ clears it).
@@ -234,13 +256,6 @@ class Plant {
   mutable bool rho_valid_ = false;
   mutable Theta1References theta1_;
   mutable bool theta1_stale_ = false;
-  // ROS2's initial layer (located_step.hpp's InnerSteps::layer): pending
-  // after initialize(), else carried from the last advance (none after restore()).
-  bool layer_pending_ = true;
-  double layer_ = 0;
-  // ROS2's step in the current contact (PlantOde::contact_step); < 0: not
-  // known yet (after initialize() and restore(): computed at the next advance).
-  double contact_step_ = -1.0;
   long rhs_count_ = 0;
   Status rhs_status_ = Status::Ok;
   std::string error_;

@@ -155,13 +155,13 @@ Status Plant::advance_fixed(double t_end) {
   PlantOde ode{*this, sub.contact};
   if (rosenbrock) {  // the ringing from the Jacobian at each switch into contact
     inner.contact_from_system = true;
-    inner.contact = contact_step_ >= 0.0 ? contact_step_
+    inner.contact = memory_.contact_step >= 0.0 ? memory_.contact_step
                     : (stops_ & kStopBits) != 0u ? ode.contact_step(t_, packed(false))
                                                  : std::numeric_limits<double>::infinity();
   }
   // The transient started at initialisation or carried over from the last advance.
-  inner.layer = layer_pending_ ? (stops_ != 0 ? sub.layer_contact : sub.layer_free) : layer_;
-  layer_pending_ = false;
+  inner.layer = memory_.layer_pending ? (stops_ != 0 ? sub.layer_contact : sub.layer_free) : memory_.layer;
+  memory_.layer_pending = 0;
   // One budget for the whole advance: work_budget inner steps per grid step.
   WorkBudget budget;
   budget.limit = static_cast<long>(std::min(settings_.work_budget * static_cast<double>(n), 1e18));
@@ -175,11 +175,11 @@ Status Plant::advance_fixed(double t_end) {
     settle_energy();
     const Status s = mechanical_energy(y_, e_mech);
     if (s != Status::Ok) return s;
-  } else if (rosenbrock && !balance_pending_) {
-    const Status s = mechanical_energy(y_, balance_mech_);
+  } else if (rosenbrock && !memory_.balance_pending) {
+    const Status s = mechanical_energy(y_, memory_.balance_mech);
     if (s != Status::Ok) return s;
-    balance_work_ = energy_.actuator_work;
-    balance_dissipated_ = energy_.dissipated;
+    memory_.balance_work = energy_.actuator_work;
+    memory_.balance_dissipated = energy_.dissipated;
   }
   for (long k = 0; k < n; ++k) {
     const double tk = (k == 0) ? t0 : t0 + static_cast<double>(k) * h;
@@ -194,8 +194,8 @@ Status Plant::advance_fixed(double t_end) {
     Status s = rosenbrock
                    ? located_rosenbrock_step(ode, tk, t_next, inner, x, mode, rho, rho_valid, contact_events_, t, budget)
                    : located_rk4_step(ode, tk, t_next, inner, x, mode, rho, rho_valid, contact_events_, t, budget);
-    layer_ = inner.layer;
-    if (rosenbrock) contact_step_ = inner.contact;
+    memory_.layer = inner.layer;
+    if (rosenbrock) memory_.contact_step = inner.contact;
     if (s != Status::Ok) {
       if (budget.exhausted) {
         error_ = work_budget_message(model_, settings_, t, budget.limit, budget.in_contact);
@@ -216,7 +216,7 @@ Status Plant::advance_fixed(double t_end) {
     }
     if (rosenbrock && !balance_each_step) {
       x[9] = energy_.dissipated;  // the balance's reference, not this step's
-      balance_pending_ = true;
+      memory_.balance_pending = 1;
     }
     unpack(x);
     t_ = t_next;
@@ -270,9 +270,7 @@ Status Plant::advance(double t_end, const InputSignal& inputs, bool continuous) 
   const Vec8 y_start = y_;
   const EnergyIntegrals e_start = energy_;
   const unsigned stops_start = stops_;
-  const bool layer_pending_start = layer_pending_;
-  const double layer_start = layer_;
-  const double contact_step_start = contact_step_;
+  const SolverMemory memory_start = memory_;
   double audit_start = 0.0;
   const bool audit = settings_.energy_tolerance > 0.0;
   if (audit) {
@@ -303,9 +301,7 @@ Status Plant::advance(double t_end, const InputSignal& inputs, bool continuous) 
       stops_ = stops_start;
       t_ = t_start;
       rho_valid_ = false;
-      layer_pending_ = layer_pending_start;
-      layer_ = layer_start;
-      contact_step_ = contact_step_start;
+      memory_ = memory_start;
       if (cvode_ready_) cvode_.reset(t_, packed());
     }
   }
