@@ -129,8 +129,9 @@ PKM_API const char* pkm_status_string(pkm_status s);
 PKM_API pkm_status pkm_set_solver(pkm_model* m, const pkm_solver_settings* s);
 
 /** The fixed-step solvers' checks (docs/solvers.md), kept by pkm_set_solver:
- * work_budget, the inner steps (grid steps, stiff sub-steps, bisection
- * trials) allowed per grid step, summed over one pkm_advance* ([1, 1e6],
+ * work_budget, the inner steps (grid steps, stiff sub-steps, rejected
+ * steps, bisection trials) allowed per grid step, summed over one
+ * pkm_advance* and at most 1e5 per call, whatever its length ([1, 1e6],
  * default 1000; beyond, PKM_ERR_SOLVER and pkm_last_error says
  * why); energy_tolerance (J, [0, 1e9], 0 = off, the default): an advance
  * whose energy audit residual exceeds it is undone (PKM_ERR_SOLVER).

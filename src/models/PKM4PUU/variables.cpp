@@ -162,10 +162,10 @@ constexpr Variable kVariables[] = {
   real_parameter(141, "rk4_step", kDefaultSolver.rk4_step, "s",
                  "Fixed step of RK4 and Rosenbrock: a communication step is split into whole steps no longer than this", PLANT_SCALAR(rk4_step), 0,
                  pkm::kMinRk4Step, pkm::kMaxRk4Step),
-  real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance", PLANT_SCALAR(rtol), 0, pkm::kMinRtol, pkm::kMaxRtol),
-  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)", PLANT_SCALAR(atol), 0, pkm::kMinAtol, pkm::kMaxAtol),
+  real_parameter(142, "rtol", kDefaultSolver.rtol, "", "CVODE relative tolerance (at most 1e-2: looser, impacts on undamped stiff stops run away)", PLANT_SCALAR(rtol), 0, pkm::kMinRtol, pkm::kMaxRtol),
+  real_parameter(143, "atol", kDefaultSolver.atol, "", "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J; on the velocities at most friction_velocity / 10 where Coulomb friction acts): at least 1e-14, below which the stiffest stops' impact needs more work than one step may take, at most 1e-2, above which impacts on undamped stiff stops run away", PLANT_SCALAR(atol), 0, pkm::kMinAtol, pkm::kMaxAtol),
   integer_parameter(144, "cvode_method", static_cast<int>(kDefaultSolver.cvode_method),
-                    "CVODE method: 0 = Adams-Moulton (non-stiff), 1 = BDF", PLANT_SCALAR(cvode_method), 0, 1),
+                    "CVODE method: 0 = Adams-Moulton (non-stiff; BDF on a machine whose friction or stop damping against the slider's mass exceeds 1e5 1/s), 1 = BDF", PLANT_SCALAR(cvode_method), 0, 1),
   integer_parameter(145, "formulation", static_cast<int>(kDefaultSolver.formulation),
                     "Forward dynamics: 0 = augmented saddle-point system (Eq. 12), 1 = null-space projection with a QR "
                     "(Eq. 13), 2 = null space from the leg blocks (Eq. 13, leg-partitioned)",

@@ -77,8 +77,6 @@ Status Plant::initialize(double t0, const Pose& pose, const Pose& velocity) {
   for (int i = 0; i < kLegs; ++i) theta1_.ref[i] = q[leg_offset(i) + 1];
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
-  layer_pending_ = true;
-  contact_step_ = -1.0;
   initialized_ = true;
   return Status::Ok;
 }
@@ -136,9 +134,6 @@ Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref, unsigned 
   theta1_.ref = theta1_ref;
   theta1_stale_ = false;
   if (cvode_ready_) cvode_.reset(t_, packed());
-  layer_pending_ = false;  // a restored run goes on as it would have (no new transient)
-  layer_ = std::numeric_limits<double>::infinity();
-  contact_step_ = -1.0;
   initialized_ = true;
   return Status::Ok;
 }

@@ -172,6 +172,12 @@ class Plant {
   friend struct PlantOde;  // the integrators' view (plant.cpp)
   static int cvode_rhs(double t, const Vec10& x, Vec10& xdot, void* self);
   static int cvode_roots(double t, const Vec10& x, double* g, void* self);
+  /// BDF's Jacobian: the analytic one of the pose and velocity rates
+  /// (state_derivative_jacobians), as ROS2's.
+  static int cvode_jacobian(double t, const Vec10& x, Mat10& J, void* self);
+  /// Whether this CVODE advance has used up kMaxCvodeEvaluationsPerCall
+  /// (then the callbacks abort it).
+  bool cvode_capped();
   /// d/dt of x = [y; actuator_work; dissipated] for the integrators
   /// (counts the evaluation; the inputs of the current advance, the stops held).
   Status derivative(double t, const Vec10& x, Vec10& xdot);
@@ -234,15 +240,12 @@ class Plant {
   mutable bool rho_valid_ = false;
   mutable Theta1References theta1_;
   mutable bool theta1_stale_ = false;
-  // ROS2's initial layer (located_step.hpp's InnerSteps::layer): pending
-  // after initialize(), else carried from the last advance (none after restore()).
-  bool layer_pending_ = true;
-  double layer_ = 0;
-  // ROS2's step in the current contact (PlantOde::contact_step); < 0: not
-  // known yet (after initialize() and restore(): computed at the next advance).
-  double contact_step_ = -1.0;
   long rhs_count_ = 0;
   Status rhs_status_ = Status::Ok;
+  // Within one CVODE advance: rhs_count_ at its start, and whether it hit
+  // kMaxCvodeEvaluationsPerCall.
+  long cvode_call_start_ = 0;
+  bool cvode_work_capped_ = false;
   std::string error_;
 };
 

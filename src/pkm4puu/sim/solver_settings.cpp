@@ -43,7 +43,7 @@ std::string validate(const SolverSettings& s) {
     return buf;
   }
   if (!(s.atol >= kMinAtol) || !(s.atol <= kMaxAtol)) {
-    std::snprintf(buf, sizeof buf, "atol = %.17g must be positive and at most 1 (at least %g)", s.atol, kMinAtol);
+    std::snprintf(buf, sizeof buf, "atol = %.17g must lie in [%g, %g]", s.atol, kMinAtol, kMaxAtol);
     return buf;
   }
   if (!(s.work_budget >= kMinWorkBudget && s.work_budget <= kMaxWorkBudget)) {
