@@ -31,8 +31,8 @@ using Mat10 = Eigen::Matrix<double, 10, 10>;
 bool cvode_available();
 
 /// CVODE's smallest step (s) on a machine whose fastest rate is at most
-/// 1e3 / kMinStep; a stiffer one gets a floor below its fastest time
-/// constant (cvode_min_step, cvode_integrator.cpp says why).
+/// 1e3 1/s; a stiffer one gets a floor a billion times below its fastest
+/// time constant (cvode_min_step, cvode_integrator.cpp says why).
 constexpr double kMinStep = 1e-12;
 /// min(kMinStep, 1e-9 / fastest_rate): fastest_rate (1/s) bounds the
 /// magnitude of the Jacobian's eigenvalues (fixed_step_stability.hpp).

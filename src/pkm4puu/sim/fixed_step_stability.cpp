@@ -77,11 +77,12 @@ std::string work_budget_message(const Model& m, const SolverSettings& s, double 
   if (s.solver == Solver::Rosenbrock) {
     std::snprintf(buf, sizeof buf,
                   "%s%s: the last Rosenbrock step tried, %.3g s, had an error estimate %.3g times its tolerance "
-                  "(%g of the speed plus %g m/s; %s, stop_stiffness = %g N/m, stop_damping = %g N.s/m, "
-                  "friction_coulomb = %g N, friction_velocity = %g m/s): use solver = 0 (CVODE), a larger "
-                  "work_budget or shorter communication steps",
+                  "(%g of the speed plus %g m/s per grid step, at least %g m/s; %s, stop_stiffness = %g N/m, "
+                  "stop_damping = %g N.s/m, friction_coulomb = %g N, friction_velocity = %g m/s): use solver = 0 "
+                  "(CVODE), a larger work_budget or shorter communication steps",
                   head, budget.in_contact ? " in an end-stop contact" : "", budget.step, budget.estimate,
-                  kRosenbrockTolerance, kRosenbrockSpeedFloor, budget.in_contact ? "held stops" : "no stop held",
+                  kRosenbrockTolerance, kRosenbrockSpeedFloor, kRosenbrockStepFloor,
+                  budget.in_contact ? "held stops" : "no stop held",
                   p.stop_stiffness, p.stop_damping, p.friction_coulomb, p.friction_velocity);
   } else if (budget.in_contact) {
     std::snprintf(buf, sizeof buf,

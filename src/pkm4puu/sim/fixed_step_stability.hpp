@@ -51,15 +51,17 @@ constexpr double kRk4StiffFraction = 0.1;
 /// ROS2's error control (docs/solvers.md "ROS2's error estimate"): every
 /// accepted step's estimate of each velocity error (dphi times 0.1 m) is at
 /// most kRosenbrockTolerance times the advance's speed (the largest |dx|,
-/// |dy|, |dz|, 0.1 m |dphi| at its start and its accepted steps) plus
-/// kRosenbrockSpeedFloor per grid step (a step of h: h / grid step of it,
-/// so that a contact's many short steps do not each take the whole floor).
-/// A velocity error made in a contact shifts the next impact in time (a
-/// flight lasts 2 v / g) and the next contact's deceleration magnifies it:
-/// the tolerance is relative to the speed for that, and tight; the floor
-/// lets a smooth motion take its whole 1 ms grid steps.
-constexpr double kRosenbrockTolerance = 4e-6;
-constexpr double kRosenbrockSpeedFloor = 1e-5;  // m/s
+/// |dy|, |dz|, 0.1 m |dphi| at its start and its accepted steps) plus a
+/// floor: kRosenbrockSpeedFloor per grid step (a step of h: h / grid step
+/// of it), at least kRosenbrockStepFloor. A velocity error made in a contact
+/// shifts the next impact in time (a flight lasts 2 v / g) and the next
+/// contact's deceleration magnifies it: the tolerance is relative to the
+/// speed for that, and tight; the floor per grid step lets a smooth motion
+/// take whole 1 ms steps, and the one per step bounds a contact's cost where
+/// the speed passes through zero (a rebound).
+constexpr double kRosenbrockTolerance = 3e-6;
+constexpr double kRosenbrockSpeedFloor = 1e-5;  // m/s per grid step
+constexpr double kRosenbrockStepFloor = 1e-6;   // m/s
 /// The estimate is filtered (located_rosenbrock.hpp) with H at least this
 /// fraction of the grid step: a mode with |lambda| H = 1 decays by e^-10
 /// over the grid step, its error with it.

@@ -65,13 +65,13 @@ struct PlantOde {
   }
   /// ROS2's error estimate of a step of h in units of its tolerance: each
   /// velocity's (dphi times 0.1 m) against kRosenbrockTolerance times the
-  /// speed scale plus kRosenbrockSpeedFloor per grid step (h / grid_step
-  /// of it); an accepted step's speed joins the scale.
+  /// speed scale plus the floor (kRosenbrockSpeedFloor per grid step, at
+  /// least kRosenbrockStepFloor); an accepted step's speed joins the scale.
   double error_norm(const Vec10& error, const Vec10& y0, const Vec10& y1, double h) {
     const double v = std::max(speed, std::max(speed_of(y0), speed_of(y1)));
     Vec10 e = error;
     e[7] *= kConditionLength;
-    const double floor = kRosenbrockSpeedFloor * std::min(1.0, h / grid_step);
+    const double floor = std::max(kRosenbrockStepFloor, kRosenbrockSpeedFloor * std::min(1.0, h / grid_step));
     const double norm = e.segment<4>(4).cwiseAbs().maxCoeff() / (kRosenbrockTolerance * v + floor);
     if (norm <= 1.0) speed = v;
     return norm;
