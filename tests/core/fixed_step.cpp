@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // The fixed-step solvers are right or say so (docs/solvers.md): the stiff
 // cases of issue 28 at 1 ms steps, RK4 (sub-stepped within its stability
-// bound, or refused with a message) and ROS2 (solver = 2) against CVODE at
-// rtol 1e-10; the work budget; the energy audit as a run-time check; ROS2's
-// order.
+// bound, or refused with a message) and ROS2 (solver = 2, under its error
+// estimate) against CVODE at rtol 1e-10, the default drop's repeated
+// impacts among them; the work budget and the cap on one advance, every
+// solver; the energy audit as a run-time check; ROS2's order and its
+// estimate's.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
