@@ -68,11 +68,14 @@ std::string work_budget_message(const Model& m, const SolverSettings& s, double 
   const StiffRates r = stiff_rates(m);
   const SubSteps h = fixed_sub_steps(m, s.solver);
   const Params& p = m.p;
-  char head[320];
-  std::snprintf(head, sizeof head,
-                "at t = %.17g s the work budget of this call, %ld inner steps (work_budget = %g per grid step times "
-                "%ld grid steps, at most %.0f per call), ran out",
-                t, budget.limit, s.work_budget, grid_steps, kMaxInnerStepsPerCall);
+  char head[400];
+  const int n = std::snprintf(head, sizeof head,
+                              "at t = %.17g s the work budget of this call, %ld inner steps (work_budget = %g per grid "
+                              "step times %ld grid steps, at most %.0f per call), ran out",
+                              t, budget.limit, s.work_budget, grid_steps, kMaxInnerStepsPerCall);
+  if (budget.reserve > 0 && n > 0 && n < static_cast<int>(sizeof head))
+    std::snprintf(head + n, sizeof head - static_cast<size_t>(n),
+                  " (%ld used, the rest kept for the %ld grid steps still to take)", budget.used, budget.reserve);
   char buf[1024];
   if (s.solver == Solver::Rosenbrock) {
     std::snprintf(buf, sizeof buf,
@@ -91,10 +94,14 @@ std::string work_budget_message(const Model& m, const SolverSettings& s, double 
                   "%.3g s: use solver = 2 (Rosenbrock), a larger work_budget, or softer stops",
                   head, p.stop_stiffness, p.stop_damping, r.mass, r.contact, h.contact);
   } else {
+    char friction[160] = "";
+    if (std::isfinite(h.free))
+      std::snprintf(friction, sizeof friction, ", and sub-steps of at most %.3g s for the friction's bound %.4g 1/s",
+                    h.free, r.friction);
     std::snprintf(buf, sizeof buf,
-                  "%s (contact events located by bisection, or sub-steps of at most %.3g s for the friction's bound "
-                  "%.4g 1/s): a larger work_budget, a smaller rk4_step, or solver = 0 (CVODE)",
-                  head, h.free, r.friction);
+                  "%s, locating contact events by bisection%s: a larger work_budget, shorter communication steps, a "
+                  "smaller rk4_step, or solver = 0 (CVODE)",
+                  head, friction);
   }
   return buf;
 }
