@@ -140,8 +140,8 @@ TEST_P(FixedStepAllocations, AdvanceAfterInitialisation) {
 }
 
 // The drop onto the stops (F = 0 from the home pose, contact at 95 ms):
-// located switches, RK4's contact sub-steps, ROS2's graded steps and its
-// ringing from the Jacobian's eigenvalues (fixed-size EigenSolver).
+// located switches, RK4's contact sub-steps, ROS2's steps under its error
+// estimate (rejected and retried, the filter's second factorisation).
 TEST_P(FixedStepAllocations, DropOntoTheStops) {
   pkm::SolverSettings st;
   st.solver = GetParam();

@@ -7,7 +7,9 @@
 // refusal of unreachable poses; bad, overflowing, vanishing, too long and
 // past-stopTime steps, huge finite inputs, and the motion's independence of
 // the start time.
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
@@ -367,12 +369,13 @@ TEST_F(Stepping, AStepTooLongForCvodeIsDiscarded) {
   ASSERT_EQ(p.step(0.0, 1e-3), fmi2OK);
   const std::vector<double> before = p.all_reals();
   EXPECT_EQ(p.step(1e-3, 1e6), fmi2Discard);
-  EXPECT_TRUE(p.log.contains("mxstep")) << p.log.dump();
+  EXPECT_TRUE(p.log.contains("CVODE evaluated the state derivative 100000 times in this call")) << p.log.dump();
   EXPECT_TRUE(p.terminated());
   EXPECT_EQ(p.last_successful_time(), 1e-3);
   EXPECT_TRUE(bit_identical(p.all_reals(), before));
-  table_row("CVODE, fmi2DoStep(h = 1e6 s): more than CVODE's 100000 internal steps",
-            "fmi2Discard, fmi2Terminated = true (\"CVODE ... mxstep steps taken before reaching tout\")",
+  table_row("CVODE, fmi2DoStep(h = 1e6 s): more than the 100000 evaluations one call may take",
+            "fmi2Discard, fmi2Terminated = true (\"CVODE evaluated the state derivative 100000 times in this call "
+            "..., the most one call may take\")",
             "yes: every variable bit-identical at fmi2LastSuccessfulTime = the step start");
 }
 
@@ -398,25 +401,55 @@ TEST_F(Stepping, AStepPastTheStopTimeIsAnError) {
 }
 
 TEST_F(Stepping, TooManyRk4StepsAreRefusedBeforeAnyWork) {
-  // The smallest rk4_step its range allows (1e-6 s): a 20 s step needs 2e7
-  // RK4 steps, twice what one call may take (1e7, about 25 s of computing).
+  // The smallest rk4_step its range allows (1e-6 s): a 0.2 s step needs 2e5
+  // RK4 steps, twice what one call may take (1e5 inner steps, whatever the
+  // step's length: docs/solvers.md "The work budget").
   PlantFmu p("refused"), twin("twin");
   for (PlantFmu* q : {&p, &twin}) {
     slow_rk4(*q);
     drive_forces(*q, 0.0);
   }
   const std::vector<double> before = p.all_reals();
-  EXPECT_EQ(p.step(0.0, 20.0), fmi2Error);
-  EXPECT_TRUE(p.log.contains("more than the 1e+07 one call may take")) << p.log.dump();
+  EXPECT_EQ(p.step(0.0, 0.2), fmi2Error);
+  EXPECT_TRUE(p.log.contains("more than the 100000 inner steps one call may take")) << p.log.dump();
   EXPECT_TRUE(bit_identical(p.all_reals(), before));
   // Usable as it was (no Reset, no SetFMUstate): the next step is the twin's.
   ASSERT_EQ(p.step(0.0, 1e-3), fmi2OK) << p.log.dump();
   ASSERT_EQ(twin.step(0.0, 1e-3), fmi2OK);
   EXPECT_TRUE(bit_identical(p.outputs(), twin.outputs()));
-  table_row("RK4 with rk4_step = 1e-6 s (the smallest its range allows), then fmi2DoStep(h = 20 s): 2e7 RK4 steps",
-            "fmi2Error at once, \"a communication step of 20 s needs 2e+07 fixed steps of rk4_step = 1e-06 s, more "
-            "than the 1e+07 one call may take ...; the call has no effect\"",
+  table_row("RK4 with rk4_step = 1e-6 s (the smallest its range allows), then fmi2DoStep(h = 0.2 s): 2e5 RK4 steps",
+            "fmi2Error at once, \"a communication step of 0.2 s needs 2e+05 fixed steps of rk4_step = 1e-06 s, more "
+            "than the 100000 inner steps one call may take ...; the call has no effect\"",
             "yes: every variable bit-identical; the next step bit-identical to an untouched twin's");
+}
+
+TEST_F(Stepping, OneLongStepAtTheStiffestStopsEndsWithinItsCap) {
+  // Before: RK4 at stop_stiffness 1e9, stop_damping 1e6 spent 14-17 s in
+  // fmi2DoStep(0, 10 s) and 205 s in fmi2DoStep(0, 100 s) before its
+  // Discard. Now every call is capped (1e5 inner steps of RK4 or ROS2, 1e5
+  // evaluations of CVODE; tests/core/fixed_step.cpp asserts the work
+  // counted): each solver answers OK or Discard with the reason. The wall
+  // times are printed.
+  for (int solver : {0, 1, 2}) {
+    for (double span : {10.0, 100.0}) {
+      PlantFmu p;
+      ASSERT_EQ(p.set_int("solver", solver), fmi2OK);
+      ASSERT_EQ(p.set("stop_stiffness", 1e9), fmi2OK);
+      ASSERT_EQ(p.set("stop_damping", 1e6), fmi2OK);
+      ASSERT_EQ(p.set("m_slider", 1e-6), fmi2OK);
+      p.initialize();
+      for (int i = 1; i <= 4; ++i) ASSERT_EQ(p.set(force_name(i), 0.0), fmi2OK);
+      const auto t0 = std::chrono::steady_clock::now();
+      const fmi2Status st = p.step(0.0, span);
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      std::printf("solver %d, fmi2DoStep(0, %g s) at the stiffest stops: %s in %.3f s\n", solver, span,
+                  st == fmi2OK ? "fmi2OK" : st == fmi2Discard ? "fmi2Discard" : "another status", seconds);
+      ASSERT_TRUE(st == fmi2OK || st == fmi2Discard) << p.log.dump();
+      if (st == fmi2Discard) {
+        EXPECT_TRUE(p.log.contains("per call") || p.log.contains("the most one call may take")) << p.log.dump();
+      }
+    }
+  }
 }
 
 TEST_F(Stepping, HugeFiniteInputsEndTheStepWithADiscard) {

@@ -189,11 +189,11 @@ Status PlantData::check_step(Context& ctx, double h) const {
   if (!plant || !pkm::fixed_step(plant->solver().solver)) return Status::OK;
   const double step = plant->solver().rk4_step;
   const double steps = pkm::rk4_steps_for(h, step);
-  if (steps <= pkm::kMaxRk4StepsPerAdvance) return Status::OK;
+  if (steps <= pkm::kMaxInnerStepsPerCall) return Status::OK;
   ctx.log.error("DoStep: a communication step of %.6g s needs %.3g fixed steps of rk4_step = %.6g s, more than the "
-                "%.0e one call may take: use shorter communication steps or a larger rk4_step; the call has "
-                "no effect",
-                h, steps, step, pkm::kMaxRk4StepsPerAdvance);
+                "%.0f inner steps one call may take: use shorter communication steps or a larger rk4_step; the call "
+                "has no effect",
+                h, steps, step, pkm::kMaxInnerStepsPerCall);
   return Status::Error;
 }
 

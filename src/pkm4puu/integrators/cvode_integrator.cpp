@@ -8,6 +8,7 @@
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +16,18 @@
 namespace pkm {
 
 bool cvode_available() { return true; }
+
+// The floor must lie below every step that a converging run needs. The
+// mechanism's own motions take milliseconds, and 1 ps (kMinStep) is far
+// below them; but a stiff contact or stuck friction has transients of time
+// constant 1 / rate, down to 1e-16 s at the declared extremes (friction
+// velocity 1e-9 m/s on a 1 mg slider), and BDF resolves their start with
+// steps of sqrt(atol) / rate and below. A fixed 1 ps made every run with
+// atol <= 1e-12 fail at the stiffest stops' impact (the error test at
+// hmin); 1e-9 / rate lies a billion times below the fastest time constant.
+double cvode_min_step(double fastest_rate) {
+  return fastest_rate > 0.0 ? std::min(kMinStep, 1e-9 / fastest_rate) : kMinStep;
+}
 
 namespace {
 
@@ -182,6 +195,15 @@ int CvodeIntegrator::rhs_trampoline(double t, N_Vector y, N_Vector ydot, void* s
   return r;
 }
 
+int CvodeIntegrator::jac_trampoline(double t, N_Vector y, N_Vector, SUNMatrix J, void* self, N_Vector, N_Vector,
+                                    N_Vector) {
+  auto* me = static_cast<CvodeIntegrator*>(self);
+  Mat10 out;
+  const int r = me->jac_(t, as_vec(y), out, me->user_);
+  if (r == 0) Eigen::Map<Mat10>(SUNDenseMatrix_Data(J)) = out;  // both column-major
+  return r;
+}
+
 int CvodeIntegrator::root_trampoline(double t, N_Vector y, double* g, void* self) {
   auto* me = static_cast<CvodeIntegrator*>(self);
   return me->roots_(t, as_vec(y), g, me->user_);
@@ -199,12 +221,12 @@ void CvodeIntegrator::error_handler(int code, const char* module, const char* fu
   }
 }
 
-Status CvodeIntegrator::init(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user, int n_roots,
-                             RootFn roots) {
+Status CvodeIntegrator::init(CvodeMethod method, double rtol, const Vec10& atol, Rhs rhs, void* user, int n_roots,
+                             RootFn roots, JacFn jac, double min_step) {
   t_initializing = this;
   Status s = Status::SolverFailure;
   try {
-    s = create(method, rtol, atol, rhs, user, n_roots, roots);
+    s = create(method, rtol, atol, rhs, user, n_roots, roots, jac, min_step);
   } catch (...) {  // std::bad_alloc from error_
   }
   t_initializing = nullptr;
@@ -217,15 +239,16 @@ Status CvodeIntegrator::init(CvodeMethod method, double rtol, double atol, Rhs r
   return s;
 }
 
-Status CvodeIntegrator::create(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user, int n_roots,
-                               RootFn roots) {
+Status CvodeIntegrator::create(CvodeMethod method, double rtol, const Vec10& atol, Rhs rhs, void* user, int n_roots,
+                               RootFn roots, JacFn jac, double min_step) {
   release();
   error_.clear();
   steps_before_reset_ = 0;
-  if (!(rtol > 0.0) || !(atol > 0.0) || !std::isfinite(rtol) || !std::isfinite(atol) || !rhs)
+  if (!(rtol > 0.0) || !std::isfinite(rtol) || !(atol.minCoeff() > 0.0) || !atol.allFinite() || !rhs)
     return Status::InvalidArgument;
   rhs_ = rhs;
   roots_ = roots;
+  jac_ = jac;
   user_ = user;
   if (SUNContext_Create(nullptr, &ctx_) != 0) return Status::SolverFailure;
   spare_ = N_VNew_Serial(10, ctx_);
@@ -257,26 +280,24 @@ Status CvodeIntegrator::create(CvodeMethod method, double rtol, double atol, Rhs
   atol_ = N_VNew_Serial(10, ctx_);
   if (!atol_) return Status::SolverFailure;
   use_own_ops(atol_, &CvodeIntegrator::clone_or_spare);
-  for (int k = 0; k < 10; ++k) N_VGetArrayPointer(atol_)[k] = atol;
+  as_vec(atol_) = atol;
   flag |= CVodeSVtolerances(mem_, rtol, atol_);
   // Enough for a long communication interval at the natural step (~1 ms),
   // few enough that a run into a singularity fails in a fraction of a second.
   flag |= CVodeSetMaxNumSteps(mem_, 100000);
-  // No step below 1 ps: the mechanism's fastest motions take milliseconds;
-  // steps this small only occur when the trajectory runs into the edge of the
-  // workspace (a leg singularity) or the inputs are absurd. Without a floor
-  // CVODE creeps towards the edge in ever smaller steps until it has spent
-  // its 100000 (about 0.2 s per failing call, 5 s under the sanitizers);
-  // with it, such a call fails after a few hundred evaluations, at the same
-  // point. The floor is never reached by a step that succeeds otherwise, so
-  // regular results are unchanged, bit for bit.
-  flag |= CVodeSetMinStep(mem_, kMinStep);
+  // A floor on the step (cvode_min_step): without one CVODE creeps towards
+  // the edge of the workspace (a leg singularity) in ever smaller steps
+  // until it has spent its 100000 (about 0.2 s per failing call, 5 s under
+  // the sanitizers); with it, such a call fails after a few hundred
+  // evaluations, at the same point.
+  flag |= CVodeSetMinStep(mem_, min_step);
   if (roots && n_roots > 0) flag |= CVodeRootInit(mem_, n_roots, &CvodeIntegrator::root_trampoline);
   if (method == CvodeMethod::BDF) {
     A_ = SUNDenseMatrix(10, 10, ctx_);
     LS_ = SUNLinSol_Dense(y_, A_, ctx_);
     if (!A_ || !LS_) return Status::SolverFailure;
     flag |= CVodeSetLinearSolver(mem_, LS_, A_);
+    if (jac) flag |= CVodeSetJacFn(mem_, &CvodeIntegrator::jac_trampoline);
   } else {
     NLS_ = SUNNonlinSol_FixedPoint(y_, 0, ctx_);
     if (!NLS_) return Status::SolverFailure;

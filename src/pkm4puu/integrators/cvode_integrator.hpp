@@ -22,13 +22,21 @@ namespace pkm {
 
 enum class CvodeMethod { Adams = 0, BDF = 1 };
 
+/// The Jacobian of CVODE's integrated vector (column-major, as SUNDIALS' dense matrix).
+using Mat10 = Eigen::Matrix<double, 10, 10>;
+
 /// Whether this build has CVODE: true when linked with cvode_integrator.cpp
 /// (SUNDIALS), false with cvode_unavailable.cpp (the source-code FMUs,
 /// built with nothing but a C++17 compiler; solver = 1, RK4, only).
 bool cvode_available();
 
-/// CVODE's smallest step, s (see cvode_integrator.cpp).
+/// CVODE's smallest step (s) on a machine whose fastest rate is at most
+/// 1e3 1/s; a stiffer one gets a floor a billion times below its fastest
+/// time constant (cvode_min_step, cvode_integrator.cpp says why).
 constexpr double kMinStep = 1e-12;
+/// min(kMinStep, 1e-9 / fastest_rate): fastest_rate (1/s) bounds the
+/// magnitude of the Jacobian's eigenvalues (fixed_step_stability.hpp).
+double cvode_min_step(double fastest_rate);
 
 class CvodeIntegrator {
  public:
@@ -37,16 +45,21 @@ class CvodeIntegrator {
   using Rhs = int (*)(double t, const Vec10& y, Vec10& ydot, void* user);
   /// g[0..n_roots-1] at (t, y); returns 0 on success, nonzero to abort.
   using RootFn = int (*)(double t, const Vec10& y, double* g, void* user);
+  /// J = d rhs / d y at (t, y) (BDF's Newton iteration); returns 0 on
+  /// success, > 0 for a recoverable failure, < 0 to abort.
+  using JacFn = int (*)(double t, const Vec10& y, Mat10& J, void* user);
 
   CvodeIntegrator() = default;
   ~CvodeIntegrator();
   CvodeIntegrator(const CvodeIntegrator&) = delete;
   CvodeIntegrator& operator=(const CvodeIntegrator&) = delete;
 
-  /// `roots` (may be null) with `n_roots` indicators: CVODE stops where one
-  /// changes sign (CVodeRootInit).
-  Status init(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user, int n_roots = 0,
-              RootFn roots = nullptr);
+  /// `atol` per component (each positive). `roots` (may be null) with
+  /// `n_roots` indicators: CVODE stops where one changes sign
+  /// (CVodeRootInit). `jac` (may be null: difference quotients) is BDF's
+  /// Jacobian; `min_step` CVODE's smallest step.
+  Status init(CvodeMethod method, double rtol, const Vec10& atol, Rhs rhs, void* user, int n_roots = 0,
+              RootFn roots = nullptr, JacFn jac = nullptr, double min_step = kMinStep);
   /// Restart the history at (t0, y0): needed after any jump in the inputs.
   Status reset(double t0, const Vec10& y0);
   /// Integrates towards t_out (stop time set, no overshoot). Returns at
@@ -66,9 +79,12 @@ class CvodeIntegrator {
  private:
   static int rhs_trampoline(double t, _generic_N_Vector* y, _generic_N_Vector* ydot, void* self);
   static int root_trampoline(double t, _generic_N_Vector* y, double* g, void* self);
+  static int jac_trampoline(double t, _generic_N_Vector* y, _generic_N_Vector* fy, _generic_SUNMatrix* J,
+                            void* self, _generic_N_Vector* tmp1, _generic_N_Vector* tmp2, _generic_N_Vector* tmp3);
   static void error_handler(int code, const char* module, const char* function, char* msg,
                             void* self);
-  Status create(CvodeMethod method, double rtol, double atol, Rhs rhs, void* user, int n_roots, RootFn roots);
+  Status create(CvodeMethod method, double rtol, const Vec10& atol, Rhs rhs, void* user, int n_roots, RootFn roots,
+                JacFn jac, double min_step);
   static _generic_N_Vector* clone_or_spare(_generic_N_Vector* w);
   void release();
 
@@ -83,6 +99,7 @@ class CvodeIntegrator {
   bool out_of_memory_ = false;
   Rhs rhs_ = nullptr;
   RootFn roots_ = nullptr;
+  JacFn jac_ = nullptr;
   void* user_ = nullptr;
   bool needs_reset_ = true;
   long steps_before_reset_ = 0;  // steps() of the histories before the current one

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // One fixed grid step of any one-step method across the end stops'
-// switches: split where the contact mode changes (located by bisection) and
-// sub-stepped where the stiff terms need it (fixed_step_stability.hpp), every
-// inner step counted against a work budget.
+// switches: split where the contact mode changes (located by bisection),
+// sub-stepped where the stiff terms need it (fixed_step_stability.hpp) or
+// where the method's error estimate asks (ROS2), every inner step counted
+// against a work budget.
 #pragma once
 
 #include <algorithm>
@@ -27,42 +28,56 @@ inline double switch_time_tolerance(double t) {
   return 1e-12 + 8.0 * std::numeric_limits<double>::epsilon() * std::fabs(t);
 }
 
-/// Inner steps (grid steps, sub-steps, bisection trials) allowed and taken
-/// in one advance; `exhausted` tells a step refused for want of budget
-/// (then `in_contact`: whether a stop was held).
+/// Inner steps (grid steps, sub-steps, rejected steps, bisection trials)
+/// allowed and taken in one advance; `exhausted` tells a step refused for
+/// want of budget (then `in_contact`: whether a stop was held, and
+/// `estimate`: the last error estimate, in units of its tolerance, of a
+/// method that has one; 0 otherwise).
 struct WorkBudget {
   long limit = std::numeric_limits<long>::max();
   long used = 0;
+  long reserve = 0;  // kept for the grid steps after this one (one inner step each at least)
   bool exhausted = false;
   bool in_contact = false;
+  double estimate = 0;
+  double step = 0;  // the step (s) that estimate belongs to
 };
 
-/// The longest inner steps: out of contact (`free`) and while a stop is held.
-/// After a switch of the contact mode (and where `layer` is set by the
-/// caller, at the start of a run) a new fast transient starts: with
-/// `layer_free` / `layer_contact` finite the steps start that short and grow
-/// by kLayerGrowth per step (`layer`, the current one; +inf: none), so that
-/// the transient is resolved while it lasts at a logarithmic cost.
+/// The longest inner steps: out of contact (`free`) and while a stop is held
+/// (RK4's stability bounds; +inf: none).
 struct InnerSteps {
   double free = std::numeric_limits<double>::infinity();
   double contact = std::numeric_limits<double>::infinity();
-  double layer_free = std::numeric_limits<double>::infinity();
-  double layer_contact = std::numeric_limits<double>::infinity();
-  double layer = std::numeric_limits<double>::infinity();
-  // With `contact_from_system`, `contact` is the system's own at each switch
-  // into a contact mode (sys.contact_step(t, x, mode): ROS2's ringing from
-  // the Jacobian's eigenvalues there), else fixed.
-  bool contact_from_system = false;
 };
-/// The layer's growth per step: the time since the switch is then about six
-/// steps (1 + 1/1.2 + 1/1.2^2 + ...), so that a mode of rate lambda has
-/// decayed by exp(-6 h lambda) where the step is h; the cost is
-/// log(h_grid lambda / 0.1) / log(1.2) steps per switch, about 100 at the
-/// stiffest declared stops (docs/solvers.md).
-constexpr double kLayerGrowth = 1.2;
 
-/// The step from (t0, x) to t1 with `step(t, h, x)` (one step of the method,
-/// x unchanged on failure). `sys` provides
+/// The step-size control of a method with an error estimate: the step
+/// function returns the estimate in units of its tolerance (accepted where
+/// at most 1); a rejected step is retried shorter, an accepted one proposes
+/// the next. The estimate of an embedded solution of order p is O(h^(p+1)).
+/// `after_switch(mode)` is the first step to try after a switch into `mode`
+/// (a new fast transient: ROS2 starts at h |lambda| = 0.1 on the stiffness
+/// bound, fixed_step_stability.hpp) and at the start of the advance.
+struct StepControl {
+  bool on = false;  // off: the method has no estimate (RK4)
+  double exponent = 0.5;  // 1 / (p + 1)
+  double next = std::numeric_limits<double>::infinity();  // the next step to try (s)
+  double first_free = std::numeric_limits<double>::infinity();     // after a switch out of contact
+  double first_contact = std::numeric_limits<double>::infinity();  // after a switch into contact
+  long rejected = 0;
+};
+/// The controller's factors: the usual safety 0.9 on the predicted step,
+/// growth at most 5x and shrinking at least 0.1x per step (Hairer, Norsett
+/// and Wanner, Solving ODEs I, II.4).
+constexpr double kStepSafety = 0.9, kStepGrowth = 5.0, kStepShrink = 0.1;
+
+inline double step_factor(double estimate, double exponent) {
+  if (!(estimate > 0.0)) return kStepGrowth;  // also NaN: the caller rejects a NaN estimate first
+  return std::clamp(kStepSafety * std::pow(estimate, -exponent), kStepShrink, kStepGrowth);
+}
+
+/// The step from (t0, x) to t1 with `step(t, h, x, estimate)` (one step of
+/// the method, x unchanged on failure; `estimate` its error estimate in
+/// units of the tolerance, 0 without one). `sys` provides
 ///   void hold(unsigned stops)                           the stops held from now on,
 ///   unsigned mode(const Vec10& x, Vec4& rho)            the contact mode at x (end_stops.hpp's
 ///                                                       bits, the clamps' included; ~0u off the
@@ -74,44 +89,62 @@ constexpr double kLayerGrowth = 1.2;
 /// plant's contact mode from there on). Out of budget: SolverFailure with
 /// budget.exhausted, x at t.
 template <class System, class Stepper>
-Status located_fixed_step(System& sys, Stepper&& step_fn, double t0, double t1, InnerSteps& inner, Vec10& x,
-                          unsigned& mode, Vec4& rho, bool& rho_valid, long& switches, double& t, WorkBudget& budget) {
+Status located_fixed_step(System& sys, Stepper&& step_fn, double t0, double t1, const InnerSteps& inner,
+                          StepControl& control, Vec10& x, unsigned& mode, Vec4& rho, bool& rho_valid, long& switches,
+                          double& t, WorkBudget& budget) {
   t = t0;
   int located = 0;
   Status s = Status::Ok;
-  auto take = [&](double tt, double hh, Vec10& xx) {
-    if (budget.used >= budget.limit) {
+  auto take = [&](double tt, double hh, Vec10& xx, double& estimate) {
+    if (budget.used >= budget.limit - budget.reserve) {
       budget.exhausted = true;
       budget.in_contact = mode != 0;
       return Status::SolverFailure;
     }
     ++budget.used;
-    return step_fn(tt, hh, xx);
+    estimate = 0.0;
+    return step_fn(tt, hh, xx, estimate);
   };
   while (t < t1 && s == Status::Ok) {
     double step = t1 - t;
     bool to_end = true;
-    const double limit = std::min(mode != 0 ? std::min(inner.free, inner.contact) : inner.free, inner.layer);
+    const double limit = std::min(mode != 0 ? std::min(inner.free, inner.contact) : inner.free, control.next);
     if (step > limit) {
       step = limit;
       to_end = false;
     }
     sys.hold(mode & kContactModeBits);  // over the step and its re-steps
     Vec10 trial = x;
-    s = take(t, step, trial);
+    double estimate = 0.0;
+    s = take(t, step, trial, estimate);
     if (s != Status::Ok) break;
+    if (control.on) {
+      budget.estimate = estimate;
+      budget.step = step;
+      if (!(estimate <= 1.0)) {  // rejected (also NaN): again, shorter
+        ++control.rejected;
+        control.next = step * (std::isfinite(estimate) ? step_factor(estimate, control.exponent) : kStepShrink);
+        continue;
+      }
+      // Accepted: the next step from this one's estimate; a step cut short
+      // (by t1 or a bound) does not shrink a longer proposal that stands.
+      const double proposed = step * step_factor(estimate, control.exponent);
+      control.next = step < control.next ? std::max(proposed, control.next) : proposed;
+    }
     Vec4 rho_trial;
     unsigned trial_mode = sys.mode(trial, rho_trial);
     bool rho_trial_valid = trial_mode != ~0u;
     if (trial_mode == ~0u) trial_mode = mode;  // off the workspace: the caller's guard reports it
     if (trial_mode != mode && located < kMaxSwitchesPerStep) {
-      // The shortest step, re-stepped from t, after which the mode has changed.
+      // The shortest step, re-stepped from t, after which the mode has
+      // changed (shorter than the accepted step: its estimate is not asked).
       double lo = 0.0, hi = step;
       const double tol = switch_time_tolerance(t);
       while (hi - lo > tol && s == Status::Ok) {
         const double mid = 0.5 * (lo + hi);
         Vec10 xm = x;
-        s = take(t, mid, xm);
+        double ignored = 0.0;
+        s = take(t, mid, xm, ignored);
         if (s != Status::Ok) break;
         Vec4 rho_m;
         const unsigned mm = sys.mode(xm, rho_m);
@@ -131,15 +164,8 @@ Status located_fixed_step(System& sys, Stepper&& step_fn, double t0, double t1, 
       ++located;
       ++switches;
     }
-    if (trial_mode != mode) {
-      inner.layer = trial_mode != 0 ? inner.layer_contact : inner.layer_free;  // a new transient
-      if (inner.contact_from_system && (trial_mode & kStopBits) != 0) {
-        sys.hold(trial_mode & kContactModeBits);
-        inner.contact = sys.contact_step(t + step, trial);
-      }
-    } else if (step >= inner.layer) {
-      inner.layer *= kLayerGrowth;
-    }
+    if (trial_mode != mode && control.on)  // a new fast transient
+      control.next = std::min(control.next, (trial_mode & kStopBits) != 0 ? control.first_contact : control.first_free);
     x = trial;
     mode = trial_mode;
     rho = rho_trial;

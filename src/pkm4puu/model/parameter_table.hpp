@@ -130,11 +130,16 @@ std::string check_parameter(const char* name, double value, double lo, double hi
     "linearly implicit with the analytic Jacobian: stiff friction and end stops in real time)") \
   X(141, "rk4_step", Solver, rk4_step, Real, "s", kMinRk4Step, kMaxRk4Step, kPositive, Fixed, Plant, \
     "Fixed step of RK4 and Rosenbrock: a communication step is split into whole steps no longer than this") \
-  X(142, "rtol", Solver, rtol, Real, "", kMinRtol, kMaxRtol, kInRange, Fixed, Plant, "CVODE relative tolerance") \
-  X(143, "atol", Solver, atol, Real, "", kMinAtol, kMaxAtol, kPositive, Fixed, Plant, \
-    "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J)") \
+  X(142, "rtol", Solver, rtol, Real, "", kMinRtol, kMaxRtol, kInRange, Fixed, Plant, \
+    "CVODE relative tolerance (at most 1e-2: looser, impacts on undamped stiff stops run away)") \
+  X(143, "atol", Solver, atol, Real, "", kMinAtol, kMaxAtol, kInRange, Fixed, Plant, \
+    "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J; on the " \
+    "velocities at most friction_velocity / 10 where Coulomb friction acts): at least 1e-14, below which the " \
+    "stiffest stops' impact needs more work than one step may take, at most 1e-2, above which impacts on " \
+    "undamped stiff stops run away") \
   X(144, "cvode_method", Solver, cvode_method, Integer, "", 0, 1, says("must be 0 (Adams) or 1 (BDF)"), Fixed, Plant, \
-    "CVODE method: 0 = Adams-Moulton (non-stiff), 1 = BDF") \
+    "CVODE method: 0 = Adams-Moulton (non-stiff; BDF on a machine whose friction or stop damping against the " \
+    "slider's mass exceeds 1e5 1/s), 1 = BDF") \
   X(145, "formulation", Solver, formulation, Integer, "", 0, 2, \
     says("must be 0 (Eq. 12), 1 (Eq. 13, QR) or 2 (Eq. 13, leg-partitioned)"), Fixed, Plant, \
     "Forward dynamics: 0 = augmented saddle-point system (Eq. 12), 1 = null-space projection with a QR " \
@@ -178,9 +183,9 @@ std::string check_parameter(const char* name, double value, double lo, double hi
   X(160, "payload_Izz", Model, payload_Izz, Real, "kg.m2", 0.0, kMaxInertia, kNonNegative, Fixed, Both, \
     "Payload inertia about the vertical axis through its own centre of mass") \
   X(161, "work_budget", Solver, work_budget, Real, "", kMinWorkBudget, kMaxWorkBudget, kInRange, Fixed, Plant, \
-    "Fixed-step solvers: inner steps (grid steps, stiff sub-steps, bisection trials locating end-stop " \
-    "events) allowed per grid step, summed over a communication step; a step that needs more returns " \
-    "Discard with the reason") \
+    "Fixed-step solvers: inner steps (grid steps, stiff sub-steps, rejected steps, bisection trials locating " \
+    "end-stop events) allowed per grid step, summed over a communication step and at most 1e5 per step " \
+    "whatever its length; a step that needs more returns Discard with the reason") \
   X(162, "energy_tolerance", Solver, energy_tolerance, Real, "J", 0.0, kMaxEnergyTolerance, kNonNegative, Fixed, \
     Plant, "Energy audit as a run-time check: a communication step whose audit residual (change of " \
     "kinetic + potential - actuator_work + dissipated_energy) exceeds this returns Discard with the " \

@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: BSD-2-Clause
 #include "pkm4puu/sim/fixed_step_stability.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+
+#include "pkm4puu/kinematics/constraints.hpp"
 
 namespace pkm {
 
@@ -13,23 +16,32 @@ StiffRates stiff_rates(const Model& m) {
   r.mass = p.m_slider + m.reflected_mass;
   const double c = p.friction_viscous + (p.friction_coulomb != 0.0 ? p.friction_coulomb / p.friction_velocity : 0.0);
   r.friction = c / r.mass;
-  r.contact = std::sqrt(p.stop_stiffness / r.mass) + (p.stop_damping + c) / r.mass;
-  // omega^2 = k x - d^2 x^2 / 4 with x = 1 / m' over the masses m' >= m: its
-  // maximum at x = 2 k / d^2 (k / d) if that mass is heavier than m.
-  const double k = p.stop_stiffness, d = p.stop_damping, x = 1.0 / r.mass;
-  const double w2 = (d > 0.0 && 2.0 * k / (d * d) <= x) ? (k / d) * (k / d) : k * x - 0.25 * d * d * x * x;
-  r.ringing = w2 > 0.0 ? std::sqrt(w2) : 0.0;
+  r.damping = (p.stop_damping + c) / r.mass;
+  r.contact = std::sqrt(p.stop_stiffness / r.mass) + r.damping;
   return r;
+}
+
+Vec10 cvode_atol(const Model& m, const SolverSettings& s) {
+  Vec10 atol = Vec10::Constant(s.atol);
+  if (m.p.friction_coulomb > 0.0) {
+    const double v = 0.1 * m.p.friction_velocity;
+    atol.segment<3>(4) = atol.segment<3>(4).cwiseMin(v);
+    atol[7] = std::min(atol[7], v / kConditionLength);
+  }
+  return atol;
+}
+
+CvodeMethod cvode_method_for(const Model& m, const SolverSettings& s) {
+  if (s.cvode_method == CvodeMethod::Adams && stiff_rates(m).damping > kAdamsMaxDampingRate) return CvodeMethod::BDF;
+  return s.cvode_method;
 }
 
 SubSteps fixed_sub_steps(const Model& m, Solver solver) {
   const StiffRates r = stiff_rates(m);
   constexpr double inf = std::numeric_limits<double>::infinity();
-  auto step = [inf](double fraction, double rate) { return rate > 0.0 ? fraction / rate : inf; };
-  if (solver == Solver::Rosenbrock)
-    return {inf, step(kRosenbrockRingFraction, r.ringing), step(kRk4StiffFraction, r.friction),
-            step(kRk4StiffFraction, r.contact)};
-  return {step(kRk4StiffFraction, r.friction), step(kRk4StiffFraction, r.contact), inf, inf};
+  auto step = [inf](double rate) { return rate > 0.0 ? kRk4StiffFraction / rate : inf; };
+  if (solver == Solver::Rosenbrock) return {inf, inf, step(r.friction), step(r.contact)};
+  return {step(r.friction), step(r.contact), inf, inf};
 }
 
 std::string fixed_step_refusal(const Model& m, const SolverSettings& s) {
@@ -51,27 +63,45 @@ std::string fixed_step_refusal(const Model& m, const SolverSettings& s) {
   return buf;
 }
 
-std::string work_budget_message(const Model& m, const SolverSettings& s, double t, long budget, bool contact) {
+std::string work_budget_message(const Model& m, const SolverSettings& s, double t, const WorkBudget& budget,
+                                long grid_steps) {
   const StiffRates r = stiff_rates(m);
   const SubSteps h = fixed_sub_steps(m, s.solver);
   const Params& p = m.p;
-  char buf[720];
-  if (contact) {
-    const bool rk4 = s.solver == Solver::Rk4;
+  char head[400];
+  const int n = std::snprintf(head, sizeof head,
+                              "at t = %.17g s the work budget of this call, %ld inner steps (work_budget = %g per grid "
+                              "step times %ld grid steps, at most %.0f per call), ran out",
+                              t, budget.limit, s.work_budget, grid_steps, kMaxInnerStepsPerCall);
+  if (budget.reserve > 0 && n > 0 && n < static_cast<int>(sizeof head))
+    std::snprintf(head + n, sizeof head - static_cast<size_t>(n),
+                  " (%ld used, the rest kept for the %ld grid steps still to take)", budget.used, budget.reserve);
+  char buf[1024];
+  if (s.solver == Solver::Rosenbrock) {
     std::snprintf(buf, sizeof buf,
-                  "at t = %.17g s the work budget of %ld inner steps (work_budget = %g per grid step) ran out in an "
-                  "end-stop contact: stop_stiffness = %g N/m and stop_damping = %g N.s/m against m_slider + reflected "
-                  "mass = %g kg bound the contact's rate at %.4g 1/s, which needs %s sub-steps of at most %.3g s: "
-                  "%s, a larger work_budget, or softer stops",
-                  t, budget, s.work_budget, p.stop_stiffness, p.stop_damping, r.mass,
-                  rk4 ? r.contact : r.ringing, rk4 ? "RK4" : "Rosenbrock", h.contact,
-                  rk4 ? "use solver = 2 (Rosenbrock)" : "use solver = 0 (CVODE)");
+                  "%s%s: the last Rosenbrock step tried, %.3g s, had an error estimate %.3g times its tolerance "
+                  "(%g of the speed plus %g m/s per grid step, at least %g m/s; %s, stop_stiffness = %g N/m, "
+                  "stop_damping = %g N.s/m, friction_coulomb = %g N, friction_velocity = %g m/s): use solver = 0 "
+                  "(CVODE), a larger work_budget or shorter communication steps",
+                  head, budget.in_contact ? " in an end-stop contact" : "", budget.step, budget.estimate,
+                  kRosenbrockTolerance, kRosenbrockSpeedFloor, kRosenbrockStepFloor,
+                  budget.in_contact ? "held stops" : "no stop held",
+                  p.stop_stiffness, p.stop_damping, p.friction_coulomb, p.friction_velocity);
+  } else if (budget.in_contact) {
+    std::snprintf(buf, sizeof buf,
+                  "%s in an end-stop contact: stop_stiffness = %g N/m and stop_damping = %g N.s/m against m_slider + "
+                  "reflected mass = %g kg bound the contact's rate at %.4g 1/s, which needs RK4 sub-steps of at most "
+                  "%.3g s: use solver = 2 (Rosenbrock), a larger work_budget, or softer stops",
+                  head, p.stop_stiffness, p.stop_damping, r.mass, r.contact, h.contact);
   } else {
+    char friction[160] = "";
+    if (std::isfinite(h.free))
+      std::snprintf(friction, sizeof friction, ", and sub-steps of at most %.3g s for the friction's bound %.4g 1/s",
+                    h.free, r.friction);
     std::snprintf(buf, sizeof buf,
-                  "at t = %.17g s the work budget of %ld inner steps (work_budget = %g per grid step) ran out "
-                  "(contact events located by bisection, or sub-steps of at most %.3g s for the friction's bound "
-                  "%.4g 1/s): a larger work_budget, a smaller rk4_step, or solver = 0 (CVODE)",
-                  t, budget, s.work_budget, h.free, r.friction);
+                  "%s, locating contact events by bisection%s: a larger work_budget, shorter communication steps, a "
+                  "smaller rk4_step, or solver = 0 (CVODE)",
+                  head, friction);
   }
   return buf;
 }

@@ -194,6 +194,12 @@ class Plant {
   friend struct PlantOde;  // the integrators' view (plant.cpp)
   static int cvode_rhs(double t, const Vec10& x, Vec10& xdot, void* self);
   static int cvode_roots(double t, const Vec10& x, double* g, void* self);
+  /// BDF's Jacobian: the analytic one of the pose and velocity rates
+  /// (state_derivative_jacobians), as ROS2's.
+  static int cvode_jacobian(double t, const Vec10& x, Mat10& J, void* self);
+  /// Whether this CVODE advance has used up kMaxCvodeEvaluationsPerCall
+  /// (then the callbacks abort it).
+  bool cvode_capped();
   /// d/dt of x = [y; actuator_work; dissipated] for the integrators
   /// (counts the evaluation; the inputs of the current advance, the stops held).
   Status derivative(double t, const Vec10& x, Vec10& xdot);
@@ -258,6 +264,10 @@ class Plant {
   mutable bool theta1_stale_ = false;
   long rhs_count_ = 0;
   Status rhs_status_ = Status::Ok;
+  // Within one CVODE advance: rhs_count_ at its start, and whether it hit
+  // kMaxCvodeEvaluationsPerCall.
+  long cvode_call_start_ = 0;
+  bool cvode_work_capped_ = false;
   std::string error_;
 };
 

@@ -8,8 +8,6 @@
 #include <cstdio>
 #include <limits>
 
-#include <Eigen/Eigenvalues>
-
 #include "pkm4puu/integrators/located_cvode.hpp"
 #include "pkm4puu/integrators/located_rk4.hpp"
 #include "pkm4puu/integrators/located_rosenbrock.hpp"
@@ -22,10 +20,15 @@
 namespace pkm {
 
 /// What the fixed-step solvers integrate: the plant's derivative under the
-/// held stops, its Jacobian (ROS2), and its contact mode.
+/// held stops, its Jacobian and ROS2's error measure (ROS2), and its contact
+/// mode.
 struct PlantOde {
   Plant& plant;
-  double contact_fallback = 0;  // contact_step where the Jacobian cannot be evaluated
+  // ROS2's speed scale (m/s): the largest speed at the advance's start and
+  // its accepted steps (kRosenbrockTolerance, fixed_step_stability.hpp),
+  // and the grid step (s) its floor is per.
+  double speed = 0;
+  double grid_step = 0;
   Status rates(double t, const Vec10& x, Vec10& xdot) { return plant.derivative(t, x, xdot); }
   /// The rates at (t, x) with the analytic Jacobian of the pose and velocity
   /// rates (the leg-partitioned terms, the machine included; one evaluation
@@ -56,33 +59,34 @@ struct PlantOde {
     f_t = B * (du / h);
     return (xdot.allFinite() && A.allFinite() && f_t.allFinite()) ? Status::Ok : Status::SolverFailure;
   }
-  void hold(unsigned stops) { plant.stops_ = stops; }
-  /// ROS2's step in the contact just switched on at (t, x) under the held
-  /// stops: h omega <= kRosenbrockRingFraction with omega the largest
-  /// imaginary part of the Jacobian's eigenvalues there (the stop's ringing
-  /// against the mechanism's actual mass); +inf if nothing rings.
-  double contact_step(double t, const Vec10& x) {
-    Vec4 F, tau;
-    Wrench we;
-    read_inputs(plant.inputs_, t, F, we, tau);
-    Vec8 ydot;
-    Mat8 A;
-    Mat8x12 B;
-    if (state_derivative_jacobians(plant.model_, x.head<8>(), F, tau, we, plant.stops_, ydot, A, B) != Status::Ok ||
-        !A.allFinite())
-      return contact_fallback;
-    const Eigen::EigenSolver<Mat8> eig(A, false);
-    if (eig.info() != Eigen::Success) return contact_fallback;
-    const double omega = eig.eigenvalues().imag().cwiseAbs().maxCoeff();
-    return omega > 0.0 ? kRosenbrockRingFraction / omega : std::numeric_limits<double>::infinity();
+  /// |dx|, |dy|, |dz|, 0.1 m |dphi| at their largest (m/s).
+  static double speed_of(const Vec10& x) {
+    return std::max(x.segment<3>(4).cwiseAbs().maxCoeff(), kConditionLength * std::fabs(x[7]));
   }
+  /// ROS2's error estimate of a step of h in units of its tolerance: each
+  /// velocity's (dphi times 0.1 m) against kRosenbrockTolerance times the
+  /// speed scale plus the floor (kRosenbrockSpeedFloor per grid step, at
+  /// least kRosenbrockStepFloor); an accepted step's speed joins the scale.
+  double error_norm(const Vec10& error, const Vec10& y0, const Vec10& y1, double h) {
+    const double v = std::max(speed, std::max(speed_of(y0), speed_of(y1)));
+    Vec10 e = error;
+    e[7] *= kConditionLength;
+    const double floor = std::max(kRosenbrockStepFloor, kRosenbrockSpeedFloor * std::min(1.0, h / grid_step));
+    const double norm = e.segment<4>(4).cwiseAbs().maxCoeff() / (kRosenbrockTolerance * v + floor);
+    if (norm <= 1.0) speed = v;
+    return norm;
+  }
+  void hold(unsigned stops) { plant.stops_ = stops; }
   unsigned mode(const Vec10& x, Vec4& rho) const { return plant.contact_mode(x, rho); }
 };
 
 Status Plant::prepare_cvode() {
   if (settings_.solver != Solver::Cvode || cvode_ready_) return Status::Ok;
-  const Status s = cvode_.init(settings_.cvode_method, settings_.rtol, settings_.atol, &Plant::cvode_rhs, this,
-                               kContactIndicators, &Plant::cvode_roots);
+  // The method, the tolerances and the smallest step for this machine
+  // (fixed_step_stability.hpp), BDF with the analytic Jacobian.
+  const Status s = cvode_.init(cvode_method_for(model_, settings_), settings_.rtol, cvode_atol(model_, settings_),
+                               &Plant::cvode_rhs, this, kContactIndicators, &Plant::cvode_roots,
+                               &Plant::cvode_jacobian, cvode_min_step(stiff_rates(model_).contact));
   if (s != Status::Ok) {
     error_ = "CVODE could not be set up: " + cvode_.last_error();
     return s == Status::InvalidArgument ? s : Status::SolverFailure;
@@ -125,6 +129,7 @@ int Plant::cvode_roots(double t, const Vec10& x, double* g, void* self) {
 
 int Plant::cvode_rhs(double t, const Vec10& y, Vec10& ydot, void* self) {
   auto* me = static_cast<Plant*>(self);
+  if (me->cvode_capped()) return -1;
   const Status s = me->derivative(t, y, ydot);
   me->rhs_status_ = s;
   // A trial state off the workspace (or not finite) may be CVODE's
@@ -134,15 +139,42 @@ int Plant::cvode_rhs(double t, const Vec10& y, Vec10& ydot, void* self) {
   return (s == Status::Unreachable || s == Status::Singular || s == Status::SolverFailure) ? 1 : -1;
 }
 
+int Plant::cvode_jacobian(double t, const Vec10& x, Mat10& J, void* self) {
+  auto* me = static_cast<Plant*>(self);
+  if (me->cvode_capped()) return -1;
+  ++me->rhs_count_;
+  Vec4 F, tau;
+  Wrench we;
+  read_inputs(me->inputs_, t, F, we, tau);
+  Vec8 ydot;
+  Mat8 A;
+  Mat8x12 B;
+  if (!std::isfinite(t) ||
+      state_derivative_jacobians(me->model_, x.head<8>(), F, tau, we, me->stops_, ydot, A, B) != Status::Ok ||
+      !A.allFinite())
+    return 1;  // a trial state off the workspace: CVODE retries with a smaller step
+  // The energy integrals do not act back on the motion: their rows left 0,
+  // the Newton iteration converges on them with the motion.
+  J.setZero();
+  J.topLeftCorner<8, 8>() = A;
+  return 0;
+}
+
+bool Plant::cvode_capped() {
+  if (rhs_count_ - cvode_call_start_ < static_cast<long>(kMaxCvodeEvaluationsPerCall)) return false;
+  cvode_work_capped_ = true;
+  return true;
+}
+
 Status Plant::advance_fixed(double t_end) {
   const double span = t_end - t_;
   const double steps = rk4_steps_for(span, settings_.rk4_step);
-  if (!(steps <= kMaxRk4StepsPerAdvance)) {  // also NaN
-    char buf[200];
+  if (!(steps <= kMaxInnerStepsPerCall)) {  // also NaN
+    char buf[240];
     std::snprintf(buf, sizeof buf,
-                  "an interval of %.6g s needs %.3g fixed steps of rk4_step = %.6g s, more than %.0e: "
-                  "use shorter intervals or a larger rk4_step",
-                  span, steps, settings_.rk4_step, kMaxRk4StepsPerAdvance);
+                  "an interval of %.6g s needs %.3g fixed steps of rk4_step = %.6g s, more than the %.0f inner steps "
+                  "one call may take: use shorter intervals or a larger rk4_step",
+                  span, steps, settings_.rk4_step, kMaxInnerStepsPerCall);
     error_ = buf;
     return Status::InvalidArgument;
   }
@@ -151,20 +183,21 @@ Status Plant::advance_fixed(double t_end) {
   const double t0 = t_;
   const bool rosenbrock = settings_.solver == Solver::Rosenbrock;
   const SubSteps sub = fixed_sub_steps(model_, settings_.solver);
-  InnerSteps inner{sub.free, sub.contact, sub.layer_free, sub.layer_contact};
-  PlantOde ode{*this, sub.contact};
-  if (rosenbrock) {  // the ringing from the Jacobian at each switch into contact
-    inner.contact_from_system = true;
-    inner.contact = memory_.contact_step >= 0.0 ? memory_.contact_step
-                    : (stops_ & kStopBits) != 0u ? ode.contact_step(t_, packed(false))
-                                                 : std::numeric_limits<double>::infinity();
-  }
-  // The transient started at initialisation or carried over from the last advance.
-  inner.layer = memory_.layer_pending ? (stops_ != 0 ? sub.layer_contact : sub.layer_free) : memory_.layer;
-  memory_.layer_pending = 0;
-  // One budget for the whole advance: work_budget inner steps per grid step.
+  const InnerSteps inner{sub.free, sub.contact};
+  PlantOde ode{*this};
+  // ROS2's error control, within this advance: its first step is the grid
+  // step (the estimate shortens it where the motion needs it), and after a
+  // switch of the contact mode the stiffness bound's h |lambda| = 0.1.
+  StepControl control;
+  control.on = rosenbrock;
+  control.first_free = sub.first_free;
+  control.first_contact = sub.first_contact;
+  ode.speed = PlantOde::speed_of(packed(false));
+  ode.grid_step = h;
+  // One budget for the whole advance: work_budget inner steps per grid
+  // step, at most kMaxInnerStepsPerCall.
   WorkBudget budget;
-  budget.limit = static_cast<long>(std::min(settings_.work_budget * static_cast<double>(n), 1e18));
+  budget.limit = static_cast<long>(std::min(settings_.work_budget * static_cast<double>(n), kMaxInnerStepsPerCall));
   // ROS2's stage rates do not resolve the power dissipated in a transient it
   // steps over (a stiff stop's damper), so its dissipated energy is the
   // audit's balance: brought up to date when read (settle_energy), or at
@@ -185,20 +218,22 @@ Status Plant::advance_fixed(double t_end) {
     const double tk = (k == 0) ? t0 : t0 + static_cast<double>(k) * h;
     const double t_next = (k + 1 == n) ? t_end : t0 + static_cast<double>(k + 1) * h;
     const unsigned stops_start = stops_;  // kept with the state if the step is undone
+    // Stop as soon as the budget cannot suffice: every grid step after this
+    // one takes one inner step at least.
+    budget.reserve = n - k - 1;
     Vec10 x = packed(!rosenbrock);
     // rho at x: the previous grid step's end computed it (actuator_positions).
     Vec4 rho;
     unsigned mode = actuator_positions(rho) == Status::Ok ? contact_mode_at(x, rho) : ~0u;
     bool rho_valid = mode != ~0u;
     double t = tk;
-    Status s = rosenbrock
-                   ? located_rosenbrock_step(ode, tk, t_next, inner, x, mode, rho, rho_valid, contact_events_, t, budget)
+    Status s =
+        rosenbrock ? located_rosenbrock_step(ode, tk, t_next, inner, control, x, mode, rho, rho_valid, contact_events_,
+                                             t, budget, kRosenbrockFilterFraction * h)
                    : located_rk4_step(ode, tk, t_next, inner, x, mode, rho, rho_valid, contact_events_, t, budget);
-    memory_.layer = inner.layer;
-    if (rosenbrock) memory_.contact_step = inner.contact;
     if (s != Status::Ok) {
       if (budget.exhausted) {
-        error_ = work_budget_message(model_, settings_, t, budget.limit, budget.in_contact);
+        error_ = work_budget_message(model_, settings_, t, budget, n);
       } else {
         char buf[160];
         std::snprintf(buf, sizeof buf, "the %s step from t = %.17g s could not be evaluated: %s",
@@ -240,14 +275,25 @@ Status Plant::advance_cvode(double t_end, bool continuous) {
   }
   Vec10 x = packed();
   rhs_status_ = Status::Ok;
+  cvode_call_start_ = rhs_count_;
+  cvode_work_capped_ = false;
   // The stops held between roots: the contact mode, switched at each root.
   const unsigned stops_start = stops_;
   bool chattering = false;
   Status s = located_cvode_advance(cvode_, t_end, x, stops_, contact_events_, error_, chattering);
   if (s != Status::Ok) {
+    if (cvode_work_capped_) {
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "CVODE evaluated the state derivative %.0f times in this call from t = %.17g s to %.17g s, the "
+                    "most one call may take, before reaching its end: shorter communication steps, looser rtol or "
+                    "atol, cvode_method = 1 (BDF) or solver = 2 (Rosenbrock)",
+                    kMaxCvodeEvaluationsPerCall, t_, t_end);
+      error_ = buf;
+    }
     stops_ = stops_start;
     cvode_.reset(t_, packed());
-    return (rhs_status_ != Status::Ok && !chattering) ? rhs_status_ : s;
+    return (rhs_status_ != Status::Ok && !chattering && !cvode_work_capped_) ? rhs_status_ : s;
   }
   s = guard(x.head<8>(), t_end);  // the interval ends within the limits, or is undone
   if (s != Status::Ok) {

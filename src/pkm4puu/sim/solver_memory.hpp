@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // What the fixed-step integrators carry from one Plant::advance to the next
 // besides the state (time, pose and velocity, energy integrals, contact
-// mode): a run continues bit for bit from a snapshot only with it.
+// mode): a run continues bit for bit from a snapshot only with it. ROS2's
+// step control lives within one advance and keeps nothing here.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <string>
 #include <type_traits>
 
@@ -19,14 +19,6 @@ namespace pkm {
 /// std::int64_t for flags and counts): no padding, and the same bytes on
 /// every platform the FMUs are built for (all little-endian).
 struct SolverMemory {
-  // RK4's and ROS2's initial layer (located_step.hpp's InnerSteps::layer):
-  // pending (1) after Plant::initialize(), then the one of the contact mode
-  // there; else (0) the current one, carried from the last advance (+inf: none).
-  std::int64_t layer_pending = 1;
-  double layer = std::numeric_limits<double>::infinity();
-  // ROS2's step in the current contact (PlantOde::contact_step); < 0: not
-  // known yet (computed at the next advance).
-  double contact_step = -1.0;
   // ROS2's dissipated energy is the energy audit's balance, brought up to
   // date when read (Plant::settle_energy): pending (1) or not (0), and the
   // energies (J) where it was last exact.
@@ -37,19 +29,12 @@ static_assert(std::is_trivially_copyable<SolverMemory>::value, "SolverMemory tra
 static_assert(sizeof(SolverMemory) % 8 == 0 && alignof(SolverMemory) == 8, "SolverMemory: 8-byte members only");
 
 /// The memory of a run restored from outside (Plant::restore from a time
-/// and a state alone): no transient pending, nothing known of the contact.
-constexpr SolverMemory restarted_solver_memory() {
-  SolverMemory m;
-  m.layer_pending = 0;
-  return m;
-}
+/// and a state alone): its energy balance exact.
+constexpr SolverMemory restarted_solver_memory() { return SolverMemory{}; }
 
 /// "" if `m` is a memory some run can have, else why not (a restored
 /// snapshot is checked with it: a forged one is refused).
 inline std::string solver_memory_fault(const SolverMemory& m) {
-  if (m.layer_pending != 0 && m.layer_pending != 1) return "the layer flag is neither 0 nor 1";
-  if (!(m.layer > 0.0)) return "the layer step is not positive";
-  if (!(m.contact_step > 0.0) && m.contact_step != -1.0) return "the contact step is neither positive nor -1 (unknown)";
   if (m.balance_pending != 0 && m.balance_pending != 1) return "the energy balance flag is neither 0 nor 1";
   if (!std::isfinite(m.balance_mech) || !std::isfinite(m.balance_work) || !std::isfinite(m.balance_dissipated))
     return "an energy of the balance is not finite";
