@@ -164,9 +164,16 @@ pkm_status pkm_set_state(pkm_model* m, const pkm_state* state) {
   if (!m) return PKM_ERR_INVALID_ARGUMENT;
   const pkm_status a = struct_argument(m, fn, "state", "pkm_state", state, kStateSize);
   if (a != PKM_OK) return a;
-  const pkm::Vec8 y = Eigen::Map<const pkm::Vec8>(state->y);
-  const pkm::EnergyIntegrals e{state->actuator_work, state->dissipated_energy};
-  const pkm::Status s = m->plant->restore(state->t, y, vec4(state->theta1_ref), e, state->stops);
+  // pkm_get_state settled the energy balance (energy_integrals()), so the
+  // integrators' memory is a restarted one's: the run continues bit for bit.
+  pkm::PlantSnapshot snap;
+  snap.t = state->t;
+  snap.y = Eigen::Map<const pkm::Vec8>(state->y);
+  snap.theta1_ref = vec4(state->theta1_ref);
+  snap.energy = {state->actuator_work, state->dissipated_energy};
+  snap.stops = state->stops;
+  snap.memory = pkm::restarted_solver_memory();
+  const pkm::Status s = m->plant->restore(snap);
   if (s != pkm::Status::Ok) return fail(m, s, fn);
   m->run_ended.clear();
   return PKM_OK;
