@@ -25,6 +25,7 @@ configure_package_config_file("${CMAKE_CURRENT_LIST_DIR}/pkm4puuConfig.cmake.in"
 write_basic_package_version_file("${PROJECT_BINARY_DIR}/cmake/pkm4puuConfigVersion.cmake"
                                  COMPATIBILITY SameMinorVersion)
 install(FILES "${PROJECT_BINARY_DIR}/cmake/pkm4puuConfig.cmake" "${PROJECT_BINARY_DIR}/cmake/pkm4puuConfigVersion.cmake"
+              "${CMAKE_CURRENT_LIST_DIR}/pkm4puuSundials.cmake"
         DESTINATION "${PKM_INSTALL_CMAKEDIR}" COMPONENT Development)
 # pkg-config: relative to the .pc file's own place, so the prefix can move.
 # Libs.private (`pkg-config --static`): what the static library's users link
