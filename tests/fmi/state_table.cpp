@@ -8,8 +8,6 @@
 // (Co-Simulation) literally. Then the departures of issue 27 items 4 and 5,
 // one test each, citing the clause: FMI 3.0's Discard, Model Exchange time
 // rules and stopTime (what is computed past it), FMI 3.0 logging.
-#include <dlfcn.h>
-
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -18,9 +16,8 @@
 
 #include <gtest/gtest.h>
 
+#include "any_fmu.hpp"
 #include "fmi/state_machine.hpp"
-#include "fmi3FunctionTypes.h"
-#include "fmu_fixture.hpp"
 
 namespace {
 
@@ -28,152 +25,8 @@ using namespace pkm_test;
 using pkm_fmi::Call;
 using pkm_fmi::CallRule;
 
-/// The FMI 3.0 functions of a library (dlsym).
-struct Fmi3 {
-#define PKM_DECLARE3(name) name##TYPE* name = nullptr;
-  PKM_FMI3_FUNCTIONS(PKM_DECLARE3)
-#undef PKM_DECLARE3
-  explicit Fmi3(FmuLibrary& lib) {
-#define PKM_LOAD3(name) name = reinterpret_cast<name##TYPE*>(dlsym(lib.handle, #name));
-    PKM_FMI3_FUNCTIONS(PKM_LOAD3)
-#undef PKM_LOAD3
-  }
-};
-
-Fmi3& fmi3() {
-  static Fmi3 f(plant_library());
-  return f;
-}
-
-void collect3(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message) {
-  static_cast<Log*>(env)->messages.push_back(
-      {static_cast<fmi2Status>(status), category ? category : "", message ? message : ""});
-}
-
 const pkm_fmi::ModelDefinition& plant() { return pkm_fmi::pkm4puu_definition(); }
 std::uint32_t vr(const char* name) { return vr_of(plant(), name); }
-
-/// One instance of the plant through either FMI version.
-struct Any {
-  int version;
-  bool me;
-  void* c = nullptr;
-  Log log;
-  fmi2CallbackFunctions functions{&collect_log, &std::calloc, &std::free, nullptr, &log};
-  FmuLibrary& lib = plant_library();
-
-  Any(int v, bool model_exchange, bool logging_on = true) : version(v), me(model_exchange) {
-    const std::string token = pkm_fmi::pkm4puu_definition().guid();  // alive through the calls below
-    const char* guid = token.c_str();
-    if (v == 2) {
-      c = lib.fmi2Instantiate("table", me ? fmi2ModelExchange : fmi2CoSimulation, guid, "", &functions, fmi2False,
-                              logging_on ? fmi2True : fmi2False);
-    } else if (me) {
-      c = fmi3().fmi3InstantiateModelExchange("table", guid, nullptr, fmi3False, logging_on, &log, &collect3);
-    } else {
-      c = fmi3().fmi3InstantiateCoSimulation("table", guid, nullptr, fmi3False, logging_on, fmi3False, fmi3False,
-                                             nullptr, 0, &log, &collect3, nullptr);
-    }
-  }
-  ~Any() {
-    if (!c) return;
-    if (version == 2) {
-      lib.fmi2FreeInstance(c);
-    } else {
-      fmi3().fmi3FreeInstance(c);
-    }
-  }
-  Any(const Any&) = delete;
-  Any& operator=(const Any&) = delete;
-
-  int enter(double start = 0.0, double stop = NAN) {
-    const bool stop_defined = std::isfinite(stop);
-    if (version == 2) {
-      const int s = lib.fmi2SetupExperiment(c, fmi2False, 0.0, start, stop_defined, stop_defined ? stop : 0.0);
-      return s != fmi2OK ? s : lib.fmi2EnterInitializationMode(c);
-    }
-    return fmi3().fmi3EnterInitializationMode(c, fmi3False, 0.0, start, stop_defined, stop_defined ? stop : 0.0);
-  }
-  int exit() { return version == 2 ? +lib.fmi2ExitInitializationMode(c) : +fmi3().fmi3ExitInitializationMode(c); }
-  int continuous() {
-    return version == 2 ? +lib.fmi2EnterContinuousTimeMode(c) : +fmi3().fmi3EnterContinuousTimeMode(c);
-  }
-  int event() { return version == 2 ? +lib.fmi2EnterEventMode(c) : +fmi3().fmi3EnterEventMode(c); }
-  int terminate() { return version == 2 ? +lib.fmi2Terminate(c) : +fmi3().fmi3Terminate(c); }
-  int set_time(double t) { return version == 2 ? +lib.fmi2SetTime(c, t) : +fmi3().fmi3SetTime(c, t); }
-  int completed() {
-    if (version == 2) {
-      fmi2Boolean a = fmi2False, b = fmi2False;
-      return lib.fmi2CompletedIntegratorStep(c, fmi2True, &a, &b);
-    }
-    fmi3Boolean a = fmi3False, b = fmi3False;
-    return fmi3().fmi3CompletedIntegratorStep(c, fmi3True, &a, &b);
-  }
-  int step(double t, double h) {
-    if (version == 2) return lib.fmi2DoStep(c, t, h, fmi2True);
-    fmi3Boolean event = fmi3False, terminate = fmi3False, early = fmi3False;
-    double last = NAN;
-    return fmi3().fmi3DoStep(c, t, h, fmi3True, &event, &terminate, &early, &last);
-  }
-  int set(const char* name, double x) {
-    const std::uint32_t r = vr(name);
-    return version == 2 ? +lib.fmi2SetReal(c, &r, 1, &x) : +fmi3().fmi3SetFloat64(c, &r, 1, &x, 1);
-  }
-  int get(const char* name, double& x) {
-    const std::uint32_t r = vr(name);
-    return version == 2 ? +lib.fmi2GetReal(c, &r, 1, &x) : +fmi3().fmi3GetFloat64(c, &r, 1, &x, 1);
-  }
-  std::vector<double> reals(int* status = nullptr) {
-    std::vector<std::uint32_t> vrs;
-    for (std::size_t k = 0; k < plant().n_variables; ++k)
-      if (plant().variables[k].type == pkm_fmi::VarType::Real) vrs.push_back(plant().variables[k].vr);
-    std::vector<double> v(vrs.size(), NAN);
-    const int s = version == 2 ? +lib.fmi2GetReal(c, vrs.data(), vrs.size(), v.data())
-                               : +fmi3().fmi3GetFloat64(c, vrs.data(), vrs.size(), v.data(), v.size());
-    if (status) *status = s;
-    return v;
-  }
-  /// The last message names a refusal by the state table.
-  bool refused(int status) const {
-    return status == fmi2Error && !log.messages.empty() && log.last().find("not allowed") != std::string::npos;
-  }
-};
-
-// The states an instance of a version and interface can be brought to.
-struct Reach {
-  std::uint32_t state;
-  const char* name;
-};
-
-std::vector<Reach> states_of(int version, bool me) {
-  std::vector<Reach> s = {{pkm_fmi::kInstantiated, "Instantiated"}, {pkm_fmi::kInitializationMode, "Initialization"}};
-  if (me) {
-    s.push_back({pkm_fmi::kEventMode, "EventMode"});
-    s.push_back({pkm_fmi::kContinuousTimeMode, "ContinuousTimeMode"});
-  } else {
-    s.push_back({pkm_fmi::kStepMode, "StepMode"});
-    if (version == 2) s.push_back({pkm_fmi::kStepFailed, "StepFailed"});
-  }
-  s.push_back({pkm_fmi::kTerminated, "Terminated"});
-  return s;
-}
-
-void bring_to(Any& a, std::uint32_t state) {
-  if (state == pkm_fmi::kInstantiated) return;
-  ASSERT_EQ(a.enter(), fmi2OK) << a.log.dump();
-  if (state == pkm_fmi::kInitializationMode) return;
-  ASSERT_EQ(a.exit(), fmi2OK) << a.log.dump();
-  if (state == pkm_fmi::kContinuousTimeMode) {
-    ASSERT_EQ(a.continuous(), fmi2OK) << a.log.dump();
-  }
-  if (state == pkm_fmi::kStepFailed) {
-    ASSERT_EQ(a.set("F[3]", 1e300), fmi2OK);
-    ASSERT_EQ(a.step(0.0, 1e-3), fmi2Discard) << a.log.dump();
-  }
-  if (state == pkm_fmi::kTerminated) {
-    ASSERT_EQ(a.terminate(), fmi2OK) << a.log.dump();
-  }
-}
 
 /// Calls the row's function (version's) with arguments valid in the states it is allowed in.
 int invoke(Any& a, Call call) {
