@@ -201,7 +201,8 @@ print("| name | unit | default | range | FMUs | a change | description |")
 print("|---|---|---|---|---|---|---|")
 for p in lib.parameters.values():
     start = str(int(p.start)) if p.is_integer else num(p.start)
-    change = "applies from the next advance" if p.is_solver_setting else "ends the run"
+    change = ("applies from the next advance" if p.is_solver_setting else
+              "keeps the run (tunable)" if p.is_tunable else "ends the run")
     print(f"| `{p.name}` | {cell(p.unit)} | {start} | [{num(p.min)}, {num(p.max)}] | {fmus[p.fmus]} | {change} "
           f"| {cell(p.description)} |")
 """
