@@ -163,23 +163,19 @@ struct Any {
     if (states_changed) *states_changed = changed;
     return s;
   }
-  /// The continuous states and their derivatives (Model Exchange), expected OK.
-  std::vector<double> states() {
+  /// The continuous states, or (`derivatives`) their derivatives (Model
+  /// Exchange), expected OK.
+  std::vector<double> states(bool derivatives = false) {
     std::vector<double> x(def.n_states, NAN);
-    EXPECT_EQ(version == 2 ? +lib.fmi2GetContinuousStates(c, x.data(), x.size())
-                           : +fmi3(lib).fmi3GetContinuousStates(c, x.data(), x.size()),
-              fmi2OK)
-        << log.dump();
+    Fmi3& f = fmi3(lib);
+    const int s = version == 2 ? (derivatives ? +lib.fmi2GetDerivatives(c, x.data(), x.size())
+                                              : +lib.fmi2GetContinuousStates(c, x.data(), x.size()))
+                               : (derivatives ? +f.fmi3GetContinuousStateDerivatives(c, x.data(), x.size())
+                                              : +f.fmi3GetContinuousStates(c, x.data(), x.size()));
+    EXPECT_EQ(s, fmi2OK) << log.dump();
     return x;
   }
-  std::vector<double> derivatives() {
-    std::vector<double> dx(def.n_states, NAN);
-    EXPECT_EQ(version == 2 ? +lib.fmi2GetDerivatives(c, dx.data(), dx.size())
-                           : +fmi3(lib).fmi3GetContinuousStateDerivatives(c, dx.data(), dx.size()),
-              fmi2OK)
-        << log.dump();
-    return dx;
-  }
+  std::vector<double> derivatives() { return states(true); }
   /// The last message names a refusal by the state table.
   bool refused(int status) const {
     return status == fmi2Error && !log.messages.empty() && log.last().find("not allowed") != std::string::npos;
