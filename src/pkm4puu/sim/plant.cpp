@@ -61,9 +61,9 @@ Status Plant::retune(const Params& p) {
       model_ = old;
       return s;
     }
-    energy_.actuator_work += after - before;  // the grasp's (or release's) work: the audit stays constant
-    balance_pending_ = false;
-    contact_step_ = -1.0;  // ROS2's step in a contact depends on the masses
+    // The grasp's (or release's) work: the audit stays constant; ROS2's
+    // energy balance starts again from here.
+    set_energy_integrals({energy_.actuator_work + (after - before), energy_.dissipated});
     if (cvode_ready_) cvode_.reset(t_, packed());
   } else {
     model_ = next;
