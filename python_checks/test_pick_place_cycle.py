@@ -17,6 +17,7 @@ import sys
 import numpy as np
 import pytest
 
+from conftest import command_help, promised_files
 from pkm4puu import capi, spec
 from pkm4puu.planning import segment
 from pkm4puu.cli import cycle as program
@@ -141,6 +142,7 @@ def test_closed_loop_tracks_the_plan_through_the_plant_fmu(standard):
     assert abs(net) <= spec.CYCLE_PAYLOAD * spec.G * TRACKING_BOUND
     png = (out / "closed_loop.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 50_000
+    assert {p.name for p in out.iterdir()} == promised_files(command_help("cycle"))
 
 
 def test_table_lists_every_payload_and_force_limit():
