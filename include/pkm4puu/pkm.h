@@ -108,9 +108,12 @@ PKM_API const char* pkm_last_error(const pkm_model* m);
  * "rtol", ... : docs/c_api.md lists them). PKM_ERR_INVALID_ARGUMENT for an
  * unknown name, PKM_ERR_INVALID_PARAMETER for a value outside its range or
  * one that leaves the set inconsistent (rho_max not above rho_min); nothing
- * changes then. A solver setting applies from the next advance; a change of
- * any other parameter ends the run: forward dynamics answers
- * PKM_ERR_NOT_INITIALIZED until the next pkm_init_pose. */
+ * changes then. A solver setting applies from the next advance. A tunable
+ * parameter (is_tunable: the payload) keeps the run: a grasp or a release at
+ * the current time, the platform's velocity unchanged, the jump of kinetic
+ * and potential energy booked into actuator_work. A change of any other
+ * parameter ends the run: forward dynamics answers PKM_ERR_NOT_INITIALIZED
+ * until the next pkm_init_pose. */
 PKM_API pkm_status pkm_set_parameter(pkm_model* m, const char* name, double value);
 /** Sets n parameters as one change: the set is checked as a whole, so
  * rho_min and rho_max can move past each other; all or nothing. */
@@ -126,8 +129,9 @@ typedef struct {
   double start;            /**< the default */
   double min, max;         /**< the closed range pkm_set_parameter accepts (max may be +Inf) */
   int is_integer;          /**< 1: a whole number (a choice: solver, cvode_method, formulation) */
-  int is_solver_setting;   /**< 1: applies from the next advance; 0: a change ends the run */
-  int is_tunable;          /**< 1: the FMUs let it change during a run (variability tunable) */
+  int is_solver_setting;   /**< 1: applies from the next advance */
+  int is_tunable;          /**< 1: a change keeps the run, here and in the FMUs (variability tunable);
+                                with is_solver_setting 0 both: a change ends the run */
   unsigned fmus;           /**< bit 0: PKM4PUU.fmu has it, bit 1: PKM4PUU_Inverse.fmu */
   unsigned value_reference; /**< the FMUs' value reference */
 } pkm_parameter;
@@ -177,7 +181,7 @@ typedef struct {
   double F_hold[4];              /**< N: hold the current pose at rest (gravity, payload, wrench) */
   double kinetic_energy;         /**< J, rotors included */
   double potential_energy;       /**< J, gravity plus the stops' springs */
-  double actuator_work;          /**< J, running integral since pkm_init_pose */
+  double actuator_work;          /**< J, running integral since pkm_init_pose, plus each payload change's work */
   double dissipated_energy;      /**< J, running integral since pkm_init_pose */
   double stop_indicators[8];     /**< rho_i - rho_min (i = 1..4), then rho_max - rho_i */
 } pkm_outputs;
@@ -201,7 +205,7 @@ typedef struct {
 PKM_API pkm_status pkm_get_state(const pkm_model* m, pkm_state* state);
 /** Restores a state taken by pkm_get_state (of a model with the same
  * parameters), in this handle or another; a run continues from it bit for
- * bit. Refused, nothing changed, beyond the guards or the speed limit, with
+ * bit. The parameters, tunable ones included, are not part of the state. Refused, nothing changed, beyond the guards or the speed limit, with
  * a theta1 reference that is not the pose's, or a contact mode that names no
  * stop. */
 PKM_API pkm_status pkm_set_state(pkm_model* m, const pkm_state* state);

@@ -209,7 +209,10 @@ class Plant:
 
     def set(self, **params):
         """Sets parameters as one change (pkm_set_parameters: checked as a
-        set, all or nothing)."""
+        set, all or nothing). A run goes on through a change of the payload
+        (the tunable parameters: a grasp or a release now, the velocity kept,
+        the payload's energy booked into actuator_work) and of solver
+        settings; a change of any other parameter ends it."""
         items = self._expand(params)
         if not items:
             return

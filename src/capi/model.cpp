@@ -92,7 +92,7 @@ pkm_status no_such_parameter(const pkm_model* m, const char* fn, const char* nam
 /// pkm_set_parameters for `fn`.
 pkm_status set_parameters(pkm_model* m, const char* fn, size_t n, const char* const names[], const double values[]) {
   pkm::Configuration next = m->config;
-  bool model_changed = false, solver_changed = false;
+  bool fixed_changed = false, tunable_changed = false, solver_changed = false;
   for (size_t k = 0; k < n; ++k) {
     if (!names[k]) return null_argument(m, fn, "a name");
     const pkm::Parameter* p = api_row(names[k]);
@@ -101,19 +101,34 @@ pkm_status set_parameters(pkm_model* m, const char* fn, size_t n, const char* co
     if (!why.empty()) return fail(m, PKM_ERR_INVALID_PARAMETER, fn, why);
     if (p->get(next) == values[k]) continue;
     p->set(next, values[k]);
-    (is_solver_setting(*p) ? solver_changed : model_changed) = true;
+    (is_solver_setting(*p) ? solver_changed
+     : p->variability == pkm::ParameterVariability::Tunable ? tunable_changed
+                                                            : fixed_changed) = true;
   }
   std::string why;
-  if (model_changed) {
+  if (fixed_changed) {
     // A new plant: the run ends (a changed machine has no state to go on from).
     std::unique_ptr<pkm::Plant> plant;
     const pkm_status s = make_plant(next, plant, &why);
     if (s != PKM_OK) return fail(m, s, fn, why);
     if (m->plant->initialized()) m->run_ended = "a parameter of the machine changed since pkm_init_pose";
     m->plant = std::move(plant);
-  } else if (solver_changed) {
-    if (m->plant->set_solver(next.solver, &why) != pkm::Status::Ok)
+  } else {
+    // Solver settings and tunable parameters keep the run: checked first, so
+    // that the settings, once taken, are followed by a change that cannot fail.
+    if (tunable_changed) {
+      why = pkm::validate(next.params);
+      if (!why.empty()) return fail(m, PKM_ERR_INVALID_PARAMETER, fn, why);
+    }
+    if (solver_changed && m->plant->set_solver(next.solver, &why) != pkm::Status::Ok)
       return fail(m, PKM_ERR_INVALID_PARAMETER, fn, why);
+    if (tunable_changed) {
+      const pkm::Status s = m->plant->retune(next.params);
+      if (s != pkm::Status::Ok) {
+        if (solver_changed) m->plant->set_solver(m->config.solver);
+        return fail(m, s, fn);
+      }
+    }
   }
   m->config = next;
   return PKM_OK;

@@ -247,6 +247,7 @@ Status Instance::reset() {
   apply_start_values();
   data_->reset();
   input_derivatives_set_ = false;
+  states_changed_ = false;
   mode_ = kInstantiated;
   start_time_ = stop_time_ = time_ = last_successful_time_ = elapsed_ = time_floor_ = 0.0;
   stop_time_defined_ = false;

@@ -257,6 +257,7 @@ class Instance {
   bool terminated_ = false;             // CS: set after a discarded step
   unsigned valid_groups_ = 0;           // output groups (Variable::group) up to date
   bool input_derivatives_set_ = false;  // SetRealInputDerivatives was used (or a state restored)
+  bool states_changed_ = false;  // ME: a tunable parameter set in this Event Mode changed the continuous states
   // The table's variables with an input derivative lie in [derivatives_begin_,
   // derivatives_end_) (do_step checks only these, every step).
   std::size_t derivatives_begin_ = 0, derivatives_end_ = 0;

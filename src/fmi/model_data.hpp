@@ -54,6 +54,16 @@ class ModelData {
   /// mode and times were restored (ctx tells them); false (with a logged
   /// message) if the state cannot be used or is none the instance can be in.
   virtual bool load(StateReader& r, Context& ctx) = 0;
+  /// Tunable parameters were set while running (Co-Simulation's Step Mode,
+  /// Model Exchange's Event Mode): take their new values into the running
+  /// model. states_changed: the continuous states changed with them (Model
+  /// Exchange's next event update says so). Error (logged): nothing changed,
+  /// and the table holds the values in effect again.
+  virtual Status tune(Context& ctx, const char* function, bool& states_changed) {
+    (void)ctx, (void)function;
+    states_changed = false;
+    return Status::OK;
+  }
 
   // ---- Co-Simulation
   /// From t to t + h (t is the current time). On return t_reached is the last

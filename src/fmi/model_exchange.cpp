@@ -30,7 +30,10 @@ Status Instance::event_update(bool* discrete_states_need_update, bool* terminate
   if (discrete_states_need_update) *discrete_states_need_update = false;
   if (terminate) *terminate = stop;
   if (nominals_changed) *nominals_changed = false;
-  if (values_changed) *values_changed = false;
+  // A tunable parameter set in this Event Mode may have changed the states
+  // (ModelData::tune): the importer reads them again.
+  if (values_changed) *values_changed = states_changed_;
+  states_changed_ = false;
   if (next_event_time_defined) *next_event_time_defined = false;
   if (next_event_time) *next_event_time = 0.0;
   if (s == Status::Error) mode_ = kError;
@@ -42,6 +45,7 @@ Status Instance::enter_continuous_time_mode() {
   const char* fn = PKM_FN(EnterContinuousTimeMode);
   if (!allowed(Call::EnterContinuousTimeMode, fn)) return Status::Error;
   mode_ = kContinuousTimeMode;
+  states_changed_ = false;
   return Status::OK;
 }
 

@@ -103,6 +103,16 @@ Status Instance::set_values(const char* function, VarType type, const std::uint3
                  PKM_FN(ExitInitializationMode));
       return Status::Error;
     }
+    // A tunable parameter changes at an event or a communication point, never
+    // while the importer integrates: not in Continuous-Time Mode (FMI 2.0.4
+    // 3.2.3, fmi2SetReal's conditions 4 and 5; FMI 3.0.2 2.4.7.4 and 3.2.1).
+    if (v->causality == Causality::Parameter && v->variability == Variability::Tunable &&
+        mode_ == kContinuousTimeMode) {
+      log_.error("%s: %s is a tunable parameter: in Model Exchange it can be set in Event Mode (%s), not in "
+                 "Continuous-Time Mode",
+                 function, v->name, PKM_FN(EnterEventMode));
+      return Status::Error;
+    }
     const double x = static_cast<double>(value[k]);
     if (std::is_floating_point<T>::value && !std::isfinite(x)) {
       log_.error("%s: %s = %g is not finite; value rejected", function, v->name, x);
@@ -129,12 +139,15 @@ Status Instance::set_values(const char* function, VarType type, const std::uint3
     if (s != Status::OK) return s;
   }
   const bool log_calls = log_.enabled(LogCategory::Calls);
+  bool tuned = false;  // a tunable parameter set while running: the model takes it at once
   for (std::size_t k = 0; k < n; ++k) {
     const Variable* v = k < kFoundCache ? found[k] : def_.find(vr[k]);
     if (sets_states && v->state >= 0) {
       if (log_calls) log_.call("%s: %s = %.17g (state)", function, v->name, static_cast<double>(value[k]));
       continue;
     }
+    tuned = tuned || (v->causality == Causality::Parameter && v->variability == Variability::Tunable &&
+                      (mode_ & (kEventMode | kStepMode)));
     void* p = address(v);
     if (type == VarType::Boolean) {
       *static_cast<T*>(p) = value[k] != 0 ? 1 : 0;
@@ -146,6 +159,12 @@ Status Instance::set_values(const char* function, VarType type, const std::uint3
     if (log_calls) log_.call("%s: %s = %.17g", function, v->name, static_cast<double>(value[k]));
   }
   valid_groups_ = 0;
+  if (tuned) {
+    bool states_changed = false;
+    const Status s = data_->tune(ctx, function, states_changed);
+    if (s != Status::OK) return s;
+    states_changed_ = states_changed_ || states_changed;
+  }
   return Status::OK;
 }
 

@@ -5,25 +5,40 @@ z = z0 + h sin(pi s), phi = -(theta/2) cos(pi s) from A (s = 0) to B (s = 1)
 carrying the payload and back empty, each leg the fastest rest-to-rest
 traversal with every |F_i| <= f_max and |drho_i/dt| <= v_max (TOPP-RA over
 the C API's inverse dynamics), and prints the cycle time. The defaults are
-the standard cycle.
+the standard cycle. Then it runs the planned cycle closed-loop through the
+plant FMU (PKM4PUU.fmu sampled at 10 kHz: the planned forces as
+feed-forward, a PD on the sliders' errors, the payload grasped at A and
+released at B through the FMU's tunable payload_mass) and prints the
+tracking error, the peak forces against f_max and the energy per cycle;
+--plan-only leaves that out (it needs the FMUs built).
 
 With --out DIR it writes
-  cycle.csv   t, x, y, z, phi, their rates and accelerations, F[1..4] and
-              payload_mass, every --dt over the whole cycle (SI units; the
-              release at B appears twice, with and without the payload)
-  cycle.png   the forces against their limit, the slider speeds against
-              theirs, the path velocity against its speed limit, the path in 3D
-both complete or neither: they are written into a temporary folder beside
-DIR and moved into it at the end. --table prints instead the Markdown table
-of the cycle time against payload and f_max (the documentation's).
+  cycle.csv         t, x, y, z, phi, their rates and accelerations, F[1..4]
+                    and payload_mass, every --dt over the whole cycle (SI
+                    units; the release at B appears twice, with and without
+                    the payload)
+  cycle.png         the forces against their limit, the slider speeds against
+                    theirs, the path velocity against its speed limit, the
+                    path in 3D
+  closed_loop.csv   the closed-loop run at each sample: t, x, y, z, phi,
+                    x_ref, y_ref, z_ref, phi_ref, then F[1..4] applied,
+                    F_ff[1..4] (the planned part), payload_mass and the
+                    plant's kinetic_energy, potential_energy, actuator_work,
+                    dissipated_energy (not with --plan-only)
+  closed_loop.png   the reference against the plant's pose, the tracking
+                    error, the forces against f_max and the feedback's part
+all complete or none: they are written into a temporary folder beside DIR
+and moved into it at the end. --table prints instead the Markdown table of
+the cycle time against payload and f_max (the documentation's).
 
 Exit status: 0; 2 for bad input (a value that is not finite or negative,
 a path that leaves the workspace or crosses a singularity, limits too low
 to hold the payload), one line on stderr saying which and where; 1 when
-the C API library cannot be loaded.
+the C API library or the plant FMU cannot be found.
 
 usage: pkm4puu cycle [--payload KG] [--f-max N] [--v-max M/S] [--a M] [--h M] [--z0 M]
-                     [--theta-deg DEG] [--grid N] [--dt S] [--build DIR] [--out DIR | --table]
+                     [--theta-deg DEG] [--grid N] [--dt S] [--plan-only] [--build DIR]
+                     [--out DIR | --table]
 """
 import argparse
 import math
@@ -62,12 +77,15 @@ def parser():
             ("--grid", int, GRID, "N", "intervals", "grid intervals per leg"),
             ("--dt", float, DT, "S", "s", "spacing of the samples in cycle.csv")):
         ap.add_argument(flag, type=kind, default=default, metavar=metavar, help=f"{what} (default %(default)g {unit})")
+    ap.add_argument("--plan-only", action="store_true",
+                    help="plan the cycle only, without the closed-loop run through the plant FMU")
     ap.add_argument("--build", type=Path, default=None, metavar="DIR",
                     help="build directory holding lib/libpkm.so (default: $PKM_BUILD_DIR, else the installed "
                          "package's own, else ./build)")
     out = ap.add_mutually_exclusive_group()
     out.add_argument("--out", type=writable_dir, default=None, metavar="DIR",
-                     help="write cycle.csv and cycle.png into DIR (default: write nothing)")
+                     help="write cycle.csv, cycle.png, closed_loop.csv and closed_loop.png into DIR (default: "
+                          "write nothing)")
     out.add_argument("--table", action="store_true",
                      help="print the table of the cycle time against payload and f_max (Markdown; its own "
                           "payloads and force limits, the other values as given)")
@@ -79,10 +97,9 @@ def error(message, status=2):
     return status
 
 
-def write_csv(cycle, path):
+def write_csv(rows, columns, path):
     import numpy as np
-    from ..planning import COLUMNS
-    np.savetxt(path, cycle.samples(), delimiter=",", header=",".join(COLUMNS), comments="", fmt="%.12g")
+    np.savetxt(path, rows, delimiter=",", header=",".join(columns), comments="", fmt="%.12g")
 
 
 def plot(cycle, path):
@@ -143,22 +160,81 @@ def plot(cycle, path):
     plt.close(fig)
 
 
-def write_outputs(cycle, out):
-    """cycle.csv and cycle.png into `out`, both or neither: written into a
-    temporary folder beside it, then moved in (each move atomic)."""
+def plot_closed_loop(track, path):
+    """The closed-loop run: the reference against the plant's pose, the
+    tracking errors against their bounds, the applied forces against
+    f_max, the feedback's part."""
+    import numpy as np
+    from ..planning.tracking import TRACKING_BOUND
+    from ..plots import pyplot, save_figure
+    plt = pyplot()
+    r = track.loop
+    t = 1e3 * r.t
+    release = 1e3 * track.cycle.segments[0].duration
+    f_max = track.cycle.segments[0].force_limit
+    fig, ((ax_p, ax_e), (ax_f, ax_b)) = plt.subplots(2, 2, figsize=(12, 8.5), sharex=True)
+    for k, (name, scale, unit) in enumerate((("x", 1e3, "mm"), ("z", 1e3, "mm"), ("phi", 180 / np.pi, "deg"))):
+        col = "xyz".index(name) if name != "phi" else 3
+        ax = ax_p if name != "phi" else ax_p.twinx()
+        ax.plot(t, scale * r.pose_d[:, col], f"C{k}", ls="--", lw=2.2, alpha=0.5, label=f"{name}_ref ({unit})")
+        ax.plot(t, scale * r.pose[:, col], f"C{k}", lw=0.9, label=f"{name} ({unit})")
+        if name == "phi":
+            ax.set_ylabel("phi (deg)")
+            ax.legend(fontsize=7, loc="lower right")
+    ax_p.set_ylabel("x, z (mm)")
+    ax_p.legend(fontsize=7, loc="lower left")
+    ax_p.set_title("reference (dashed) against the plant FMU's pose", fontsize=9)
+    ax_e.semilogy(t, 1e6 * np.maximum(r.pos_err, 1e-12), "C0", lw=1.0, label="|p - p_ref| (um)")
+    r_q = TRACKING_BOUND / track.phi_bound  # phi's bound is 0.1 mm at r_Q
+    ax_e.semilogy(t, 1e6 * r_q * np.maximum(r.phi_err, 1e-15), "C1", lw=1.0, label="r_Q |phi - phi_ref| (um)")
+    ax_e.axhline(1e6 * TRACKING_BOUND, color="k", ls="--", lw=1.0, label="bound 100 um")
+    ax_e.set_ylabel("tracking error (um)")
+    ax_e.set_title(f"tracking error: max {1e6 * r.pos_err.max():.3g} um", fontsize=9)
+    ax_e.legend(fontsize=7, loc="lower right")
+    for i in range(4):
+        ax_f.plot(t[:-1], r.F[:-1, i], f"C{i}", lw=1.0, label=f"F[{i + 1}]")
+        ax_b.plot(t[:-1], 1e3 * r.F_pd[:-1, i], f"C{i}", lw=0.8, label=f"F[{i + 1}] - F_ff[{i + 1}]")
+    for sign in (1, -1):
+        ax_f.axhline(sign * f_max, color="k", ls="--", lw=1.0)
+    ax_f.set_ylabel("applied force (N)")
+    ax_f.set_title(f"forces against f_max = {f_max:g} N: peak {np.abs(r.F[:-1]).max():.4f} N", fontsize=9)
+    ax_b.set_ylabel("feedback part (mN)")
+    ax_b.set_title("the feedback's part of the forces", fontsize=9)
+    for ax in (ax_p, ax_e, ax_f, ax_b):
+        ax.axvline(release, color="0.6", lw=0.8)
+        ax.grid(True, alpha=0.3)
+    for ax in (ax_f, ax_b):
+        ax.set_xlabel("t (ms)")
+        ax.legend(fontsize=7, loc="lower right", ncol=2)
+    fig.suptitle(f"the cycle in closed loop through PKM4PUU.fmu ({track.gains.f_c:g} Hz PD on the sliders, the "
+                 f"planned forces as feed-forward; payload released at B: grey line)", fontsize=10)
+    save_figure(fig, path, dpi=110)
+
+
+def write_outputs(cycle, out, track=None):
+    """cycle.csv and cycle.png (and with a closed-loop run `track`,
+    closed_loop.csv and closed_loop.png) into `out`, all or none: written
+    into a temporary folder beside it, then moved in (each move atomic)."""
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.cycle-", dir=out.parent))
     umask = os.umask(0)
     os.umask(umask)
     os.chmod(tmp, 0o777 & ~umask)  # mkdtemp's is private; the folder may become `out`
     try:
-        write_csv(cycle, tmp / "cycle.csv")
+        from ..planning import COLUMNS
+        write_csv(cycle.samples(), COLUMNS, tmp / "cycle.csv")
         plot(cycle, tmp / "cycle.png")
+        names = ["cycle.csv", "cycle.png"]
+        if track is not None:
+            from ..planning.tracking import COLUMNS as LOOP_COLUMNS
+            write_csv(track.samples(), LOOP_COLUMNS, tmp / "closed_loop.csv")
+            plot_closed_loop(track, tmp / "closed_loop.png")
+            names += ["closed_loop.csv", "closed_loop.png"]
         if not out.exists():
             tmp.rename(out)
-            return [out / "cycle.csv", out / "cycle.png"]
+            return [out / name for name in names]
         paths = []
-        for name in ("cycle.csv", "cycle.png"):
+        for name in names:
             os.replace(tmp / name, out / name)
             paths.append(out / name)
         return paths
@@ -202,6 +278,13 @@ def main(argv=None):
         _library(args.build)
     except OSError as e:
         return error(f"cannot load the C API library: {e}", 1)
+    plant_fmu = None
+    if not (args.table or args.plan_only):
+        from ..fmu import find_fmu
+        try:
+            plant_fmu = find_fmu("PKM4PUU", 2, args.build)
+        except FileNotFoundError as e:
+            return error(f"the closed loop needs the plant FMU: {e} (--plan-only plans without it)", 1)
     try:
         if args.table:
             from ..planning import Limits, arch
@@ -220,8 +303,19 @@ def main(argv=None):
     print("\n".join(cycle.summary()), flush=True)
     print(f"{prog()}: planned in {planned:.2f} s ({args.grid} grid intervals per leg, samples every {args.dt:g} s)",
           file=sys.stderr, flush=True)
+    track = None
+    if plant_fmu is not None:
+        from ..planning import track_cycle
+        t0 = time.perf_counter()
+        try:
+            track = track_cycle(cycle, plant_fmu, build=args.build)
+        except RuntimeError as e:
+            return error(str(e), 1)
+        print("\n".join(track.summary()), flush=True)
+        print(f"{prog()}: closed loop run in {time.perf_counter() - t0:.2f} s ({len(track.t)} steps of the plant FMU)",
+              file=sys.stderr, flush=True)
     if args.out is not None:
-        for path in write_outputs(cycle, args.out):
+        for path in write_outputs(cycle, args.out, track):
             print(f"{prog()}: wrote {path}", file=sys.stderr, flush=True)
     return 0
 

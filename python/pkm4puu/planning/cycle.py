@@ -3,7 +3,7 @@
 back from B to A empty, each leg rest to rest and time-optimal, no dwell
 (docs/pick_and_place.md; the standard cycle's numbers are spec.CYCLE_*)."""
 from dataclasses import dataclass
-from typing import List
+from typing import List, Optional
 
 import numpy as np
 
@@ -20,10 +20,13 @@ COLUMNS = (["t", "x", "y", "z", "phi", "dx", "dy", "dz", "dphi", "ddx", "ddy", "
 @dataclass
 class Cycle:
     """The planned cycle: segments[0] is A -> B with the payload,
-    segments[1] B -> A without; each segment's time starts at 0."""
+    segments[1] B -> A without; each segment's time starts at 0. machine
+    and params: the machine it was planned for (plan_cycle's)."""
     arch: Arch
     limits: Limits
     segments: List[Segment]
+    machine: Optional[dict] = None
+    params: Optional[dict] = None
 
     @property
     def duration(self):
@@ -79,7 +82,7 @@ def plan_cycle(payload=spec.CYCLE_PAYLOAD, f_max=spec.CYCLE_F_MAX, v_max=spec.CY
     common = dict(limits=limits, machine=machine, params=params, grid=grid, dt=dt, build=build, check_workspace=False)
     there = plan_segment(path, payload, name="A -> B", **common)
     back = plan_segment(path.reversed(), 0.0, name="B -> A", **common)
-    return Cycle(path, limits, [there, back])
+    return Cycle(path, limits, [there, back], machine, params)
 
 
 def arch(a=spec.CYCLE_A, h=spec.CYCLE_H, z0=spec.CYCLE_Z0, theta=spec.CYCLE_THETA):

@@ -234,13 +234,17 @@ def plan_segment(path, payload_mass=0.0, limits=None, machine=None, params=None,
     return seg
 
 
+def sample_times(T, dt):
+    """0, dt, 2 dt, ... up to T, and T itself."""
+    n = int(math.floor(T / dt + 1e-9))
+    return np.append(np.arange(n + 1) * dt, T) if n * dt < T * (1 - 1e-12) else np.arange(n + 1) * dt
+
+
 def sample(seg, dt, machine=None, params=None, build=None):
     """Fills seg's samples every dt s (and at its end): the motion, the
     forces with friction and the slider rates from the C API, and checks
     them against the limits."""
-    T = seg.duration
-    n = int(math.floor(T / dt + 1e-9))
-    t = np.append(np.arange(n + 1) * dt, T) if n * dt < T * (1 - 1e-12) else np.arange(n + 1) * dt
+    t = sample_times(seg.duration, dt)
     _, _, _, pose, vel, acc = seg.at(t)
     with InverseDynamics(seg.payload_mass, machine, params, build) as dyn:
         F, rho, drho = dyn.forces_and_rates(pose, vel, acc)

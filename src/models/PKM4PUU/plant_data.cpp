@@ -107,6 +107,26 @@ pkm::LinearInputs PlantData::inputs(double t0) const {
 
 Status PlantData::exit_initialization(Context& ctx) { return build(ctx, "ExitInitializationMode"); }
 
+Status PlantData::tune(Context& ctx, const char* function, bool& states_changed) {
+  states_changed = false;
+  if (!plant) return Status::OK;  // no run (initialisation failed): the next one is built with the new values
+  const double work = plant->energy_integrals().actuator_work;
+  if (plant->retune(parameters().params) != pkm::Status::Ok) {
+    ctx.log.error("%s: %s; the parameters in effect are kept", function, plant->last_error().c_str());
+    put_back_tunable(plant->model().p);
+    return Status::Error;
+  }
+  jacobian_cache.valid = false;
+  may_continue = false;  // CVODE restarts: the dynamics changed here
+  if (!plant->initialized()) return Status::OK;
+  states_changed = true;  // actuator_work took the jump of kinetic and potential energy
+  ctx.log.event("%s at t = %.17g: the payload changed (payload_mass = %g kg); the platform's velocity is kept, the "
+                "jump of kinetic and potential energy, %.9g J, is booked into actuator_work",
+                function, absolute_time(ctx), plant->model().p.payload_mass,
+                plant->energy_integrals().actuator_work - work);
+  return Status::OK;
+}
+
 Status PlantData::ready(Context& ctx, const char* function) {
   if (ctx.initialization_mode) {
     // Initial values for the parameters set so far.

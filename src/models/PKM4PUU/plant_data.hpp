@@ -144,6 +144,8 @@ struct PlantData final : MechanismData {
   Status update_outputs(Context& ctx, unsigned groups) override;
   void save(StateWriter& w) const override;
   bool load(StateReader& r, Context& ctx) override;
+  /// The payload changed between steps or in Event Mode: Plant::retune.
+  Status tune(Context& ctx, const char* function, bool& states_changed) override;
 
   void set_time(double t) override {
     if (plant) plant->set_time(t);

@@ -37,6 +37,18 @@ Status InverseData::exit_initialization(Context& ctx) {
   return Status::OK;
 }
 
+Status InverseData::tune(Context& ctx, const char* function, bool& states_changed) {
+  states_changed = false;  // no states: the outputs follow the new model at the next get
+  if (!model) return Status::OK;
+  pkm::Model next;
+  if (make(ctx, function, next) != Status::OK) {
+    put_back_tunable(model->p);
+    return Status::Error;
+  }
+  *model = next;
+  return Status::OK;
+}
+
 const pkm::Model* InverseData::current_model(Context& ctx, const char* function,
                                              std::optional<pkm::Model>& temporary) {
   if (ctx.initialization_mode) return make(ctx, function, temporary.emplace()) == Status::OK ? &*temporary : nullptr;

@@ -70,6 +70,8 @@ struct InverseData final : MechanismData {
   Status compute_outputs(Context& ctx, const pkm::Model& with, unsigned groups);
   void save(StateWriter& w) const override;
   bool load(StateReader& r, Context& ctx) override;
+  /// The payload changed between steps or in Event Mode: the model made again.
+  Status tune(Context& ctx, const char* function, bool& states_changed) override;
 
   Status partial_derivatives(Context& ctx, const Variable* const unknowns[], std::size_t nu,
                              const Variable* const knowns[], std::size_t nk, double J[]) override;

@@ -28,6 +28,15 @@ struct MechanismData : ModelData {
       integer_parameters[row] = static_cast<std::int32_t>(real_parameters[row]);
     }
   }
+  /// The tunable rows' values back to those of `in_effect` (a change the
+  /// running model refused: ModelData::tune).
+  void put_back_tunable(const pkm::Params& in_effect) {
+    const pkm::Configuration c{in_effect};
+    for (std::size_t row = 0; row < pkm::kParameterCount; ++row)
+      if (pkm::kParameters[row].variability == pkm::ParameterVariability::Tunable &&
+          pkm::kParameters[row].target == pkm::ParameterTarget::Model)
+        real_parameters[row] = pkm::kParameters[row].get(c);
+  }
   /// What the parameters set now.
   pkm::Configuration parameters() const {
     pkm::Configuration c;

@@ -17,7 +17,10 @@
 //   unit         the FMUs' unit ("" dimensionless)
 //   lo, hi       the closed range (the model descriptions' min and max)
 //   rule         what the message says outside it (ParameterRule below)
-//   variability  Fixed or Tunable (the FMUs' variability)
+//   variability  Fixed or Tunable: the FMUs' variability; a Tunable row may change
+//                during a run (Co-Simulation: between steps; Model Exchange:
+//                in Event Mode; the C API: pkm_set_parameter keeps the run),
+//                which Plant::retune applies
 //   fmus         Both or Plant: the FMUs that have it
 //   description  the FMUs' description
 // Rows are in increasing value reference. The default is the target
@@ -174,13 +177,14 @@ std::string check_parameter(const char* name, double value, double lo, double hi
     "Lower end of each slider's travel (end stop)") \
   X(156, "rho_max", Model, rho_max, Real, "m", -kMaxLength, kMaxLength, kInRange, Fixed, Both, \
     "Upper end of each slider's travel (end stop), above rho_min") \
-  X(157, "payload_mass", Model, payload_mass, Real, "kg", 0.0, kMaxMass, kNonNegative, Fixed, Both, \
-    "Mass of a payload fixed to the platform") \
-  X(158, "payload_com[1]", Model, payload_com[0], Real, "m", -kMaxLength, kMaxLength, kInRange, Fixed, Both, \
+  X(157, "payload_mass", Model, payload_mass, Real, "kg", 0.0, kMaxMass, kNonNegative, Tunable, Both, \
+    "Mass of a payload fixed to the platform; tunable: a grasp or a release during a run keeps the platform's " \
+    "velocity and books the jump of kinetic and potential energy into actuator_work") \
+  X(158, "payload_com[1]", Model, payload_com[0], Real, "m", -kMaxLength, kMaxLength, kInRange, Tunable, Both, \
     "Payload centre of mass in the platform frame relative to P, x") \
-  X(159, "payload_com[2]", Model, payload_com[1], Real, "m", -kMaxLength, kMaxLength, kInRange, Fixed, Both, \
+  X(159, "payload_com[2]", Model, payload_com[1], Real, "m", -kMaxLength, kMaxLength, kInRange, Tunable, Both, \
     "Payload centre of mass in the platform frame relative to P, y") \
-  X(160, "payload_Izz", Model, payload_Izz, Real, "kg.m2", 0.0, kMaxInertia, kNonNegative, Fixed, Both, \
+  X(160, "payload_Izz", Model, payload_Izz, Real, "kg.m2", 0.0, kMaxInertia, kNonNegative, Tunable, Both, \
     "Payload inertia about the vertical axis through its own centre of mass") \
   X(161, "work_budget", Solver, work_budget, Real, "", kMinWorkBudget, kMaxWorkBudget, kInRange, Fixed, Plant, \
     "Fixed-step solvers: inner steps (grid steps, stiff sub-steps, rejected steps, bisection trials locating " \

@@ -12,6 +12,7 @@
 #include "pkm4puu/kinematics/servo_kinematics.hpp"
 #include "pkm4puu/machine/passive_force.hpp"
 #include "pkm4puu/sim/fixed_step_stability.hpp"
+#include "pkm4puu/sim/parameters.hpp"
 
 namespace pkm {
 
@@ -30,6 +31,44 @@ Status Plant::set_solver(const SolverSettings& s, std::string* error) {
   }
   settings_ = s;
   cvode_ready_ = false;  // re-created on the next CVODE advance
+  return Status::Ok;
+}
+
+Status Plant::retune(const Params& p) {
+  Model next;
+  std::string why;
+  if (make_model(p, next, &why) != Status::Ok) {
+    error_ = why;
+    return Status::InvalidParameter;
+  }
+  const Configuration now{model_.p}, then{p};
+  for (const Parameter& row : kParameters) {
+    if (row.target != ParameterTarget::Model || row.variability == ParameterVariability::Tunable) continue;
+    if (row.get(now) != row.get(then)) {
+      error_ = std::string("parameter ") + row.name + " is not tunable: a change of it needs a new run";
+      return Status::InvalidArgument;
+    }
+  }
+  if (initialized_) {
+    settle_energy();  // ROS2's balance, at the energy it refers to
+    double before = 0.0, after = 0.0;
+    Status s = mechanical_energy(y_, before);
+    if (s != Status::Ok) return s;
+    const Model old = model_;
+    model_ = next;
+    s = mechanical_energy(y_, after);
+    if (s != Status::Ok) {
+      model_ = old;
+      return s;
+    }
+    // The grasp's (or release's) work: the audit stays constant; ROS2's
+    // energy balance starts again from here.
+    set_energy_integrals({energy_.actuator_work + (after - before), energy_.dissipated});
+    if (cvode_ready_) cvode_.reset(t_, packed());
+  } else {
+    model_ = next;
+  }
+  error_.clear();
   return Status::Ok;
 }
 

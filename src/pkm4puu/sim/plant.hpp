@@ -27,7 +27,7 @@ constexpr double kMaxSpeed = 1e3;
 /// the motion by the same integrator: kinetic + potential - actuator_work +
 /// dissipated stays constant.
 struct EnergyIntegrals {
-  double actuator_work = 0;  // of (F_i + (2 pi/p) tau_i) rhod_i plus the external wrench's power
+  double actuator_work = 0;  // of (F_i + (2 pi/p) tau_i) rhod_i plus the external wrench's power, plus retune's jumps
   double dissipated = 0;     // friction plus the end stops' damping
 };
 
@@ -72,6 +72,16 @@ class Plant {
   /// Replaces the solver settings (validated first).
   Status set_solver(const SolverSettings& s, std::string* error = nullptr);
   const SolverSettings& solver() const { return settings_; }
+
+  /// Applies new values of the tunable parameters (the parameter table's
+  /// Tunable rows: the payload) to the running plant; every other member of
+  /// `p` must equal model().p. The state is kept: the platform's velocity is
+  /// continuous (a part grasped or released at rest relative to it), the
+  /// jump of kinetic plus potential energy is booked into actuator_work (the
+  /// work of the grasp: the audit stays constant), and CVODE restarts.
+  /// InvalidParameter (p invalid) or InvalidArgument (a fixed parameter
+  /// differs): nothing changes, last_error() says why.
+  Status retune(const Params& p);
 
   /// Consistent initial state at time t0 from a pose and a velocity
   /// (position and velocity problems). Status::Unreachable if the pose
