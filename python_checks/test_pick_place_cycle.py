@@ -17,7 +17,7 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import command_help, promised_files
+from conftest import REPO, command_help, promised_files
 from pkm4puu import capi, spec
 from pkm4puu.planning import segment
 from pkm4puu.cli import cycle as program
@@ -85,6 +85,17 @@ def test_standard_cycle_csv(standard, pkm_library):
                         for r in rows])
     np.testing.assert_allclose(F[rows], ref, rtol=0, atol=1e-9)  # the CSV's 12 digits
     assert np.abs(F).max() <= spec.CYCLE_F_MAX * (1 + 1e-5)
+
+
+def test_the_readmes_cycle_time_is_this_builds(standard):
+    """README.md's headline states the standard cycle's time to two digits:
+    the one this build plans."""
+    _, stdout = standard
+    cycle_time = float(re.search(r"cycle time: ([0-9.]+) s", stdout).group(1))
+    readme = (REPO / "README.md").read_text()
+    stated = re.search(r"\*\*Pick-and-place\.\*\*.*?takes ([0-9.]+) s", readme, re.S)
+    assert stated, "README.md: no cycle time in the pick-and-place headline"
+    assert stated.group(1) == f"{cycle_time:.2f}", (stated.group(1), cycle_time)
 
 
 def test_standard_cycle_figure_and_summary(standard):
