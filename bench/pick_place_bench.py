@@ -1,16 +1,11 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Speed of the pick-and-place planner (a benchmark, not a test):
-pkm4puu.plan_cycle on the standard cycle, against the target of one second,
-printed beside the cycle time it plans (their ratio: how much of one cycle
-the planning takes) and beside its parts measured in the same run: the C
-API's inverse dynamics along the grid (the coefficients of both legs),
-toppra's solve of both legs, and the sampling of the result (forces and
-slider rates from the C API every 0.1 ms).
-
-With --grids it also prints how the cycle time converges as the grid is
-refined: the time on each grid, its difference from the finest and from the
-Richardson extrapolate of the two finest (the error is first order in the
-grid step).
+pkm4puu.plan_cycle on the standard cycle against the target of one second,
+beside the cycle time it plans and its parts measured in the same run: the
+C API's inverse dynamics along the grid, toppra's solve of both legs, and
+the sampling of the result every 0.1 ms. --grids: the cycle time on each
+grid against the finest and the Richardson extrapolate of the two finest
+(the error is first order in the grid step).
 
 usage: pick_place_bench.py [--build DIR] [--repeat N] [--grids N [N ...]]
 """
