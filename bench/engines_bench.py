@@ -63,18 +63,16 @@ def timed(run, batches, setup=None):
     return per
 
 
-def c_cases(program, batches, keep_runs):
-    """One run of `pkm_fmu_bench compare`: {case: its summary row, with "run" (kept runs only)}, and its output."""
+def c_cases(program, batches):
+    """One run of `pkm_fmu_bench compare`: {case: its summary row, with its "run"}, and its output."""
     with tempfile.TemporaryDirectory() as tmp:
         out = run_program(program, ["compare", "--out", tmp, "--batches", str(batches)])
         with open(Path(tmp) / "summary.csv") as f:
             cases = {row["case"]: row for row in csv.DictReader(f)}
         for key, c in cases.items():
-            c["run"] = None
-            if keep_runs:
-                d = np.genfromtxt(Path(tmp) / f"{key}.csv", delimiter=",", names=True)
-                c["run"] = {n: d[n] for n in ("t", "x", "y", "z", "phi")}
-                c["run"]["delta_rho1"] = d["rho1"] - d["rho1"][0]
+            d = np.genfromtxt(Path(tmp) / f"{key}.csv", delimiter=",", names=True)
+            c["run"] = {n: d[n] for n in ("t", "x", "y", "z", "phi")}
+            c["run"]["delta_rho1"] = d["rho1"] - d["rho1"][0]
     return cases, out
 
 
@@ -174,7 +172,7 @@ def main(argv=None):
     first, c_out = None, ""
     for r in range(args.rounds):
         log(f"round {r + 1} of {args.rounds}")
-        cases, out = c_cases(program, args.batches, keep_runs=(r == 0))
+        cases, out = c_cases(program, args.batches)
         first, c_out = first or cases, c_out or out
         for key, c in cases.items():
             add(key, c["median_s_per_sim_s"], c["min_s_per_sim_s"])
@@ -215,7 +213,8 @@ def main(argv=None):
                      f"{cs} | {ds} | {forces} |")
 
     print(c_out.rstrip() + "\n")
-    print(f"engines_bench: python {platform.python_version()}, mujoco {mujoco.__version__}, pinocchio {pin.__version__}")
+    print(f"engines_bench: python {platform.python_version()}, mujoco {mujoco.__version__}, "
+          f"pinocchio {pin.__version__}")
     print(f"one simulated second of the comparison test at a 1 ms step; {args.rounds} interleaved rounds of "
           f"{args.batches} batches (Pinocchio: 1 per round): median of the rounds' medians, and the best batch; "
           "‖C(q)‖ and the differences over the whole 1.5 s test (one-call rows: at 0.5, 1 and 1.5 s), against "
@@ -225,10 +224,9 @@ def main(argv=None):
     print(f"derivatives, Pinocchio: constraintDynamics {1e6 * t_cd:.1f} us, with computeConstraintDynamicsDerivatives "
           f"{1e6 * t_dd:.1f} us per call (16 coordinates, 4 constraints, from Python): {t_dd / t_cd:.2f}x; this "
           "project's Jacobians A, B over one state derivative: pkm_bench, item 1b")
-    for how, t in (("median", median), ("best batches", best)):
-        c_us, py_us = 1e3 * t["mujoco_rollout"], 1e3 * t["mujoco_loop"]  # per 1 ms step
-        print(f"mj_step per 1 ms step ({how}): {c_us:.2f} us in mujoco.rollout (C loop), {py_us:.2f} us in a Python "
-              f"loop (mj_step + setting ctrl): the Python loop adds {py_us - c_us:+.2f} us per step")
+    adds = [1e3 * (t["mujoco_loop"] - t["mujoco_rollout"]) for t in (median, best)]  # us per 1 ms step
+    print(f"a Python loop (mj_step + setting ctrl) adds {adds[0]:+.2f} us per mj_step to mujoco.rollout's C loop "
+          f"(best batches: {adds[1]:+.2f} us)")
     print("the targets compare C loop with C loop (the FMU's ticks: step + 12-output read, against mj_step RK4 1 ms)")
     for key, target in TARGETS:
         ratio = t_mj / median[key]

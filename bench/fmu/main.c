@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
   plant.so = o.so;
   if (!o.xml) o.xml = xml_path = default_xml_path(o.so, sub);
   plant.text = o.xml ? read_text(o.xml) : NULL;
-  ok = load(sub, o.xml ? o.xml : "", &plant);
+  ok = load(sub, o.xml ? o.xml : "(none beside the binary: give --xml)", &plant);
   if (ok) {
     printf("pkm_fmu_bench %s: %s\n", sub->name, sub->summary);
     bench_print_machine();
