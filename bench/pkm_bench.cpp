@@ -617,8 +617,8 @@ void stiff_cases(double rk4_tick_us) {
       std::snprintf(cell, sizeof cell, "%.2f/%ld", o->us, o->last.ok_steps);
       std::printf(" %14s", cell);
     }
-    std::printf(" %10.2f %10.2f %10.2f %11.2g%%\n", r4.last.ok_steps ? rb.us / r4.us : 0.0, rb.us / rk4_tick_us, rb.us / cv.us,
-                scale > 0 ? 100 * dev / scale : 0.0);
+    std::printf(" %10.2f %10.2f %10.2f %11.2g%%\n", r4.last.ok_steps ? rb.us / r4.us : 0.0, rb.us / rk4_tick_us,
+                rb.us / cv.us, scale > 0 ? 100 * dev / scale : 0.0);
   }
   std::printf("us/ok: median microseconds per step (the failing step included) / steps answered OK; /RK4 tick: ROS2\n"
               "against the held-input RK4 tick above (%.3f us, the default machine). RK4 refuses the stuck-friction\n"
