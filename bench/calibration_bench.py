@@ -2,18 +2,13 @@
 """Speed of the identification (a benchmark, not a test): pkm4puu.identify on
 --seconds (default 10) of a 1 kHz drive log, against the target of one
 second for 10 s, beside the regressor's own share measured in the same run
-(pkm_regressor_joints over the same samples: the C API's part).
-
-The log: a random Fourier trajectory within the workspace
-(pkm4puu.calibration.random_trajectory), the sliders' positions and the
-exact forces F = Y pi + F0 from the C API, 1 % force noise and 1 um
-encoder quantisation. The first call (scipy's modules imported, the
-library loaded) and the median of --repeat later calls are printed, and the
-peak memory one call allocates (tracemalloc) against the stacked regressor's
-size (n x 4 x n_pi doubles, what least squares on the stacked rows holds at
-the least): the regressor goes in blocks of calibration.identification.BLOCK
-samples, so the peak falls below it once the log is a few blocks long
-(--seconds 100 and more).
+(pkm_regressor_joints over the same samples: the C API's part); the first
+call (imports, library) and the median of --repeat later calls; the peak
+memory of one call (tracemalloc) against the stacked regressor's size (the
+regressor goes in blocks of calibration.identification.BLOCK samples, so the
+peak falls below it from a few blocks on: --seconds 100). The log: a random
+Fourier trajectory, the exact forces from the C API, 1 % force noise and
+1 um encoder quantisation.
 
 usage: calibration_bench.py [--build DIR] [--seconds S] [--repeat N]
 """

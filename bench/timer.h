@@ -58,14 +58,8 @@ static inline void bench_print_machine(void) {
   char line[512], cpu[256] = "unknown processor", os[256] = "unknown system";
   long cores = 0;
   FILE* fp = fopen("/proc/cpuinfo", "r");
-  while (fp && fgets(line, sizeof line, fp)) {
-    const char* v = strncmp(line, "model name", 10) == 0 ? strchr(line, ':') : NULL;
-    if (v) {
-      snprintf(cpu, sizeof cpu, "%s", v + 1 + strspn(v + 1, " \t"));
-      cpu[strcspn(cpu, "\r\n")] = '\0';
-      break;
-    }
-  }
+  while (fp && fgets(line, sizeof line, fp))
+    if (strncmp(line, "model name", 10) == 0 && sscanf(strchr(line, ':') + 1, " %255[^\r\n]", cpu) == 1) break;
   if (fp) fclose(fp);
 #if defined(_WIN32)
   SYSTEM_INFO si;

@@ -5,15 +5,11 @@
  * instance (glibc mallinfo2, over 64), instantiate + initialise (median of
  * 101), and the batch throughput of one thread per online core against one
  * thread, with the CPU time the threads got. From the home pose, the holding
- * forces plus 0.2 t N on F[1] as value and slope each tick (CVODE continues).
- *
- *   pkm_fmu_bench cost [--batches B] [--seconds S] */
-#define _GNU_SOURCE
+ * forces plus 0.2 t N on F[1] as value and slope each tick (CVODE continues). */
+#include "fmu_bench.h"
 
 #include <malloc.h>
 #include <pthread.h>
-
-#include "fmu_bench.h"
 
 #define MAX_BATCHES 101
 #define N_STEPS 3
@@ -27,7 +23,7 @@ static const struct {
   const char* name;
   int solver;
   double rtol;
-} solvers[N_SOLVERS] = {{"RK4, rk4_step = min(h, 1 ms)", 1, 0.0},
+} solvers[N_SOLVERS] = {{"RK4, rk4_step = min(h, 1 ms)", 1, 1e-8},
                         {"CVODE rtol 1e-6", 0, 1e-6},
                         {"CVODE rtol 1e-8 (default)", 0, 1e-8},
                         {"CVODE rtol 1e-10", 0, 1e-10}};
@@ -36,10 +32,9 @@ static const Plant* plant; /* the subcommand's, for the worker threads */
 static fmi2ValueReference settings[3]; /* rtol, atol, rk4_step */
 static double F[N_STEPS][MAX_TICKS][4], dF[N_STEPS][MAX_TICKS][4];
 
-static fmi2Component instantiate(const char* name, int i, int j, fmi2FMUstate* home) {
+static fmi2Component instantiate_cell(const char* name, int i, int j, fmi2FMUstate* home) {
   const fmi2Real values[3] = {solvers[i].rtol, solvers[i].rtol / 100.0, steps[j] < 1e-3 ? steps[j] : 1e-3};
-  return solvers[i].solver == 0 ? instantiate_plant(plant, name, 0, 2, settings, values, home)
-                                : instantiate_plant(plant, name, 1, 1, settings + 2, values + 2, home);
+  return instantiate(plant, FMI2_CS, name, solvers[i].solver, 3, settings, values, home);
 }
 
 /* One simulated second of instance c from t = 0 at the step steps[j]: its wall time, < 0 on failure. */
@@ -63,8 +58,8 @@ static void* worker(void* arg) {
   Worker* w = arg;
   const double start = bench_now(), cpu0 = thread_cpu_seconds();
   for (w->ok = 1; w->ok && bench_now() - start < w->seconds; w->sim_seconds += 1.0) {
-    fmi2Component c = instantiate("batch", w->solver, 1, NULL);
-    w->ok = c && second(c, 1) >= 0.0 && free_plant(plant, c, NULL);
+    fmi2Component c = instantiate_cell("batch", w->solver, 1, NULL);
+    w->ok = c && second(c, 1) >= 0.0 && free_instance(plant, FMI2_CS, c, NULL);
   }
   w->seconds = bench_now() - start;
   w->cpu = thread_cpu_seconds() - cpu0;
@@ -76,13 +71,12 @@ static double throughput(int n, int solver, double seconds, double* cores) {
   pthread_t th[256];
   Worker w[256];
   double sim = 0.0, wall = 0.0, cpu = 0.0;
-  int i;
-  for (i = 0; i < n; ++i) {
+  for (int i = 0; i < n; ++i) {
     w[i] = (Worker){solver, 0, seconds, 0.0, 0.0};
     if (pthread_create(&th[i], NULL, worker, &w[i]) != 0) return -1.0;
   }
-  for (i = 0; i < n; ++i) pthread_join(th[i], NULL);
-  for (i = 0; i < n; ++i) {
+  for (int i = 0; i < n; ++i) pthread_join(th[i], NULL);
+  for (int i = 0; i < n; ++i) {
     if (!w[i].ok) return -1.0;
     sim += w[i].sim_seconds, cpu += w[i].cpu, wall = w[i].seconds > wall ? w[i].seconds : wall;
   }
@@ -96,24 +90,20 @@ static int cost_run(const Plant* p, const Options* o) {
   fmi2Component c[N_SOLVERS][N_STEPS];
   fmi2FMUstate home[N_SOLVERS][N_STEPS];
   long cores = sysconf(_SC_NPROCESSORS_ONLN);
-  int i, j, k, b, ok = 1;
+  int i, j, ok = lookup_value_references(p, names, 3, settings);
   plant = p;
   cores = cores < 1 ? 1 : cores > 256 ? 256 : cores;
-  if (!lookup_value_references(p, names, 3, settings)) return 0;
   for (j = 0; j < N_STEPS; ++j)
-    for (k = 0; k < MAX_TICKS; ++k) {
+    for (int k = 0; k < MAX_TICKS; ++k) {
       for (i = 0; i < 4; ++i) F[j][k][i] = STATIC_FORCE, dF[j][k][i] = 0.0;
       F[j][k][0] += 0.2 * k * steps[j], dF[j][k][0] = 0.2;
     }
-  printf("pkm_fmu_bench cost: the plant FMU's cost (FMI 2.0 CS through dlopen, plain C)\n");
-  bench_print_machine();
-  printf("fmu:     %s\n", p->so);
   printf("%d interleaved batches per cell (median, min in parentheses); throughput over %.1f s\n\n", o->batches,
          o->seconds);
   /* one instance per cell; each batch restores the state after initialisation (untimed), times one second */
   for (i = 0; i < N_SOLVERS; ++i)
-    for (j = 0; j < N_STEPS; ++j) ok = ok && (c[i][j] = instantiate("cell", i, j, &home[i][j])) != NULL;
-  for (b = -1; ok && b < o->batches; ++b)
+    for (j = 0; j < N_STEPS; ++j) ok = ok && (c[i][j] = instantiate_cell("cell", i, j, &home[i][j])) != NULL;
+  for (int b = -1; ok && b < o->batches; ++b)
     for (i = 0; ok && i < N_SOLVERS; ++i)
       for (j = 0; ok && j < N_STEPS; ++j) {
         double s = -1.0;
@@ -128,18 +118,18 @@ static int cost_run(const Plant* p, const Options* o) {
     for (j = 0; j < N_STEPS; ++j) {
       double mn, md = bench_median(per[i][j], (size_t)o->batches, &mn);
       printf(" %.2f ms (%.2f) |", 1e3 * md, 1e3 * mn);
-      ok = free_plant(p, c[i][j], &home[i][j]) && ok;
+      ok = free_instance(p, FMI2_CS, c[i][j], &home[i][j]) && ok;
     }
     printf("\n");
   }
   for (i = 0; ok && i < N_SOLVERS; i += 2) { /* RK4 and CVODE at its defaults */
     fmi2Component cs[N_MEMORY];
-    double t_init[N_INIT], t_free[N_INIT], mn_i, mn_f, md_i, md_f, got_one = 0.0, got_all = 0.0, one, all;
+    double t_init[N_INIT], t_free[N_INIT], mn_i, mn_f, got_one = 0.0, got_all = 0.0;
 #if defined(__GLIBC__)
     struct mallinfo2 before, after;
     malloc_trim(0);
     before = mallinfo2();
-    for (j = 0; ok && j < N_MEMORY; ++j) ok = (cs[j] = instantiate("memory", i, 1, NULL)) != NULL;
+    for (j = 0; ok && j < N_MEMORY; ++j) ok = (cs[j] = instantiate_cell("memory", i, 1, NULL)) != NULL;
     after = mallinfo2();
     while (j > 0) p->fmu.fmi2FreeInstance(cs[--j]);
     printf("| memory per instance, %s, initialised (heap in use / %d instances) | %.1f kB | | |\n", solvers[i].name,
@@ -150,18 +140,16 @@ static int cost_run(const Plant* p, const Options* o) {
 #endif
     for (j = 0; ok && j < N_INIT; ++j) {
       const double t0 = bench_now();
-      fmi2Component ci = instantiate("init", i, 1, NULL);
+      fmi2Component ci = instantiate_cell("init", i, 1, NULL);
       const double t1 = bench_now();
-      ok = ci && free_plant(p, ci, NULL);
+      ok = ci && free_instance(p, FMI2_CS, ci, NULL);
       t_init[j] = t1 - t0, t_free[j] = bench_now() - t1;
     }
     if (!ok) return 0;
-    md_i = bench_median(t_init, N_INIT, &mn_i);
-    md_f = bench_median(t_free, N_INIT, &mn_f);
+    const double md_i = bench_median(t_init, N_INIT, &mn_i), md_f = bench_median(t_free, N_INIT, &mn_f);
     printf("| instantiate + initialise, %s (median of %d; then terminate + free) | %.1f µs (%.1f); %.1f µs | | |\n",
            solvers[i].name, N_INIT, 1e6 * md_i, 1e6 * mn_i, 1e6 * md_f);
-    one = throughput(1, i, o->seconds, &got_one);
-    all = throughput((int)cores, i, o->seconds, &got_all);
+    const double one = throughput(1, i, o->seconds, &got_one), all = throughput((int)cores, i, o->seconds, &got_all);
     if (one < 0 || all < 0) return 0;
     printf("| batch throughput, %s, h = 1 ms, instantiation included: instances × simulated s per wall s | "
            "%.0f on %ld threads, which got %.2f cores' CPU time (per CPU second: %.0f); 1 thread: %.0f (got %.2f) "

@@ -1,11 +1,17 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench: what its subcommands share (main.c defines it): the
- * options, the loaded FMU, an instance set up for a solver, the one loop of
- * a master's ticks. */
+ * options, the loaded FMU, its instances, the one loop of a master's ticks.
+ * Each source file includes it first (it asks for POSIX and GNU functions). */
 #ifndef PKM_BENCH_FMU_BENCH_H
 #define PKM_BENCH_FMU_BENCH_H
 
+#ifndef _GNU_SOURCE
+#define _GNU_SOURCE
+#endif
+#include <math.h>
+
 #define PKM_HARNESS_NAME "pkm_fmu_bench"
+#include "fmi3FunctionTypes.h"
 #include "fmu_harness.h"
 #include "timer.h"
 
@@ -18,10 +24,18 @@ typedef struct {
   double seconds; /* --seconds (cost) */
 } Options;
 
-/* The FMU binary, loaded, its model description's text and guid; the plant's F[1..4], controller outputs, solver. */
+typedef struct {
+#define PKM_BENCH_DECLARE3(name) name##TYPE* name;
+  PKM_FMI3_FUNCTIONS(PKM_BENCH_DECLARE3)
+#undef PKM_BENCH_DECLARE3
+} Fmu3;
+
+/* The FMU binary, loaded (FMI 3.0 too for the inverse FMU), its model description's text and guid; the plant's
+ * F[1..4], controller outputs and solver. */
 typedef struct {
   Fmu fmu;
-  const char *so, *xml, *text;
+  Fmu3 fmu3;
+  const char *so, *text;
   char guid[128];
   fmi2ValueReference F[4], control[12], solver;
 } Plant;
@@ -37,12 +51,14 @@ typedef struct {
 extern const Subcommand compare_subcommand, cost_subcommand, latency_subcommand, jacobian_subcommand,
     inverse_subcommand;
 
-/* A Co-Simulation instance with `solver` and n parameters set, initialised, its state then in *home (if given);
- * NULL after a message on failure. */
-fmi2Component instantiate_plant(const Plant* plant, const char* name, int solver, size_t n,
-                                const fmi2ValueReference* vr, const fmi2Real* values, fmi2FMUstate* home);
-/* Frees *home (if any), terminates and frees the instance; 0 if a call failed. */
-int free_plant(const Plant* plant, fmi2Component c, fmi2FMUstate* home);
+enum { FMI2_CS, FMI2_ME, FMI3_CS, FMI3_ME }; /* an instance's interface */
+
+/* An instance of `kind`, initialised (Model Exchange: in continuous-time mode); with FMI 2.0 its solver (if >= 0) and
+ * n Real parameters set first and its state then kept in *home (if given). NULL after a message on failure. */
+void* instantiate(const Plant* plant, int kind, const char* name, int solver, size_t n, const fmi2ValueReference* vr,
+                  const fmi2Real* values, fmi2FMUstate* home);
+/* Frees *home (if given), terminates and frees the instance; 0 if a call failed. */
+int free_instance(const Plant* plant, int kind, void* c, fmi2FMUstate* home);
 /* The value references of names[0..n-1]; 0 after a message if one is missing. */
 int lookup_value_references(const Plant* plant, const char* const* names, size_t n, fmi2ValueReference* vr);
 

@@ -1,20 +1,10 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench inverse: the inverse FMU's tick against MuJoCo's mj_inverse
- * on the same mechanism, both timed here in C, the cases interleaved batch
- * by batch. A tick, as a computed-force controller drives it every 1 ms: set
- * the 12 motion inputs, advance (Co-Simulation: DoStep; Model Exchange:
- * SetTime), get F[1..4]; FMI 2.0 and 3.0. The motion: a smooth loop about
- * the home pose, tabulated (new inputs every tick, so every get computes).
- * mj_inverse where the program was built with MuJoCo (PKM_HAVE_MUJOCO) and
- * given the MJCF and the state (qpos, qvel, qacc) bench/engines_bench.py
- * writes. Target: tick / mj_inverse <= 0.1 (printed, never asserted).
- *
- *   pkm_fmu_bench inverse [--batches N] [--mjcf FILE --state FILE] */
-#define _GNU_SOURCE
-
-#include <math.h>
-
-#include "fmi3FunctionTypes.h"
+/* pkm_fmu_bench inverse: the inverse FMU's tick (FMI 2.0 and 3.0, as a
+ * computed-force controller drives it every 1 ms) against MuJoCo's mj_inverse
+ * on the same mechanism, both timed here in C, the cases interleaved batch by
+ * batch. The motion: a smooth loop about the home pose, tabulated (new inputs
+ * every tick, so every get computes). mj_inverse where the program was built
+ * with MuJoCo and given the MJCF and state bench/engines_bench.py writes. */
 #include "fmu_bench.h"
 
 #if PKM_HAVE_MUJOCO
@@ -26,27 +16,15 @@
 #define H 1e-3
 #define TARGET 0.1 /* tick / mj_inverse */
 
-typedef struct {
-#define DECLARE3(name) name##TYPE* name;
-  PKM_FMI3_FUNCTIONS(DECLARE3)
-#undef DECLARE3
-} Fmu3;
-
-static void logger3(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message) {
-  (void)env;
-  if (status == fmi3Error || status == fmi3Fatal) fprintf(stderr, "[fmi3] %s: %s\n", category, message);
-}
-
-enum { FMI2_CS, FMI2_ME, FMI3_CS, FMI3_ME };
 static const char* const kind_names[4] = {"FMI 2.0 Co-Simulation", "FMI 2.0 Model Exchange", "FMI 3.0 Co-Simulation",
                                           "FMI 3.0 Model Exchange"};
 static double motion[TICKS][12]; /* x, y on a circle of 2 mm, z +-5 mm, phi +-0.05 rad; rates, accelerations */
-static const Fmu* f2;
-static Fmu3 f3;
 static fmi2ValueReference in[12], out[4];
 
 /* A batch of ticks of `kind` on instance c from time *t: the time per tick, < 0 after a message on failure. */
-static double time_ticks(int kind, void* c, double* t, double* sum) {
+static double time_ticks(const Plant* plant, int kind, void* c, double* t, double* sum) {
+  const Fmu* f2 = &plant->fmu;
+  const Fmu3* f3 = &plant->fmu3;
   fmi3Boolean event, terminate, early;
   fmi3Float64 reached;
   double F[4] = {0, 0, 0, 0};
@@ -59,45 +37,14 @@ static double time_ticks(int kind, void* c, double* t, double* sum) {
     if (kind == FMI2_ME)
       FMI_CHECK(f2->fmi2SetTime(c, *t + H) || f2->fmi2SetReal(c, in, 12, u) || f2->fmi2GetReal(c, out, 4, F));
     if (kind == FMI3_CS)
-      FMI_CHECK(f3.fmi3SetFloat64(c, in, 12, u, 12) ||
-                f3.fmi3DoStep(c, *t, H, fmi3True, &event, &terminate, &early, &reached) ||
-                f3.fmi3GetFloat64(c, out, 4, F, 4));
+      FMI_CHECK(f3->fmi3SetFloat64(c, in, 12, u, 12) ||
+                f3->fmi3DoStep(c, *t, H, fmi3True, &event, &terminate, &early, &reached) ||
+                f3->fmi3GetFloat64(c, out, 4, F, 4));
     if (kind == FMI3_ME)
-      FMI_CHECK(f3.fmi3SetTime(c, *t + H) || f3.fmi3SetFloat64(c, in, 12, u, 12) || f3.fmi3GetFloat64(c, out, 4, F, 4));
+      FMI_CHECK(f3->fmi3SetTime(c, *t + H) || f3->fmi3SetFloat64(c, in, 12, u, 12) ||
+                f3->fmi3GetFloat64(c, out, 4, F, 4));
   }
   return (bench_now() - t0) / (REPEAT * TICKS);
-}
-
-/* An instance of `kind` after initialisation (Model Exchange: in continuous-time mode); NULL on failure. */
-static void* instantiate(const char* guid, int kind) {
-  static const fmi2CallbackFunctions callbacks = {logger, allocate_memory, free, NULL, NULL};
-  fmi2EventInfo info;
-  fmi3Boolean a, b, d, e, g;
-  fmi3Float64 next;
-  void* c;
-  int ok;
-  if (kind <= FMI2_ME) {
-    c = f2->fmi2Instantiate("inverse", kind == FMI2_CS ? fmi2CoSimulation : fmi2ModelExchange, guid, "", &callbacks,
-                            fmi2False, fmi2False);
-    ok = c && !f2->fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) &&
-         !f2->fmi2EnterInitializationMode(c) && !f2->fmi2ExitInitializationMode(c) &&
-         (kind == FMI2_CS || (!f2->fmi2NewDiscreteStates(c, &info) && !f2->fmi2EnterContinuousTimeMode(c)));
-  } else {
-    c = kind == FMI3_CS ? f3.fmi3InstantiateCoSimulation("inverse", guid, NULL, fmi3False, fmi3False, fmi3False,
-                                                         fmi3False, NULL, 0, NULL, logger3, NULL)
-                        : f3.fmi3InstantiateModelExchange("inverse", guid, NULL, fmi3False, fmi3False, NULL, logger3);
-    ok = c && !f3.fmi3EnterInitializationMode(c, fmi3False, 0.0, 0.0, fmi3False, 0.0) &&
-         !f3.fmi3ExitInitializationMode(c) &&
-         (kind == FMI3_CS ||
-          (!f3.fmi3UpdateDiscreteStates(c, &a, &b, &d, &e, &g, &next) && !f3.fmi3EnterContinuousTimeMode(c)));
-  }
-  if (!ok) fprintf(stderr, "pkm_fmu_bench inverse: instantiating (%s) failed\n", kind_names[kind]);
-  return ok ? c : NULL;
-}
-
-static void free_instance(int kind, void* c) {
-  if (kind <= FMI2_ME) f2->fmi2Terminate(c), f2->fmi2FreeInstance(c);
-  else f3.fmi3Terminate(c), f3.fmi3FreeInstance(c);
 }
 
 #if PKM_HAVE_MUJOCO
@@ -126,15 +73,11 @@ static int inverse_run(const Plant* plant, const Options* o) {
   void* c[4] = {NULL, NULL, NULL, NULL};
   int b, k, have_mj = 0, ok = per && lookup_value_references(plant, inputs, 12, in) &&
                                lookup_value_references(plant, outputs, 4, out);
-#define LOAD3(name) ok = ok && load_symbol(plant->fmu.handle, #name, &f3.name, sizeof f3.name);
-  PKM_FMI3_FUNCTIONS(LOAD3)
-#undef LOAD3
 #if PKM_HAVE_MUJOCO
   mjModel* mm = NULL;
   mjData* md = NULL;
   if (ok && o->mjcf && o->state) ok = have_mj = load_mujoco(o->mjcf, o->state, &mm, &md);
 #endif
-  f2 = &plant->fmu;
   for (k = 0; k < TICKS; ++k) { /* one period per table, with the exact rates and accelerations */
     const double w = 2.0 * PI, s = sin(w * k * H), co = cos(w * k * H), a[4] = {0.002, 0.002, 0.005, 0.05};
     const double p[4] = {a[0] * s, a[1] * co, a[2] * s, a[3] * s}, v[4] = {a[0] * w * co, -a[1] * w * s, a[2] * w * co,
@@ -142,14 +85,12 @@ static int inverse_run(const Plant* plant, const Options* o) {
     for (b = 0; b < 4; ++b)
       motion[k][b] = p[b] + (b == 2 ? 0.05 : 0.0), motion[k][4 + b] = v[b], motion[k][8 + b] = -w * w * p[b];
   }
-  printf("pkm_fmu_bench inverse: the inverse FMU's tick against MuJoCo's mj_inverse\n");
-  bench_print_machine();
-  printf("inverse FMU: %s\ntick = set the 12 motion inputs, advance (CS: DoStep 1 ms; ME: SetTime), get F[1..4];\n"
+  printf("tick = set the 12 motion inputs, advance (CS: DoStep 1 ms; ME: SetTime), get F[1..4];\n"
          "median and min per call over %d batches of %d calls, the cases interleaved batch by batch\n\n",
-         plant->so, n, REPEAT * TICKS);
-  for (k = 0; ok && k < 4; ++k) ok = (c[k] = instantiate(plant->guid, k)) != NULL;
+         n, REPEAT * TICKS);
+  for (k = 0; ok && k < 4; ++k) ok = (c[k] = instantiate(plant, k, kind_names[k], -1, 0, NULL, NULL, NULL)) != NULL;
   for (b = 0; ok && b < n; ++b) {
-    for (k = 0; ok && k < 4; ++k) ok = (per[k * n + b] = time_ticks(k, c[k], &t[k], &sum)) > 0.0;
+    for (k = 0; ok && k < 4; ++k) ok = (per[k * n + b] = time_ticks(plant, k, c[k], &t[k], &sum)) > 0.0;
 #if PKM_HAVE_MUJOCO
     for (k = 0, per[4 * n + b] = bench_now(); ok && have_mj && k < REPEAT * TICKS; ++k)
       mj_inverse(mm, md), sum += md->qfrc_inverse[0];
@@ -158,7 +99,7 @@ static int inverse_run(const Plant* plant, const Options* o) {
   }
   for (k = 0; ok && k < 4 + have_mj; ++k) med[k] = bench_median(per + k * n, (size_t)n, &mn[k]);
   for (k = 0; k < 4; ++k)
-    if (c[k]) free_instance(k, c[k]);
+    if (c[k]) free_instance(plant, k, c[k], NULL);
 #if PKM_HAVE_MUJOCO
   if (md) mj_deleteData(md);
   if (mm) mj_deleteModel(mm);

@@ -2,18 +2,9 @@
 /* pkm_fmu_bench jacobian: the full Jacobian [A B] (8 x 20) of the state
  * derivative through fmi2GetDirectionalDerivative (Model Exchange, at an
  * off-centre, rotated, moving state with the holding forces) against the C
- * API's pkm_forward_derivatives, in one run. Each evaluation moves x by
- * 1e-12 m * (k % 1024), so nothing is reused across evaluations: (a) the C
- * API; (b) SetContinuousStates and 20 calls, all 20 knowns with a unit seed;
- * (c) (b) at an unchanged state: the FMI overhead (the FMU evaluates the
- * Jacobians once per point); (d), (e): (b), (c) with one known per call.
- * Target: (b) <= 2 (a) + (c), the same for (d) with (e).
- *
- *   pkm_fmu_bench jacobian [--batches N] */
-#define _GNU_SOURCE
-
-#include <math.h>
-
+ * API's pkm_forward_derivatives, the cases below. Each evaluation moves x by
+ * 1e-12 m * (k % 1024), so nothing is reused across them; at an unchanged
+ * state the FMU evaluates the Jacobians once, which leaves the FMI overhead. */
 #include "fmu_bench.h"
 #include "pkm4puu/pkm.h"
 
@@ -33,28 +24,27 @@ static int batch(const Fmu* f, fmi2Component c, pkm_model* m, int kind, double* 
   const double inputs[12] = {STATIC_FORCE, STATIC_FORCE, STATIC_FORCE, STATIC_FORCE}, one = 1.0;
   const int single = kind == CASE_SINGLE || kind == CASE_SINGLE_OVERHEAD;
   const int moving = kind == CASE_FMI || kind == CASE_SINGLE || kind == CASE_CAPI;
-  int k, j, i;
   memcpy(x, kState, sizeof x);
   if (!moving) FMI_CHECK(f->fmi2SetContinuousStates(c, x, 10));
   *seconds = bench_now();
-  for (k = 0; k < EVALS; ++k) {
+  for (int k = 0; k < EVALS; ++k) {
     if (moving) x[0] = kState[0] + 1e-12 * (double)(k % 1024);
     if (kind == CASE_CAPI) {
       if (pkm_forward_derivatives(m, x, inputs, ydot, A, B) == PKM_OK) continue;
       return fprintf(stderr, "pkm_fmu_bench: pkm_forward_derivatives failed\n"), 0;
     }
     FMI_CHECK(f->fmi2SetContinuousStates(c, x, 10));
-    for (j = 0; j < N_KNOWNS; ++j) {
+    for (int j = 0; j < N_KNOWNS; ++j) {
       seed[j] = 1.0;
       FMI_CHECK(single ? f->fmi2GetDirectionalDerivative(c, unknowns, N_UNKNOWNS, &knowns[j], 1, &one, col)
                        : f->fmi2GetDirectionalDerivative(c, unknowns, N_UNKNOWNS, knowns, N_KNOWNS, seed, col));
       seed[j] = 0.0;
-      for (i = 0; i < N_UNKNOWNS; ++i) J[i * N_KNOWNS + j] = col[i];
+      for (int i = 0; i < N_UNKNOWNS; ++i) J[i * N_KNOWNS + j] = col[i];
     }
   }
   *seconds = bench_now() - *seconds;
-  for (i = 0; kind == CASE_CAPI && i < N_UNKNOWNS; ++i) /* the last point's, as the FMI cases leave it */
-    for (j = 0; j < N_KNOWNS; ++j) J[i * N_KNOWNS + j] = j < 8 ? A[i * 8 + j] : B[i * 12 + j - 8];
+  for (int i = 0; kind == CASE_CAPI && i < N_UNKNOWNS; ++i) /* the last point's, as the FMI cases leave it */
+    for (int j = 0; j < N_KNOWNS; ++j) J[i * N_KNOWNS + j] = j < 8 ? A[i * 8 + j] : B[i * 12 + j - 8];
   return 1;
 }
 
@@ -69,46 +59,37 @@ static int jacobian_run(const Plant* plant, const Options* o) {
                                              "(c) FMI overhead: (b) at an unchanged state",
                                              "(d) FMI: SetContinuousStates + 20 calls, one known each",
                                              "(e) FMI overhead: (d) at an unchanged state"};
-  static const fmi2CallbackFunctions callbacks = {logger, allocate_memory, free, NULL, NULL};
   const Fmu* f = &plant->fmu;
   double per[N_CASES][BATCHES], med[N_CASES], mn[N_CASES], J[N_CASES][N_UNKNOWNS * N_KNOWNS], diff = 0.0, scale = 0.0;
   pkm_model* m = NULL;
-  fmi2EventInfo info;
   fmi2Component c = NULL;
-  int kind, b, i, ok = lookup_value_references(plant, unknown_names, N_UNKNOWNS, unknowns) &&
-                       lookup_value_references(plant, known_names, N_KNOWNS, knowns);
-  ok = ok && pkm_create(&m) == PKM_OK;
-  /* the Model Exchange instance in continuous-time mode */
-  ok = ok && (c = f->fmi2Instantiate("jacobian", fmi2ModelExchange, plant->guid, "", &callbacks, 0, 0)) != NULL &&
-       f->fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) == fmi2OK &&
-       f->fmi2EnterInitializationMode(c) == fmi2OK && f->fmi2ExitInitializationMode(c) == fmi2OK &&
-       f->fmi2NewDiscreteStates(c, &info) == fmi2OK && f->fmi2EnterContinuousTimeMode(c) == fmi2OK;
-  for (b = -1; ok && b < o->batches; ++b) /* one warm-up batch of each, then the batches interleaved */
-    for (kind = CASE_CAPI; ok && kind < N_CASES; ++kind) {
+  int ok = lookup_value_references(plant, unknown_names, N_UNKNOWNS, unknowns) &&
+           lookup_value_references(plant, known_names, N_KNOWNS, knowns);
+  ok = ok && pkm_create(&m) == PKM_OK && (c = instantiate(plant, FMI2_ME, "jacobian", -1, 0, NULL, NULL, NULL));
+  for (int b = -1; ok && b < o->batches; ++b) /* one warm-up batch of each, then the batches interleaved */
+    for (int kind = CASE_CAPI; ok && kind < N_CASES; ++kind) {
       double seconds = 0.0;
       ok = batch(f, c, m, kind, &seconds, J[kind]);
       if (b >= 0) per[kind][b] = seconds / EVALS;
     }
-  if (c && f->fmi2Terminate(c) != fmi2OK) ok = 0;
-  if (c) f->fmi2FreeInstance(c);
+  if (c && !free_instance(plant, FMI2_ME, c, NULL)) ok = 0;
   pkm_destroy(m);
   if (!ok) return 0;
-  for (kind = CASE_CAPI; kind < N_CASES; ++kind) med[kind] = 1e6 * bench_median(per[kind], (size_t)o->batches, &mn[kind]);
-  for (i = 0; i < N_UNKNOWNS * N_KNOWNS; ++i) {
+  for (int kind = CASE_CAPI; kind < N_CASES; ++kind)
+    med[kind] = 1e6 * bench_median(per[kind], (size_t)o->batches, &mn[kind]);
+  for (int i = 0; i < N_UNKNOWNS * N_KNOWNS; ++i) {
     diff = fmax(diff, fmax(fabs(J[CASE_FMI][i] - J[CASE_CAPI][i]), fabs(J[CASE_SINGLE][i] - J[CASE_CAPI][i])));
     scale = fmax(scale, fabs(J[CASE_CAPI][i]));
   }
-  printf("pkm_fmu_bench jacobian: the full Jacobian [A B] (8 x 20) of the state derivative, FMI 2.0 Model Exchange\n");
-  bench_print_machine();
-  printf("fmu:     %s\nscenario: default parameters, state (", plant->so);
-  for (i = 0; i < 8; ++i) printf("%.3g%s", kState[i], i < 7 ? ", " : "), ");
+  printf("scenario: default parameters, state (");
+  for (int i = 0; i < 8; ++i) printf("%.3g%s", kState[i], i < 7 ? ", " : "), ");
   printf("F = %.9f N; x += 1e-12 m * (k %% 1024) per evaluation; %d evaluations a batch, %d batches\n\n", STATIC_FORCE,
          EVALS, o->batches);
   printf("%-66s %10s %10s %9s\n", "per full Jacobian", "median us", "min us", "vs (a)");
-  for (kind = CASE_CAPI; kind < N_CASES; ++kind)
+  for (int kind = CASE_CAPI; kind < N_CASES; ++kind)
     printf("%-66s %10.3f %10.3f %8.2fx\n", names[kind], med[kind], 1e6 * mn[kind], med[kind] / med[CASE_CAPI]);
   printf("\n");
-  for (kind = CASE_FMI; kind < N_CASES; kind += 2) {
+  for (int kind = CASE_FMI; kind < N_CASES; kind += 2) {
     const double target = 2.0 + med[kind + 1] / med[CASE_CAPI], ratio = med[kind] / med[CASE_CAPI];
     printf("%s/(a) %.2f, target <= 2 + %s/(a) = %.2f  %s; FMI overhead %.3f us a call\n",
            kind == CASE_FMI ? "(b)" : "(d)", ratio, kind == CASE_FMI ? "(c)" : "(e)", target,
@@ -119,5 +100,6 @@ static int jacobian_run(const Plant* plant, const Options* o) {
   return 1;
 }
 
-const Subcommand jacobian_subcommand = {"jacobian", "the full Jacobian through fmi2GetDirectionalDerivative vs the C API",
-                                        jacobian_run, BATCHES, BATCHES, "", 0};
+const Subcommand jacobian_subcommand = {
+    "jacobian", "the state derivative's full Jacobian [A B] (8 x 20) through FMI 2.0 Model Exchange against the C API",
+    jacobian_run, BATCHES, BATCHES, "", 0};

@@ -1,22 +1,11 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench latency: the distribution of the control tick's time (SetReal
- * (F[1..4]) [+ SetRealInputDerivatives] + DoStep(1 ms) + GetReal of the 12
- * controller outputs), each tick timed on its own, over --batches batches of
- * 1000 ticks, each batch the same simulated second from the home pose (the
- * state after initialisation restored, untimed). F = the holding force, plus
- * on F[1] with RK4 0.2 cos(2 pi 3 t) N held over each tick, with CVODE the
- * ramp 0.2 t N as value and slope (CVODE continues across the ticks).
- *
- * The model's work at tick k is the same in every batch (same state, same
- * inputs, bit for bit) while the machine's interruptions fall on random
- * ticks: the minimum over the batches of tick k is the model's own time for
- * it, and the spread above it is the machine's.
- *
- *   pkm_fmu_bench latency [--batches N] */
-#define _GNU_SOURCE
-
-#include <math.h>
-
+/* pkm_fmu_bench latency: the distribution of the control tick's time, each
+ * tick timed on its own, each batch the same simulated second from the home
+ * pose. F = the holding force, plus on F[1] with RK4 0.2 cos(2 pi 3 t) N held
+ * over each tick, with CVODE the ramp 0.2 t N as value and slope. The model's
+ * work at tick k is the same in every batch, bit for bit, while the machine's
+ * interruptions fall on random ticks: the minimum over the batches of tick k
+ * is the model's own time for it, and the spread above it is the machine's. */
 #include "fmu_bench.h"
 
 #define TICKS 1000 /* a batch: one simulated second */
@@ -34,25 +23,26 @@ static void quantiles(const char* name, const double* sorted, size_t n, int max_
 
 static int run(const Plant* plant, int solver, int batches, double* ticks, const char* name) {
   fmi2FMUstate home = NULL;
-  fmi2Component c = instantiate_plant(plant, "latency", solver, 0, NULL, NULL, &home);
+  fmi2Component c = instantiate(plant, FMI2_CS, "latency", solver, 0, NULL, NULL, &home);
   double own[TICKS];
   const size_t n = (size_t)batches * TICKS;
-  size_t slow = 0, k;
-  int b, i;
-  for (k = 0; k < TICKS; ++k) {
+  size_t slow = 0;
+  for (int k = 0; k < TICKS; ++k) {
     const double t = k * H;
-    for (i = 0; i < 4; ++i) F[k][i] = STATIC_FORCE, dF[k][i] = 0.0;
+    for (int i = 0; i < 4; ++i) F[k][i] = STATIC_FORCE, dF[k][i] = 0.0;
     if (solver == 0) F[k][0] += 0.2 * t, dF[k][0] = 0.2;
     else F[k][0] += 0.2 * cos(2.0 * PI * 3.0 * (t + 0.5 * H));
   }
-  for (b = 0; c && b < batches; ++b) {
+  for (int b = 0; c && b < batches; ++b) {
     const Ticks t = {H, TICKS, F, solver == 0 ? dF : NULL, plant->control, 12, NULL, ticks + (size_t)b * TICKS};
     if (plant->fmu.fmi2SetFMUstate(c, home) != fmi2OK || run_ticks(plant, c, &t, 0.0) < 0.0) return 0;
   }
-  if (!c || !free_plant(plant, c, &home)) return 0;
-  for (k = 0; k < TICKS; ++k)
-    for (own[k] = ticks[k], b = 1; b < batches; ++b) own[k] = fmin(own[k], ticks[(size_t)b * TICKS + k]);
-  for (k = 0; k < n; ++k) slow += ticks[k] > 2.0 * own[k % TICKS];
+  if (!c || !free_instance(plant, FMI2_CS, c, &home)) return 0;
+  for (int k = 0; k < TICKS; ++k) {
+    own[k] = ticks[k];
+    for (int b = 1; b < batches; ++b) own[k] = fmin(own[k], ticks[(size_t)b * TICKS + k]);
+  }
+  for (size_t k = 0; k < n; ++k) slow += ticks[k] > 2.0 * own[k % TICKS];
   bench_sort(ticks, n);
   bench_sort(own, TICKS);
   quantiles(name, ticks, n, 0);
@@ -65,11 +55,9 @@ static int run(const Plant* plant, int solver, int batches, double* ticks, const
 static int latency_run(const Plant* plant, const Options* o) {
   double* ticks = malloc(sizeof(double) * (size_t)o->batches * TICKS);
   int ok = ticks != NULL;
-  printf("pkm_fmu_bench latency: %d control ticks of the plant FMU (FMI 2.0 CS, 1 ms), each timed\n",
-         o->batches * TICKS);
-  bench_print_machine();
   printf("tick: SetReal(F[1..4]) [+ SetRealInputDerivatives] + DoStep(1 ms) + GetReal(12 controller outputs)\n");
-  printf("%d batches of %d ticks, each from the home pose (FMU state restored, untimed)\n\n", o->batches, TICKS);
+  printf("%d batches of %d ticks, %d in all, each batch from the home pose (FMU state restored, untimed)\n\n",
+         o->batches, TICKS, o->batches * TICKS);
   printf("%-44s %9s %9s %9s %9s   (us)\n", "solver", "median", "p99", "p99.9", "max");
   ok = ok && run(plant, 1, o->batches, ticks, "RK4 (rk4_step 1 ms), forces held");
   ok = ok && run(plant, 0, o->batches, ticks, "CVODE (rtol 1e-8), forces as a ramp");
@@ -77,5 +65,5 @@ static int latency_run(const Plant* plant, const Options* o) {
   return ok;
 }
 
-const Subcommand latency_subcommand = {"latency", "10^6 control ticks (1000 batches of 1000), each timed",
+const Subcommand latency_subcommand = {"latency", "control ticks of the plant FMU (FMI 2.0 CS, 1 ms), each timed",
                                        latency_run, 1000, 1000, "", 0};

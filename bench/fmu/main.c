@@ -4,14 +4,7 @@
  * raw FMI functions, as a master drives it. Each prints a table with its
  * ratios measured in the same run; the exit status says whether the runs
  * worked (1 if a call fails or a file cannot be read, 2 for a usage error),
- * never how fast they were.
- *
- *   pkm_fmu_bench SUBCOMMAND [--fmu SO] [--xml modelDescription.xml] [--batches N] [its options]
- *
- * Default: the build's binary and its staged model description; for another
- * .so that of the unpacked FMU it sits in (<so>/../../../modelDescription.xml). */
-#define _GNU_SOURCE
-
+ * never how fast they were. --help lists the subcommands and their options. */
 #include "fmu_bench.h"
 
 static const Subcommand* const subcommands[] = {&compare_subcommand, &cost_subcommand, &latency_subcommand,
@@ -25,18 +18,16 @@ static int usage_error(const char* what, const char* arg) {
 
 /* The options after the subcommand (the common ones, or a word of sub->options); 0, or 2 after a message. */
 static int parse_options(const Subcommand* sub, int argc, char** argv, Options* o) {
-  int i;
-  for (i = 2; i < argc; i += 2) {
+  for (int i = 2; i < argc; i += 2) {
     const char *opt = argv[i], *value = i + 1 < argc ? argv[i + 1] : NULL, *own = strstr(sub->options, opt);
     const char** const targets[] = {&o->so, &o->xml, &o->out, &o->mjcf, &o->state};
     const char* const names[] = {"--fmu", "--xml", "--out", "--mjcf", "--state"};
     char* end = NULL;
-    size_t k;
     if (strncmp(opt, "--", 2) != 0 || (strcmp(opt, "--fmu") != 0 && strcmp(opt, "--xml") != 0 &&
                                        strcmp(opt, "--batches") != 0 && !(own && own[strlen(opt)] == ' ')))
       return usage_error(opt[0] == '-' ? "unknown option" : "unexpected argument", opt);
     if (!value) return usage_error("missing value after", opt);
-    for (k = 0; k < 5; ++k)
+    for (size_t k = 0; k < 5; ++k)
       if (strcmp(opt, names[k]) == 0) *targets[k] = value;
     if (strcmp(opt, "--batches") == 0 && ((o->batches = (int)strtol(value, &end, 10)), *end || o->batches < 1 ||
                                           o->batches > sub->max_batches))
@@ -47,7 +38,8 @@ static int parse_options(const Subcommand* sub, int argc, char** argv, Options* 
   return 0;
 }
 
-/* The model description that goes with the binary `so` (the caller frees it). */
+/* The model description that goes with the binary `so`: the build's staged one, or that of the unpacked FMU the .so
+ * sits in (<so>/../../../modelDescription.xml); the caller frees it. */
 static char* default_xml_path(const char* so, const Subcommand* sub) {
   size_t n = strlen(so);
   int slashes = 0;
@@ -61,24 +53,40 @@ static char* default_xml_path(const char* so, const Subcommand* sub) {
   return path;
 }
 
+/* The binary's functions and what the subcommand needs of its model description; 0 after a message. */
+static int load(const Subcommand* sub, const char* xml, Plant* p) {
+  const char* root = p->text ? strstr(p->text, "<fmiModelDescription") : NULL;
+  int ok;
+  if (!p->text) return fprintf(stderr, "pkm_fmu_bench: cannot read the model description %s\n", xml), 0;
+  if (sub->inverse)
+    ok = root && attribute(root, strchr(root, '>'), "guid", p->guid, sizeof p->guid);
+  else
+    ok = read_controller_interface(p->text, p->guid, sizeof p->guid, p->F, p->control) &&
+         lookup_value_reference(p->text, "solver", &p->solver);
+  ok = ok && load_fmu(p->so, &p->fmu);
+#define PKM_BENCH_LOAD3(name) ok = ok && load_symbol(p->fmu.handle, #name, &p->fmu3.name, sizeof p->fmu3.name);
+  if (sub->inverse) PKM_FMI3_FUNCTIONS(PKM_BENCH_LOAD3)
+#undef PKM_BENCH_LOAD3
+  return ok;
+}
+
 int main(int argc, char** argv) {
   const Subcommand* sub = NULL;
   Options o = {NULL, NULL, NULL, NULL, NULL, 0, 3.0};
   Plant plant;
-  char *xml_path = NULL, *text = NULL, *root;
-  size_t i;
+  char* xml_path = NULL;
   int ok;
   if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
     FILE* fp = argc < 2 ? stderr : stdout;
     fprintf(fp, "usage: pkm_fmu_bench SUBCOMMAND [--fmu SO] [--xml modelDescription.xml] [--batches N] [options]\n\n");
-    for (i = 0; i < N_SUBCOMMANDS; ++i)
+    for (size_t i = 0; i < N_SUBCOMMANDS; ++i)
       fprintf(fp, "  %-9s %s\n            --batches 1..%d (default %d)%s%s\n", subcommands[i]->name,
               subcommands[i]->summary, subcommands[i]->max_batches, subcommands[i]->default_batches,
               *subcommands[i]->options ? "; " : "", subcommands[i]->options);
     fprintf(fp, "\n--fmu: default the build's binary; --xml: default the model description that goes with it\n");
     return argc < 2 ? 2 : 0;
   }
-  for (i = 0; i < N_SUBCOMMANDS; ++i)
+  for (size_t i = 0; i < N_SUBCOMMANDS; ++i)
     if (strcmp(argv[1], subcommands[i]->name) == 0) sub = subcommands[i];
   if (!sub) return usage_error("unknown subcommand", argv[1]);
   o.batches = sub->default_batches;
@@ -86,50 +94,77 @@ int main(int argc, char** argv) {
   if (parse_options(sub, argc, argv, &o) != 0) return 2;
   memset(&plant, 0, sizeof plant);
   plant.so = o.so;
-  plant.xml = o.xml ? o.xml : (xml_path = default_xml_path(o.so, sub));
-  plant.text = text = plant.xml ? read_text(plant.xml) : NULL;
-  if (!text) fprintf(stderr, "pkm_fmu_bench: cannot read the model description %s\n", plant.xml ? plant.xml : "");
-  if (!text || sub->inverse)
-    ok = text && (root = strstr(text, "<fmiModelDescription")) && attribute(root, strchr(root, '>'), "guid", plant.guid,
-                                                                           sizeof plant.guid);
-  else
-    ok = read_controller_interface(text, plant.guid, sizeof plant.guid, plant.F, plant.control) &&
-         lookup_value_reference(text, "solver", &plant.solver);
-  ok = ok && load_fmu(o.so, &plant.fmu) && sub->run(&plant, &o);
+  if (!o.xml) o.xml = xml_path = default_xml_path(o.so, sub);
+  plant.text = o.xml ? read_text(o.xml) : NULL;
+  ok = load(sub, o.xml ? o.xml : "(none beside the binary: give --xml)", &plant);
+  if (ok) {
+    printf("pkm_fmu_bench %s: %s\n", sub->name, sub->summary);
+    bench_print_machine();
+    printf("fmu:     %s\n", plant.so);
+  }
+  ok = ok && sub->run(&plant, &o);
   if (plant.fmu.handle) dlclose(plant.fmu.handle);
-  free(text);
+  free((char*)plant.text);
   free(xml_path);
   if (!ok) fprintf(stderr, "pkm_fmu_bench %s: FAILED\n", sub->name);
   return ok ? 0 : 1;
 }
 
+static void logger3(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message) {
+  (void)env;
+  if (status == fmi3Error || status == fmi3Fatal) fprintf(stderr, "[fmi3] %s: %s\n", category, message);
+}
 
-fmi2Component instantiate_plant(const Plant* plant, const char* name, int solver, size_t n,
-                                const fmi2ValueReference* vr, const fmi2Real* values, fmi2FMUstate* home) {
+void* instantiate(const Plant* plant, int kind, const char* name, int solver, size_t n, const fmi2ValueReference* vr,
+                  const fmi2Real* values, fmi2FMUstate* home) {
   static const fmi2CallbackFunctions callbacks = {logger, allocate_memory, free, NULL, NULL};
-  const Fmu* f = &plant->fmu;
+  const Fmu* f2 = &plant->fmu;
+  const Fmu3* f3 = &plant->fmu3;
   const fmi2Integer s = solver;
-  fmi2Component c = f->fmi2Instantiate(name, fmi2CoSimulation, plant->guid, "", &callbacks, fmi2False, fmi2False);
-  if (c && !f->fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) &&
-      !f->fmi2SetInteger(c, &plant->solver, 1, &s) && (n == 0 || !f->fmi2SetReal(c, vr, n, values)) &&
-      !f->fmi2EnterInitializationMode(c) && !f->fmi2ExitInitializationMode(c) && (!home || !f->fmi2GetFMUstate(c, home)))
-    return c;
-  if (c) f->fmi2FreeInstance(c);
+  fmi2EventInfo info;
+  fmi3Boolean a, b, d, e, g;
+  fmi3Float64 next;
+  void* c;
+  int ok;
+  if (kind <= FMI2_ME) {
+    c = f2->fmi2Instantiate(name, kind == FMI2_CS ? fmi2CoSimulation : fmi2ModelExchange, plant->guid, "", &callbacks,
+                            fmi2False, fmi2False);
+    ok = c && !f2->fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) &&
+         (solver < 0 || !f2->fmi2SetInteger(c, &plant->solver, 1, &s)) &&
+         (n == 0 || !f2->fmi2SetReal(c, vr, n, values)) && !f2->fmi2EnterInitializationMode(c) &&
+         !f2->fmi2ExitInitializationMode(c) &&
+         (kind == FMI2_CS || (!f2->fmi2NewDiscreteStates(c, &info) && !f2->fmi2EnterContinuousTimeMode(c))) &&
+         (!home || !f2->fmi2GetFMUstate(c, home));
+  } else {
+    c = kind == FMI3_CS
+            ? f3->fmi3InstantiateCoSimulation(name, plant->guid, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL,
+                                              0, NULL, logger3, NULL)
+            : f3->fmi3InstantiateModelExchange(name, plant->guid, NULL, fmi3False, fmi3False, NULL, logger3);
+    ok = c && !f3->fmi3EnterInitializationMode(c, fmi3False, 0.0, 0.0, fmi3False, 0.0) &&
+         !f3->fmi3ExitInitializationMode(c) &&
+         (kind == FMI3_CS ||
+          (!f3->fmi3UpdateDiscreteStates(c, &a, &b, &d, &e, &g, &next) && !f3->fmi3EnterContinuousTimeMode(c)));
+  }
+  if (ok) return c;
+  if (c) kind <= FMI2_ME ? f2->fmi2FreeInstance(c) : f3->fmi3FreeInstance(c);
   fprintf(stderr, "pkm_fmu_bench: instantiating and initialising %s failed\n", name);
   return NULL;
 }
 
-int free_plant(const Plant* plant, fmi2Component c, fmi2FMUstate* home) {
-  const Fmu* f = &plant->fmu;
-  int ok = !(home && *home && f->fmi2FreeFMUstate(c, home) != fmi2OK);
-  ok = f->fmi2Terminate(c) == fmi2OK && ok;
-  f->fmi2FreeInstance(c);
+int free_instance(const Plant* plant, int kind, void* c, fmi2FMUstate* home) {
+  int ok = !(home && *home && plant->fmu.fmi2FreeFMUstate(c, home) != fmi2OK);
+  if (kind <= FMI2_ME) {
+    ok = plant->fmu.fmi2Terminate(c) == fmi2OK && ok;
+    plant->fmu.fmi2FreeInstance(c);
+  } else {
+    ok = plant->fmu3.fmi3Terminate(c) == fmi3OK && ok;
+    plant->fmu3.fmi3FreeInstance(c);
+  }
   return ok;
 }
 
 int lookup_value_references(const Plant* plant, const char* const* names, size_t n, fmi2ValueReference* vr) {
-  size_t i;
-  for (i = 0; i < n; ++i)
+  for (size_t i = 0; i < n; ++i)
     if (!lookup_value_reference(plant->text, names[i], &vr[i])) return 0;
   return 1;
 }
@@ -139,8 +174,7 @@ double run_ticks(const Plant* plant, fmi2Component c, const Ticks* t, double t0)
   const Fmu* f = &plant->fmu;
   double y[256];
   const double start = bench_now();
-  int k;
-  for (k = 0; k < t->n; ++k) {
+  for (int k = 0; k < t->n; ++k) {
     const double tick = t->tick_s ? bench_now() : 0.0;
     fmi2Status s = f->fmi2SetReal(c, plant->F, 4, t->F[k]);
     if (s == fmi2OK && t->dF) s = f->fmi2SetRealInputDerivatives(c, plant->F, 4, order, t->dF[k]);
