@@ -443,14 +443,17 @@ def main():
         fmu_bench, core_bench = programs["pkm_fmu_bench"], programs["pkm_bench"]
         bench("pkm_fmu_bench cost", [fmu_bench, "cost", "--batches", "3", "--seconds", "0.5"], "perf_fmu_cost.md")
         bench("pkm_fmu_bench latency", [fmu_bench, "latency", "--batches", "100"], "perf_fmu_latency.md")
+        bench("pkm_fmu_bench jacobian", [fmu_bench, "jacobian", "--batches", "5"], "perf_fmu_jacobian.md")
         bench("fmu_allocations", [programs["fmu_allocations"]], "perf_fmu_allocations.md")
         bench("pkm_bench --quick core", [core_bench, "--quick", "core"], "perf_pkm_bench.md")
         bench("pkm_bench --quick ticks", [core_bench, "--quick", "ticks"], "perf_pkm_ticks.md")
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), os.environ.get("PYTHONPATH", "")]))
+        bench("bench/calibration_bench.py", [sys.executable, ROOT / "bench" / "calibration_bench.py", "--build", build,
+                                            "--repeat", "3"], "perf_calibration_bench.md", env=env)
         if engines_python:
             print(f"build_docs: not run: bench/engines_bench.py ({engines_python}); the performance page's "
                   "include of its tables is missing, so the build fails", flush=True)
             return
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), os.environ.get("PYTHONPATH", "")]))
         bench("bench/engines_bench.py --quick", [sys.executable, ROOT / "bench" / "engines_bench.py", "--build",
                                                  build, "--rounds", "1", "--batches", "3", "--quick"],
               "perf_engines_bench.md", env=env)
