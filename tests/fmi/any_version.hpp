@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -220,5 +221,14 @@ struct Any {
     return r;
   }
 };
+
+/// Takes each instance through initialisation mode at its defaults (call
+/// it in ASSERT_NO_FATAL_FAILURE).
+inline void initialise(std::initializer_list<Any*> instances) {
+  for (Any* x : instances) {
+    ASSERT_EQ(x->enter(), fmi2OK);
+    ASSERT_EQ(x->exit(), fmi2OK);
+  }
+}
 
 }  // namespace pkm_test

@@ -623,10 +623,7 @@ TEST_F(FmuState, AHeldStopClearOfItsSliderIsRefusedInCoSimulation) {
   for (int version : {2, 3}) {
     SCOPED_TRACE(version);
     Any a(version, false), twin(version, false);
-    for (Any* x : {&a, &twin}) {
-      ASSERT_EQ(x->enter(), fmi2OK);
-      ASSERT_EQ(x->exit(), fmi2OK);
-    }
+    ASSERT_NO_FATAL_FAILURE(initialise({&a, &twin}));
     const std::vector<unsigned char> good = a.serialized_state();
     const PlantPart plant(good.size());
     const std::vector<double> before = a.reals();

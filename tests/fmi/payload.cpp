@@ -254,10 +254,7 @@ TEST(PayloadTunable, FmuStatesCarryThePayload) {
   for (int version : {2, 3}) {
     SCOPED_TRACE(version);
     Any a(version, false), twin(version, false);
-    for (Any* p : {&a, &twin}) {
-      ASSERT_EQ(p->enter(), fmi2OK);
-      ASSERT_EQ(p->exit(), fmi2OK);
-    }
+    ASSERT_NO_FATAL_FAILURE(initialise({&a, &twin}));
     void *before = nullptr, *grasped = nullptr, *saved = nullptr;
     ASSERT_EQ(a.get_state(&before), fmi2OK);
     ASSERT_EQ(a.set("payload_mass", kPayload), fmi2OK);
