@@ -190,11 +190,11 @@ def machine_of_run(build):
 STEP_TIMES = []  # (step, wall s) of this run, for the performance page
 
 # The C API's parameters as a Markdown table, from the library's list
-# (pkm_parameter_info): run with the checkout's package, argv[1] the library.
+# (pkm_parameter_info): run with the checkout's package, argv[1] the build.
 PARAMETER_TABLE = r"""
 import math, sys
 from pkm4puu import capi
-lib = capi.load(sys.argv[1])
+lib = capi.load(capi.library_path(sys.argv[1]))
 def cell(s):
     return "".join("\\" + c if c in "\\|*_<>[]`" else c for c in s)
 def num(v):
@@ -261,12 +261,13 @@ def main():
         sys.exit(f"build_docs: no {autotest}: build it first (cmake --build {build} --target pkm_autotest)")
 
     runs = work / "runs"
+    # The checkout's package for every Python program run here, figures to files.
+    py_env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), os.environ.get("PYTHONPATH", "")]),
+                  MPLBACKEND="Agg")
 
     def report(args, cwd_out):
         """python -m pkm4puu ARGS (the checkout's package), its output printed on failure."""
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), os.environ.get("PYTHONPATH", "")]),
-                   MPLBACKEND="Agg")
-        r = subprocess.run([sys.executable, "-m", "pkm4puu", *args], capture_output=True, text=True, env=env)
+        r = subprocess.run([sys.executable, "-m", "pkm4puu", *args], capture_output=True, text=True, env=py_env)
         if r.returncode != 0:
             sys.exit(f"build_docs: python -m pkm4puu {' '.join(args)} failed (exit {r.returncode}):\n"
                      f"{r.stdout}{r.stderr}")
@@ -348,14 +349,12 @@ def main():
                 ("pick_and_place", ["pick_and_place.png"])]
 
     def run_examples():
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), os.environ.get("PYTHONPATH", "")]),
-                   MPLBACKEND="Agg")
         for name, images in examples:
             out = runs / "examples" / name
             shutil.rmtree(out, ignore_errors=True)
             out.mkdir(parents=True)
             r = subprocess.run([sys.executable, str(ROOT / "examples" / f"{name}.py"), "--build", str(build),
-                                "--out", str(out)], capture_output=True, text=True, env=env)
+                                "--out", str(out)], capture_output=True, text=True, env=py_env)
             if r.returncode != 0:
                 sys.exit(f"build_docs: examples/{name}.py failed (exit {r.returncode}):\n{r.stdout}{r.stderr}")
             # its results: what it printed, without its progress log ("name [  t s]: ...")
@@ -381,8 +380,7 @@ def main():
     ]
 
     def run_tests_figures():
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), os.environ.get("PYTHONPATH", "")]),
-                   PKM_BUILD_DIR=str(build), MPLBACKEND="Agg")
+        env = dict(py_env, PKM_BUILD_DIR=str(build))
         for md_name, files, markdown in pytest_figures:
             cmd = [sys.executable, "-m", "pytest", "-q", "-s", "-p", "no:cacheprovider", *files]
             r = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
@@ -419,10 +417,7 @@ def main():
         sweep = build / "bin" / "pkm_solver_sweep"
         if not sweep.is_file():
             sys.exit(f"build_docs: no {sweep}: build it first (cmake --build {build} --target pkm_solver_sweep)")
-        r = subprocess.run([str(sweep)], capture_output=True, text=True)
-        if r.returncode != 0:
-            sys.exit(f"build_docs: {sweep.name} failed (exit {r.returncode}):\n{r.stdout}{r.stderr}")
-        write_text(generated / "solvers_sweep.md", run_as_markdown(r.stdout, sweep.name))
+        bench(sweep.name, [sweep], "solvers_sweep.md")
 
     def bench(name, cmd, md_name, env=None):
         """Runs a benchmark; its whole printed output becomes generated/md_name."""
@@ -447,16 +442,15 @@ def main():
         bench("fmu_allocations", [programs["fmu_allocations"]], "perf_fmu_allocations.md")
         bench("pkm_bench --quick core", [core_bench, "--quick", "core"], "perf_pkm_bench.md")
         bench("pkm_bench --quick ticks", [core_bench, "--quick", "ticks"], "perf_pkm_ticks.md")
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), os.environ.get("PYTHONPATH", "")]))
         bench("bench/calibration_bench.py", [sys.executable, ROOT / "bench" / "calibration_bench.py", "--build", build,
-                                            "--repeat", "3"], "perf_calibration_bench.md", env=env)
+                                            "--repeat", "3"], "perf_calibration_bench.md", env=py_env)
         if engines_python:
             print(f"build_docs: not run: bench/engines_bench.py ({engines_python}); the performance page's "
                   "include of its tables is missing, so the build fails", flush=True)
             return
         bench("bench/engines_bench.py --quick", [sys.executable, ROOT / "bench" / "engines_bench.py", "--build",
                                                  build, "--rounds", "1", "--batches", "3", "--quick"],
-              "perf_engines_bench.md", env=env)
+              "perf_engines_bench.md", env=py_env)
 
     def run_pick_and_place():
         # The pick-and-place page: the standard cycle, its figure, the table
@@ -477,21 +471,15 @@ def main():
         table = report(["cycle", "--build", str(build), "--table"], out)  # Markdown already
         write_text(generated / "pick_and_place_table.md",
                    "<!-- Generated by docs/build_docs.py from pkm4puu cycle --table; do not edit. -->\n\n" + table)
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), os.environ.get("PYTHONPATH", "")]))
-        r = subprocess.run([sys.executable, str(ROOT / "bench" / "pick_place_bench.py"), "--build", str(build),
-                            "--repeat", "3", "--grids", "500", "1000", "2000", "4000", "8000", "16000"],
-                           capture_output=True, text=True, env=env)
-        if r.returncode != 0:
-            sys.exit(f"build_docs: bench/pick_place_bench.py failed (exit {r.returncode}):\n{r.stdout}{r.stderr}")
-        write_text(generated / "pick_and_place_bench.md", run_as_markdown(r.stdout, "bench/pick_place_bench.py"))
+        bench("bench/pick_place_bench.py", [sys.executable, ROOT / "bench" / "pick_place_bench.py", "--build", build,
+                                           "--repeat", "3", "--grids", "500", "1000", "2000", "4000", "8000", "16000"],
+              "pick_and_place_bench.md", env=py_env)
 
     def run_parameter_table():
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "python"), os.environ.get("PYTHONPATH", "")]))
-        library = build / "lib" / ("pkm.dll" if os.name == "nt" else "libpkm.so")
-        r = subprocess.run([sys.executable, "-c", PARAMETER_TABLE, str(library)], capture_output=True, text=True,
-                           env=env)
+        r = subprocess.run([sys.executable, "-c", PARAMETER_TABLE, str(build)], capture_output=True, text=True,
+                           env=py_env)
         if r.returncode != 0:
-            sys.exit(f"build_docs: the parameter table from {library} failed (exit {r.returncode}):\n{r.stderr}")
+            sys.exit(f"build_docs: the parameter table from {build}'s libpkm failed (exit {r.returncode}):\n{r.stderr}")
         write_text(generated / "parameters.md", "<!-- Generated by docs/build_docs.py from libpkm's "
                    "pkm_parameter_info (the parameter table); do not edit. -->\n\n" + r.stdout)
 
