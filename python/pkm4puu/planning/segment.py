@@ -7,8 +7,10 @@ Friction is not of the form a sdd + b sd^2 + c (it goes with sign(drho) and
 drho, not sd^2), so the plan keeps the friction-free forces within the
 force limit less a bound on friction, abs(F_fric,i) <= b v_lim + F_c (b
 friction_viscous, F_c friction_coulomb, v_lim the speed limit), and the
-samples are then checked with friction (the C API's machine inverse
-dynamics). With friction off, the default, nothing is taken off.
+samples are then checked with friction (the C API's inverse dynamics).
+The screw lead and the friction are the model's (the C API's parameters,
+given by the FMUs' names in `machine` or `params`). With friction off, the
+default, nothing is taken off.
 """
 import math
 from dataclasses import dataclass, field
@@ -23,8 +25,6 @@ GRID = 2000  # grid intervals per segment (docs/pick_and_place.md: the time's gr
 DT = 1e-4  # s, the samples' spacing
 ACTIVE_TOLERANCE = 1e-6  # a limit within this fraction of its value is active (toppra keeps ~1e-8 from it)
 SAMPLE_TOLERANCE = 1e-3  # the samples may pass a limit by this fraction (the grid's interpolation error)
-FRICTIONLESS = {"friction_viscous": 0.0, "friction_coulomb": 0.0}
-DEFAULT_SCREW_LEAD = 0.004  # m, pkm_default_machine_params
 
 
 def shown_s(path, s):
@@ -40,10 +40,11 @@ def where(path, s):
 
 
 def dynamics(payload_mass, machine, params, build):
-    """capi_adapter.InverseDynamics without friction; BadValue naming a
-    parameter the C API refuses."""
+    """capi_adapter.InverseDynamics without friction (its screw_lead and
+    friction: the model's as given); BadValue naming a parameter the C API
+    refuses."""
     try:
-        return InverseDynamics(payload_mass, {**(machine or {}), **FRICTIONLESS}, params, build)
+        return InverseDynamics(payload_mass, machine, params, build, frictionless=True)
     except ValueError as e:
         raise BadValue(str(e)) from None
 
@@ -186,31 +187,31 @@ def plan_segment(path, payload_mass=0.0, limits=None, machine=None, params=None,
                  build=None, check_workspace=True):
     """The fastest rest-to-rest traversal of `path` (p(s), s in [0, 1]; see
     paths.Arch) carrying `payload_mass` kg at P, within `limits` (a
-    limits.Limits), for the machine `machine` and model `params` (the FMUs'
-    parameter names, e.g. rotor_inertia, screw_lead, friction_viscous, g),
-    on `grid` intervals of s, sampled every `dt` s. PlanningError (its
-    subclasses) when it cannot be planned, saying why and where;
-    extras.MissingExtra without toppra (the extra `planning`)."""
+    limits.Limits), for the model's parameters `machine` and `params` (both
+    by the FMUs' names, e.g. rotor_inertia, screw_lead, friction_viscous, g;
+    `machine` where both give one), on `grid` intervals of s, sampled every
+    `dt` s. PlanningError (its subclasses) when it cannot be planned, saying
+    why and where; extras.MissingExtra without toppra (the extra
+    `planning`)."""
     extras.require("pkm4puu.plan_cycle", "toppra")
     from . import topp  # toppra's classes at its module level
     limits = limits or Limits()
     payload_mass = check_value("payload_mass", payload_mass, unit=" kg")
     s = grid_points(grid)
     dt = check_value("dt", dt, strict=True, unit=" s")
-    machine = dict(machine or {})
     if not np.any(path(s, 1)):
         raise BadValue(f"{name} does not move: its start and end poses coincide and nothing between differs")
     if check_workspace:
         check_path(path, s, machine, params, build, name)
-    lead = machine.get("screw_lead", DEFAULT_SCREW_LEAD)
-    f_lim, f_src = limits.force(lead)
-    v_lim, v_src = limits.speed(lead)
-    friction = machine.get("friction_viscous", 0.0) * v_lim + machine.get("friction_coulomb", 0.0)
-    f_eff = f_lim - friction
-    if f_eff <= 0:
-        raise Infeasible(f"{f_src} leaves nothing once friction is allowed for "
-                         f"(|F_fric| <= b v_lim + F_c = {friction:.4g} N)", "friction takes the whole force limit")
     with dynamics(payload_mass, machine, params, build) as dyn:
+        f_lim, f_src = limits.force(dyn.screw_lead)
+        v_lim, v_src = limits.speed(dyn.screw_lead)
+        viscous, coulomb = dyn.friction
+        friction = viscous * v_lim + coulomb
+        f_eff = f_lim - friction
+        if f_eff <= 0:
+            raise Infeasible(f"{f_src} leaves nothing once friction is allowed for "
+                             f"(|F_fric| <= b v_lim + F_c = {friction:.4g} N)", "friction takes the whole force limit")
         a, b, c, drho_ds = topp.path_coefficients(dyn, path, s)
     need = np.abs(c) - f_eff
     k, i = np.unravel_index(np.argmax(need), need.shape)
