@@ -42,9 +42,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import spec
 from ..closed_loop import closed_loop
-from .capi_adapter import InverseDynamics
+from .capi_adapter import InverseDynamics, model_parameters
 from .segment import sample_times
 
 BANDWIDTH = 50.0  # Hz, the feedback's
@@ -185,7 +184,7 @@ def track_cycle(cycle, plant_fmu=None, step=LOOP_STEP, f_c=BANDWIDTH, zeta=1.0, 
     masses = np.linalg.eigvalsh(0.5 * (M_rho + M_rho.transpose(0, 2, 1)))
     gains = Gains(f_c, zeta, (float(masses.min()), float(masses.max())))
     kp, kd = gains.w ** 2, 2 * zeta * gains.w
-    start = {**(cycle.params or {}), **(cycle.machine or {}), "solver": 1, "rk4_step": float(np.diff(t).max()),
+    start = {**model_parameters(cycle.machine, cycle.params), "solver": 1, "rk4_step": float(np.diff(t).max()),
              **dict(zip(("x0", "y0", "z0", "phi0"), (float(v) for v in there.pose[0])))}
     energy = np.empty((len(t), len(ENERGY)))
     booked = []
@@ -204,6 +203,7 @@ def track_cycle(cycle, plant_fmu=None, step=LOOP_STEP, f_c=BANDWIDTH, zeta=1.0, 
     with Fmu(plant_fmu, start=start, instance_name="plant") as plant:
         vr_energy = plant.vrs(ENERGY)
         vr_payload = plant.vrs(["payload_mass"])
+        phi_bound = TRACKING_BOUND / float(plant.get(["r_Q"])[0])  # the plant's r_Q, from either dict
 
         def at_sample(r, k):
             energy[k] = plant.fmu.getReal(vr_energy)
@@ -215,7 +215,6 @@ def track_cycle(cycle, plant_fmu=None, step=LOOP_STEP, f_c=BANDWIDTH, zeta=1.0, 
             loop = closed_loop(plant, t, reference, control, progress, log, "closed loop", at_sample)
         except FMICallException as e:
             raise RuntimeError(f"the closed loop through {Path(plant_fmu).name} stopped: {e}") from None
-    phi_bound = TRACKING_BOUND / (cycle.params or {}).get("r_Q", spec.R_Q)
     return Tracking(loop, payload, energy, booked, gains, cycle, phi_bound)
 
 
