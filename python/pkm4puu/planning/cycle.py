@@ -7,14 +7,13 @@ from typing import List, Optional
 
 import numpy as np
 
-from .. import spec
+from .. import interface, spec
 from .limits import Limits, check_value
 from .paths import Arch
 from .segment import DT, GRID, Segment, check_path, grid_points, plan_segment
 
 # The columns of cycle.csv, in order (SI units).
-COLUMNS = (["t", "x", "y", "z", "phi", "dx", "dy", "dz", "dphi", "ddx", "ddy", "ddz", "ddphi"]
-           + [f"F[{i}]" for i in range(1, 5)] + ["payload_mass"])
+COLUMNS = ["t"] + interface.POSE + interface.VEL + interface.ACC + interface.F + ["payload_mass"]
 
 
 @dataclass
