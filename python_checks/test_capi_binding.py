@@ -11,7 +11,7 @@
   Plant.set_solver acts (max_jacobian_condition refuses the home pose), and
   an unknown keyword raises TypeError naming it and the known ones;
 - a failing batch call's PkmError names its C function and the first sample
-  not computed.
+  not computed; capi.load loads a file once.
 """
 import math
 import re
@@ -161,3 +161,10 @@ def test_a_failing_batch_call_names_its_function_and_sample(lib):
         with pytest.raises(capi.PkmError, match=r"^pkm_regressor_joints: status ") as e:
             m.regressor_joints(rho, zero, zero)
         assert e.value.sample == 2 and e.value.status == lib.c.PKM_ERR_NONFINITE
+
+
+def test_a_library_is_loaded_once_per_file(pkm_library, lib):
+    """capi.load returns the same Library for the same file however it is
+    named (the planner loads it for every model it makes)."""
+    assert capi.load(str(pkm_library)) is lib
+    assert capi.load(pkm_library.parent / ".." / pkm_library.parent.name / pkm_library.name) is lib

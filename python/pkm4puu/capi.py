@@ -17,6 +17,7 @@ the library lists (pkm_parameter_info); nothing here spells them out::
 An unknown keyword raises TypeError naming it and the known ones; a value
 the library refuses raises PkmError with its message.
 """
+import os
 from collections import namedtuple
 from functools import lru_cache
 from keyword import iskeyword
@@ -87,8 +88,14 @@ class Library:
 
 
 def load(path=None):
-    """libpkm (library_path() when no path is given) with its declarations."""
-    return Library(path or library_path())
+    """libpkm (library_path() when no path is given) with its declarations,
+    loaded once per file: every later call for it returns the same Library."""
+    return _load(Path(os.path.abspath(path or library_path())))
+
+
+@lru_cache(maxsize=None)
+def _load(path):
+    return Library(path)
 
 
 def to_python(lib, struct):

@@ -274,8 +274,8 @@ def main(argv=None):
     extras.require(ap.prog, "toppra", *(("matplotlib",) if args.out is not None else ()))
     from ..planning import PlanningError, plan_cycle
     try:
-        from ..planning.capi_adapter import _library
-        _library(args.build)
+        from .. import capi
+        capi.load(capi.library_path(args.build))
     except OSError as e:
         return error(f"cannot load the C API library: {e}", 1)
     plant_fmu = None

@@ -15,16 +15,6 @@ import numpy as np
 
 from .. import capi
 
-_LIBRARIES = {}
-
-
-def _library(build=None):
-    path = str(capi.library_path(build))
-    if path not in _LIBRARIES:
-        _LIBRARIES[path] = capi.load(path)
-    return _LIBRARIES[path]
-
-
 class PoseError(ValueError):
     """A pose the machine cannot take. kind: "unreachable" (a leg cannot
     reach it elbow-down), "singular" (beyond the singularity guards) or
@@ -60,7 +50,7 @@ class InverseDynamics:
     def __init__(self, payload_mass=0.0, machine=None, params=None, build=None, frictionless=False):
         values = {**model_parameters(machine, params), "payload_mass": float(payload_mass)}
         try:
-            self._plant = capi.Plant(_library(build), **values)
+            self._plant = capi.Plant(capi.load(capi.library_path(build)), **values)
             self.screw_lead = self._plant.get("screw_lead")
             self.friction = (self._plant.get("friction_viscous"), self._plant.get("friction_coulomb"))
             if frictionless:
