@@ -45,6 +45,9 @@ def test_a_limit_is_active_on_every_interval_but_the_switches(cycle):
             assert seg.u[i - 1] > seg.u[i] > seg.u[i + 1], (seg.name, i, seg.u[i - 1:i + 2])
         # from rest and into rest sd^2 = 0 is far from the speed bound: a force limit acts
         assert "force" in active[0] and "force" in active[-1]
+        # the bound the plan kept is the one it records: the fastest slider at v_lim where x = x_max
+        assert np.all(seg.x <= seg.x_max)
+        np.testing.assert_allclose(np.abs(seg.drho_ds).max(axis=1) * np.sqrt(seg.x_max), seg.speed_limit, rtol=1e-15)
 
 
 def test_time_converges_first_order_with_the_grid():

@@ -119,7 +119,7 @@ def plot(cycle, path):
             ax_f.plot(t, seg.F[:, i], f"C{i}", lw=1.2, label=label)
             ax_v.plot(t, seg.drho[:, i], f"C{i}", lw=1.2, label=label)
         ax_s.plot(seg.path.arch_s(seg.s), seg.sd, f"C{4 + k}", lw=1.5, label=f"{seg.name}: ds/dt")
-        ax_s.plot(seg.path.arch_s(seg.s), np.sqrt(seg.x_max()), f"C{4 + k}", ls=":", lw=1.0,
+        ax_s.plot(seg.path.arch_s(seg.s), np.sqrt(seg.x_max), f"C{4 + k}", ls=":", lw=1.0,
                   label=f"{seg.name}: slider-speed limit")
         ax_p.plot(1e3 * seg.pose[:, 0], 1e3 * seg.pose[:, 1], 1e3 * seg.pose[:, 2], f"C{4 + k}",
                   label=f"{seg.name} ({seg.payload_mass:g} kg), {seg.duration:.3f} s")

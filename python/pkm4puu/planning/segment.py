@@ -49,6 +49,14 @@ def dynamics(payload_mass, machine, params, build):
         raise BadValue(str(e)) from None
 
 
+def speed_bound(speed_limit, drho_ds):
+    """x_max, the slider-speed limit on sd^2 at each grid point:
+    speed_limit^2 / max_i (drho_i/ds)^2 (inf where no slider moves)."""
+    den = (drho_ds ** 2).max(axis=1)
+    with np.errstate(divide="ignore"):
+        return np.where(den > 0, speed_limit ** 2 / den, np.inf)
+
+
 def grid_points(grid):
     """The grid's points s_i, grid + 1 of them over [0, 1]; BadValue unless grid is an integer >= 2."""
     if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or grid < 2:
@@ -74,8 +82,8 @@ def check_path(path, s, machine=None, params=None, build=None, name="the path"):
 class Segment:
     """A planned traversal. Grid (N + 1 points s, N intervals): x = sd^2,
     u = sdd (constant on each interval), t_grid; a, b, c (F = a sdd + b sd^2
-    + c, friction-free) and drho_ds at the grid points. Samples every dt
-    (and at the end): t, pose, velocity, acceleration (each (n, 4)), F
+    + c, friction-free), drho_ds and the bound x_max (speed_bound) at the
+    grid points. Samples every dt (and at the end): t, pose, velocity, acceleration (each (n, 4)), F
     (friction included), rho, drho. SI units."""
     name: str
     payload_mass: float
@@ -92,6 +100,7 @@ class Segment:
     b: np.ndarray
     c: np.ndarray
     drho_ds: np.ndarray
+    x_max: np.ndarray
     t: np.ndarray = field(default=None, repr=False)
     pose: np.ndarray = field(default=None, repr=False)
     velocity: np.ndarray = field(default=None, repr=False)
@@ -139,18 +148,13 @@ class Segment:
         end = self.a[1:] * u + self.b[1:] * self.x[1:, None] + self.c[1:]
         return start, end
 
-    def x_max(self):
-        """The speed limit on sd^2 at each grid point (inf where no slider moves)."""
-        with np.errstate(divide="ignore"):
-            return self.speed_limit ** 2 / (self.drho_ds ** 2).max(axis=1)
-
     def activity(self):
         """Per interval, the largest use of the force limit (abs(F_i) over the
         limit less the friction bound) and of the speed limit (x over x_max)
         at its two ends."""
         start, end = self.grid_forces()
         f = np.maximum(np.abs(start).max(axis=1), np.abs(end).max(axis=1)) / (self.force_limit - self.friction_bound)
-        xm = self.x_max()
+        xm = self.x_max
         with np.errstate(invalid="ignore"):
             v = np.nan_to_num(np.maximum(self.x[:-1] / xm[:-1], self.x[1:] / xm[1:]))
         return f, v
@@ -220,17 +224,14 @@ def plan_segment(path, payload_mass=0.0, limits=None, machine=None, params=None,
         raise Infeasible(f"{name}: holding the {payload_mass:g} kg payload at rest at {where(path, s[k])} needs "
                          f"F[{i + 1}] = {c[k, i]:.4g} N, beyond {f_src}{less}",
                          f"F[{i + 1}] = {c[k, i]:.3g} N to hold at s = {shown_s(path, s[k]):.2f}")
-    den = (drho_ds ** 2).max(axis=1)
-    with np.errstate(divide="ignore"):
-        x_max = np.where(den > 0, v_lim ** 2 / den, np.inf)
-    finite = x_max[np.isfinite(x_max)]
-    x_max = np.minimum(x_max, 1e6 * finite.max() if finite.size else 1e12)
+    x_max = speed_bound(v_lim, drho_ds)
     try:
         x, u = topp.solve(s, a, b, c, f_eff, x_max)
     except topp.NoTraversal as e:
         raise Infeasible(f"{name}: no rest-to-rest traversal within {f_src} and {v_src} (toppra: {e})",
                          "no traversal found") from None
-    seg = Segment(name, payload_mass, path, f_lim, f_src, v_lim, v_src, friction, s, x, u, a, b, c, drho_ds)
+    seg = Segment(name, payload_mass, path, f_lim, f_src, v_lim, v_src, friction, s, x, u, a, b, c, drho_ds,
+                  x_max)
     sample(seg, dt, machine, params, build)
     return seg
 
