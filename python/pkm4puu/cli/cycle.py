@@ -50,7 +50,8 @@ import time
 from pathlib import Path
 
 from .. import extras
-from ..program import ArgumentParser, command_prog, description, writable_dir
+from ..locate import LIBRARY
+from ..program import ArgumentParser, add_build_arg, command_prog, description, writable_dir
 
 TABLE_PAYLOADS = (0.0, 0.1, 0.25, 0.5)  # kg
 TABLE_F_MAX = (5.0, 10.0, 20.0)  # N
@@ -79,9 +80,7 @@ def parser():
         ap.add_argument(flag, type=kind, default=default, metavar=metavar, help=f"{what} (default %(default)g {unit})")
     ap.add_argument("--plan-only", action="store_true",
                     help="plan the cycle only, without the closed-loop run through the plant FMU")
-    ap.add_argument("--build", type=Path, default=None, metavar="DIR",
-                    help="build directory holding lib/libpkm.so (default: $PKM_BUILD_DIR, else the installed "
-                         "package's own, else ./build)")
+    add_build_arg(ap, holding=f"the C API's library {LIBRARY} and, for the closed loop, PKM4PUU.fmu")
     out = ap.add_mutually_exclusive_group()
     out.add_argument("--out", type=writable_dir, default=None, metavar="DIR",
                      help="write cycle.csv, cycle.png, closed_loop.csv and closed_loop.png into DIR (default: "
@@ -103,12 +102,11 @@ def write_csv(rows, columns, path):
 
 
 def plot(cycle, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """The plan: the forces and the slider speeds against their limits, the
+    path speed against its slider-speed limit, the path in 3D."""
     import numpy as np
-
-    fig = plt.figure(figsize=(12, 8.5))
+    from ..plots import pyplot, save_figure
+    fig = pyplot().figure(figsize=(12, 8.5))
     ax_f, ax_v, ax_s = fig.add_subplot(2, 2, 1), fig.add_subplot(2, 2, 2), fig.add_subplot(2, 2, 3)
     ax_p = fig.add_subplot(2, 2, 4, projection="3d")
     t0 = 0.0
@@ -155,9 +153,7 @@ def plot(cycle, path):
     ax_p.set_title("the path of P", fontsize=9)
     ax_p.legend(fontsize=7, loc="upper left")
     fig.suptitle(f"pick-and-place cycle: {cycle.duration:.4f} s ({cycle.arch.describe()})", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
 
 
 def plot_closed_loop(track, path):
