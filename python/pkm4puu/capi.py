@@ -394,6 +394,6 @@ class Plant:
         Y = np.empty((n, 4, self.c.PKM_REGRESSOR_PARAMS))
         F0, pose = np.empty((n, 4)), np.empty((n, 4))
         self._batch("pkm_regressor_joints", n, [self._doubles(R), self._doubles(V), self._doubles(A),
-                                                     self._d4(guess), self._doubles(Y), self._doubles(F0),
-                                                     self._doubles(pose)])
+                                                self._d4(guess), self._doubles(Y), self._doubles(F0),
+                                                self._doubles(pose)])
         return Y, F0, pose

@@ -276,9 +276,9 @@ def main(argv=None):
     ap = parser()
     args = ap.parse_args(argv)
     extras.require(ap.prog, "toppra", *(("matplotlib",) if args.out is not None else ()))
+    from .. import capi
     from ..planning import PlanningError, plan_cycle
     try:
-        from .. import capi
         capi.load(capi.library_path(args.build))
     except OSError as e:
         return error(f"cannot load the C API library: {e}", 1)

@@ -43,9 +43,9 @@ class InverseDynamics:
     ...), `machine` where both give one; the payload `payload_mass` kg at P.
     ValueError naming the parameter if the C API refuses one.
 
-    screw_lead (m) and friction, (friction_viscous N s/m, friction_coulomb
-    N), are the model's as given; `frictionless` then sets its friction to
-    zero (FRICTIONLESS) for the forces it computes."""
+    screw_lead (m) and friction (friction_viscous N s/m, friction_coulomb
+    N) are read back from the model as given; `frictionless` then zeroes
+    its friction (FRICTIONLESS) in the forces it computes."""
 
     def __init__(self, payload_mass=0.0, machine=None, params=None, build=None, frictionless=False):
         values = {**model_parameters(machine, params), "payload_mass": float(payload_mass)}
