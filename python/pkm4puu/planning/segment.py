@@ -83,8 +83,8 @@ class Segment:
     """A planned traversal. Grid (N + 1 points s, N intervals): x = sd^2,
     u = sdd (constant on each interval), t_grid; a, b, c (F = a sdd + b sd^2
     + c, friction-free), drho_ds and the bound x_max (speed_bound) at the
-    grid points. Samples every dt (and at the end): t, pose, velocity, acceleration (each (n, 4)), F
-    (friction included), rho, drho. SI units."""
+    grid points. Samples every dt (and at the end): t, pose, velocity,
+    acceleration (each (n, 4)), F (friction included), rho, drho. SI units."""
     name: str
     payload_mass: float
     path: object
