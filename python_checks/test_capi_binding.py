@@ -9,12 +9,15 @@
   their defaults are docs/model.md's (spec.py);
 - every parameter is reachable from Python: a solver setting set through
   Plant.set_solver acts (max_jacobian_condition refuses the home pose), and
-  an unknown keyword raises TypeError naming it and the known ones.
+  an unknown keyword raises TypeError naming it and the known ones;
+- a failing batch call's PkmError names its C function and the first sample
+  not computed; capi.load loads a file once.
 """
 import math
 import re
 import xml.etree.ElementTree as ET
 
+import numpy as np
 import pytest
 
 from pkm4puu import capi, spec
@@ -142,3 +145,26 @@ def test_unknown_keywords_raise_naming_the_known_ones(lib):
         with pytest.raises(TypeError, match=r"beta has 4 values"):
             m.set(beta=0.1)
         assert m.get("g") == spec.G, "a refused call changes nothing"
+
+
+def test_a_failing_batch_call_names_its_function_and_sample(lib):
+    """A non-finite sample stops pkm_regressor_poses / _joints there: the
+    error starts with the C function's name and `sample` is that sample."""
+    zero = np.zeros((3, 4))
+    with capi.Plant(lib) as m:
+        poses = np.tile(spec.P0, (3, 1))
+        _, _, rho, _ = m.regressor_poses(poses, zero, zero)
+        poses[1, 2] = rho[2, 0] = math.nan
+        with pytest.raises(capi.PkmError, match=r"^pkm_regressor_poses: status ") as e:
+            m.regressor_poses(poses, zero, zero)
+        assert e.value.sample == 1 and e.value.status == lib.c.PKM_ERR_NONFINITE
+        with pytest.raises(capi.PkmError, match=r"^pkm_regressor_joints: status ") as e:
+            m.regressor_joints(rho, zero, zero)
+        assert e.value.sample == 2 and e.value.status == lib.c.PKM_ERR_NONFINITE
+
+
+def test_a_library_is_loaded_once_per_file(pkm_library, lib):
+    """capi.load returns the same Library for the same file however it is
+    named (the planner loads it for every model it makes)."""
+    assert capi.load(str(pkm_library)) is lib
+    assert capi.load(pkm_library.parent / ".." / pkm_library.parent.name / pkm_library.name) is lib

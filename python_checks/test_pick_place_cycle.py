@@ -156,13 +156,28 @@ def test_closed_loop_tracks_the_plan_through_the_plant_fmu(standard):
     assert {p.name for p in out.iterdir()} == promised_files(command_help("cycle"))
 
 
-def test_table_lists_every_payload_and_force_limit():
+def test_table_lists_every_payload_and_force_limit(monkeypatch):
     """--table: a row per f_max and payload, the cycle time the sum of the
     two legs; a leg whose holding force exceeds f_max somewhere is marked
-    infeasible with the actuator and a force beyond f_max. The sweep on a
-    coarse grid (the docs build runs the default)."""
+    infeasible with the actuator and a force beyond f_max. The arch's poses
+    are checked once and the empty B -> A planned once per f_max. The sweep
+    on a coarse grid (the docs build runs the default)."""
+    import pkm4puu.planning
+    calls = []
+
+    def counted(name, function):
+        def wrapper(*args, **kwargs):
+            calls.append((name, kwargs.get("name")))
+            return function(*args, **kwargs)
+        return wrapper
+
+    monkeypatch.setattr(segment, "check_path", counted("check_path", segment.check_path))
+    monkeypatch.setattr(pkm4puu.planning, "plan_segment", counted("plan_segment", segment.plan_segment))
     status, stdout, stderr = run("--table", "--grid", "200", "--dt", "0.01")
     assert status == 0, stderr
+    assert [c for c in calls if c[0] == "check_path"] == [("check_path", "the arch")]
+    assert calls.count(("plan_segment", "A -> B")) == len(program.TABLE_F_MAX) * len(program.TABLE_PAYLOADS)
+    assert calls.count(("plan_segment", "B -> A")) == len(program.TABLE_F_MAX)
     rows = [line for line in stdout.splitlines() if re.match(r"\| [0-9.]+ \| [0-9.]+ \|", line)]
     assert [tuple(float(c) for c in row.strip("|").split("|")[:2]) for row in rows] == \
         [(m, f) for f in program.TABLE_F_MAX for m in program.TABLE_PAYLOADS]

@@ -45,6 +45,9 @@ def test_a_limit_is_active_on_every_interval_but_the_switches(cycle):
             assert seg.u[i - 1] > seg.u[i] > seg.u[i + 1], (seg.name, i, seg.u[i - 1:i + 2])
         # from rest and into rest sd^2 = 0 is far from the speed bound: a force limit acts
         assert "force" in active[0] and "force" in active[-1]
+        # the bound the plan kept is the one it records: the fastest slider at v_lim where x = x_max
+        assert np.all(seg.x <= seg.x_max)
+        np.testing.assert_allclose(np.abs(seg.drho_ds).max(axis=1) * np.sqrt(seg.x_max), seg.speed_limit, rtol=1e-15)
 
 
 def test_time_converges_first_order_with_the_grid():
@@ -201,6 +204,22 @@ def test_friction_is_allowed_for_and_checked():
         assert np.abs(np.concatenate([start, end])).max() <= (spec.CYCLE_F_MAX - bound) * (1 + 1e-9)
         assert np.abs(seg.F).max() <= spec.CYCLE_F_MAX
         assert seg.duration > ideal.duration
+
+
+def test_drive_and_friction_parameters_act_through_params_as_through_machine():
+    """Every parameter goes by its FMU name through either dict: the screw
+    lead (the motor limits through the screw) and friction (its bound taken
+    off the force limit) given in params plan what they plan in machine."""
+    drive = {"screw_lead": 0.005, "friction_coulomb": 0.5, "friction_viscous": 1.0}
+    limits = Limits(100.0, 100.0, torque_max=0.008, motor_speed_max=400.0)
+    common = dict(payload_mass=0.1, limits=limits, grid=500, dt=1e-2)
+    by_machine = plan_segment(arch(), machine=drive, **common)
+    by_params = plan_segment(arch(), params=drive, **common)
+    v_lim = 0.005 * 400.0 / (2 * math.pi)  # the motor speed through the screw
+    assert by_params.friction_bound == by_machine.friction_bound == pytest.approx(0.5 + 1.0 * v_lim)
+    assert by_params.force_limit == by_machine.force_limit == pytest.approx(2 * math.pi * 0.008 / 0.005)
+    assert by_params.duration == by_machine.duration
+    np.testing.assert_array_equal(by_params.F, by_machine.F)
 
 
 def test_drive_limits_act_through_the_screw():

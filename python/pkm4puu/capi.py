@@ -17,6 +17,7 @@ the library lists (pkm_parameter_info); nothing here spells them out::
 An unknown keyword raises TypeError naming it and the known ones; a value
 the library refuses raises PkmError with its message.
 """
+import os
 from collections import namedtuple
 from functools import lru_cache
 from keyword import iskeyword
@@ -87,8 +88,14 @@ class Library:
 
 
 def load(path=None):
-    """libpkm (library_path() when no path is given) with its declarations."""
-    return Library(path or library_path())
+    """libpkm (library_path() when no path is given) with its declarations,
+    loaded once per file: every later call for it returns the same Library."""
+    return _load(Path(os.path.abspath(path or library_path())))
+
+
+@lru_cache(maxsize=None)
+def _load(path):
+    return Library(path)
 
 
 def to_python(lib, struct):
@@ -352,16 +359,16 @@ class Plant:
                                          self._d4(wrench), self._doubles(Y), self._doubles(F0)), "pkm_regressor")
         return Y, F0
 
-    def _batch(self, function, n, args):
-        """A batch call with its done count: PkmError carries `sample`, the
-        first sample not computed."""
+    def _batch(self, name, n, args):
+        """The batch call `name` (pkm.h's function) with its done count:
+        PkmError names the function and carries `sample`, the first sample
+        not computed."""
         done = self.ffi.new("size_t*")
-        s = function(self.handle, n, *args, done)
-        if s != self.c.PKM_OK:
-            name = function.__name__ if hasattr(function, "__name__") else "pkm_regressor_*"
-            err = PkmError(f"{name}: status {s}: {self.ffi.string(self.c.pkm_last_error(self.handle)).decode()}", s)
+        try:
+            self._check(getattr(self.c, name)(self.handle, n, *args, done), name)
+        except PkmError as err:
             err.sample = done[0]
-            raise err
+            raise
 
     def regressor_poses(self, pose, velocity, acceleration):
         """pkm_regressor_poses over (n, 4) arrays: (Y (n, 4, n_pi), F0, rho,
@@ -373,7 +380,7 @@ class Plant:
             raise ValueError("pose, velocity and acceleration need the same number of rows")
         Y = np.empty((n, 4, self.c.PKM_REGRESSOR_PARAMS))
         F0, rho, drho = np.empty((n, 4)), np.empty((n, 4)), np.empty((n, 4))
-        self._batch(self.c.pkm_regressor_poses, n, [self._doubles(a) for a in (P, V, A, Y, F0, rho, drho)])
+        self._batch("pkm_regressor_poses", n, [self._doubles(a) for a in (P, V, A, Y, F0, rho, drho)])
         return Y, F0, rho, drho
 
     def regressor_joints(self, rho, drho, ddrho, guess=None):
@@ -386,7 +393,7 @@ class Plant:
             raise ValueError("rho, drho and ddrho need the same number of rows")
         Y = np.empty((n, 4, self.c.PKM_REGRESSOR_PARAMS))
         F0, pose = np.empty((n, 4)), np.empty((n, 4))
-        self._batch(self.c.pkm_regressor_joints, n, [self._doubles(R), self._doubles(V), self._doubles(A),
-                                                     self._d4(guess), self._doubles(Y), self._doubles(F0),
-                                                     self._doubles(pose)])
+        self._batch("pkm_regressor_joints", n, [self._doubles(R), self._doubles(V), self._doubles(A),
+                                                self._d4(guess), self._doubles(Y), self._doubles(F0),
+                                                self._doubles(pose)])
         return Y, F0, pose

@@ -10,14 +10,13 @@ writing the output files."""
 import argparse
 import math
 import os
-import platform
 import sys
 import time
 from pathlib import Path
 
 from . import extras, plots
 from .fmu import find_fmu
-from .locate import BUILD_ENV, DEFAULT_BUILD, build_dir
+from .locate import BUILD_ENV, DEFAULT_BUILD
 
 COMMAND = "pkm4puu"
 
@@ -65,19 +64,6 @@ def prefixed_log(prog):
     def log(msg):
         print(f"{prog}: {msg}", file=sys.stderr, flush=True)
     return log
-
-
-def machine_description():
-    """"Linux x86_64, <CPU model>, <n> cores": the machine a benchmark ran on."""
-    cpu = "unknown"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{platform.system()} {platform.machine()}, {cpu}, {os.cpu_count()} cores"
 
 
 DEFAULT_OUT = Path("results")  # relative to the current directory
@@ -201,16 +187,6 @@ def figures_available(log):
         return True
     log(f"figures skipped: matplotlib is not installed ({extras.install_command(['matplotlib'])} draws them)")
     return False
-
-
-def find_build(build, log):
-    """The build directory (locate.build_dir(build): --build, else
-    $PKM_BUILD_DIR, else ./build), or None after logging why there is none."""
-    try:
-        return build_dir(build)
-    except FileNotFoundError as e:
-        log(f"error: {e}")
-        return None
 
 
 def find_fmus(build, log, models=("PKM4PUU", "PKM4PUU_Inverse")):

@@ -50,7 +50,8 @@ import time
 from pathlib import Path
 
 from .. import extras
-from ..program import ArgumentParser, command_prog, description, writable_dir
+from ..locate import LIBRARY
+from ..program import ArgumentParser, add_build_arg, command_prog, description, writable_dir
 
 TABLE_PAYLOADS = (0.0, 0.1, 0.25, 0.5)  # kg
 TABLE_F_MAX = (5.0, 10.0, 20.0)  # N
@@ -79,9 +80,7 @@ def parser():
         ap.add_argument(flag, type=kind, default=default, metavar=metavar, help=f"{what} (default %(default)g {unit})")
     ap.add_argument("--plan-only", action="store_true",
                     help="plan the cycle only, without the closed-loop run through the plant FMU")
-    ap.add_argument("--build", type=Path, default=None, metavar="DIR",
-                    help="build directory holding lib/libpkm.so (default: $PKM_BUILD_DIR, else the installed "
-                         "package's own, else ./build)")
+    add_build_arg(ap, holding=f"the C API's library {LIBRARY} and, for the closed loop, PKM4PUU.fmu")
     out = ap.add_mutually_exclusive_group()
     out.add_argument("--out", type=writable_dir, default=None, metavar="DIR",
                      help="write cycle.csv, cycle.png, closed_loop.csv and closed_loop.png into DIR (default: "
@@ -103,12 +102,11 @@ def write_csv(rows, columns, path):
 
 
 def plot(cycle, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """The plan: the forces and the slider speeds against their limits, the
+    path speed against its slider-speed limit, the path in 3D."""
     import numpy as np
-
-    fig = plt.figure(figsize=(12, 8.5))
+    from ..plots import pyplot, save_figure
+    fig = pyplot().figure(figsize=(12, 8.5))
     ax_f, ax_v, ax_s = fig.add_subplot(2, 2, 1), fig.add_subplot(2, 2, 2), fig.add_subplot(2, 2, 3)
     ax_p = fig.add_subplot(2, 2, 4, projection="3d")
     t0 = 0.0
@@ -119,7 +117,7 @@ def plot(cycle, path):
             ax_f.plot(t, seg.F[:, i], f"C{i}", lw=1.2, label=label)
             ax_v.plot(t, seg.drho[:, i], f"C{i}", lw=1.2, label=label)
         ax_s.plot(seg.path.arch_s(seg.s), seg.sd, f"C{4 + k}", lw=1.5, label=f"{seg.name}: ds/dt")
-        ax_s.plot(seg.path.arch_s(seg.s), np.sqrt(seg.x_max()), f"C{4 + k}", ls=":", lw=1.0,
+        ax_s.plot(seg.path.arch_s(seg.s), np.sqrt(seg.x_max), f"C{4 + k}", ls=":", lw=1.0,
                   label=f"{seg.name}: slider-speed limit")
         ax_p.plot(1e3 * seg.pose[:, 0], 1e3 * seg.pose[:, 1], 1e3 * seg.pose[:, 2], f"C{4 + k}",
                   label=f"{seg.name} ({seg.payload_mass:g} kg), {seg.duration:.3f} s")
@@ -155,9 +153,7 @@ def plot(cycle, path):
     ax_p.set_title("the path of P", fontsize=9)
     ax_p.legend(fontsize=7, loc="upper left")
     fig.suptitle(f"pick-and-place cycle: {cycle.duration:.4f} s ({cycle.arch.describe()})", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
 
 
 def plot_closed_loop(track, path):
@@ -243,9 +239,23 @@ def write_outputs(cycle, out, track=None):
 
 
 def table(args):
-    """The Markdown table of cycle time against payload and f_max."""
+    """The Markdown table of cycle time against payload and f_max. The
+    arch's poses are checked once (neither the payload nor the direction
+    changes them); B -> A, always empty, is planned once per f_max."""
     from ..planning import Infeasible, Limits, arch, plan_segment
+    from ..planning.segment import check_path, grid_points
     arch = arch(args.a, args.h, args.z0, math.radians(args.theta_deg))
+    check_path(arch, grid_points(args.grid), build=args.build, name="the arch")
+
+    def leg(path, mass, limits, name):
+        """(its two cells, its time in s; nan when infeasible)."""
+        try:
+            seg = plan_segment(path, mass, limits, grid=args.grid, dt=args.dt, name=name, build=args.build,
+                               check_workspace=False)
+        except Infeasible as e:
+            return ["—", f"infeasible: {e.short}"], math.nan
+        return [f"{seg.duration:.4f}", seg.active_summary()], seg.duration
+
     lines = [f"Cycle time on the {arch.describe()}, |drho_i/dt| <= {args.v_max:g} m/s; the payload is carried "
              "from A to B, the platform returns empty. Active: the share of each leg's time with a force or the "
              "speed limit at its bound.", "",
@@ -253,18 +263,12 @@ def table(args):
              "|---:|---:|---:|---|---:|---|---:|"]
     for f_max in TABLE_F_MAX:
         limits = Limits(f_max, args.v_max)
+        back_cells, back_time = leg(arch.reversed(), 0.0, limits, "B -> A")
         for payload in TABLE_PAYLOADS:
-            cells, total = [], 0.0
-            for path, mass, name in ((arch, payload, "A -> B"), (arch.reversed(), 0.0, "B -> A")):
-                try:
-                    seg = plan_segment(path, mass, limits, grid=args.grid, dt=args.dt, name=name, build=args.build)
-                    cells += [f"{seg.duration:.4f}", seg.active_summary()]
-                    total += seg.duration
-                except Infeasible as e:
-                    cells += ["—", f"infeasible: {e.short}"]
-                    total = math.nan
+            there_cells, there_time = leg(arch, payload, limits, "A -> B")
+            total = there_time + back_time
             cycle = "—" if math.isnan(total) else f"{total:.4f}"
-            lines.append(f"| {payload:g} | {f_max:g} | {' | '.join(cells)} | {cycle} |")
+            lines.append(f"| {payload:g} | {f_max:g} | {' | '.join(there_cells + back_cells)} | {cycle} |")
     return "\n".join(lines)
 
 
@@ -272,10 +276,10 @@ def main(argv=None):
     ap = parser()
     args = ap.parse_args(argv)
     extras.require(ap.prog, "toppra", *(("matplotlib",) if args.out is not None else ()))
+    from .. import capi
     from ..planning import PlanningError, plan_cycle
     try:
-        from ..planning.capi_adapter import _library
-        _library(args.build)
+        capi.load(capi.library_path(args.build))
     except OSError as e:
         return error(f"cannot load the C API library: {e}", 1)
     plant_fmu = None
@@ -287,11 +291,8 @@ def main(argv=None):
             return error(f"the closed loop needs the plant FMU: {e} (--plan-only plans without it)", 1)
     try:
         if args.table:
-            from ..planning import Limits, arch
-            from ..planning.segment import check_path, grid_points
+            from ..planning import Limits
             Limits(args.f_max, args.v_max)  # the values checked before the sweep
-            check_path(arch(args.a, args.h, args.z0, math.radians(args.theta_deg)), grid_points(args.grid),
-                       build=args.build, name="the arch")
             print(table(args), flush=True)
             return 0
         t0 = time.perf_counter()

@@ -15,16 +15,6 @@ import numpy as np
 
 from .. import capi
 
-_LIBRARIES = {}
-
-
-def _library(build=None):
-    path = str(capi.library_path(build))
-    if path not in _LIBRARIES:
-        _LIBRARIES[path] = capi.load(path)
-    return _LIBRARIES[path]
-
-
 class PoseError(ValueError):
     """A pose the machine cannot take. kind: "unreachable" (a leg cannot
     reach it elbow-down), "singular" (beyond the singularity guards) or
@@ -36,17 +26,35 @@ class PoseError(ValueError):
         self.kind, self.index, self.leg = kind, index, leg
 
 
+# The friction parameters a frictionless model sets to zero.
+FRICTIONLESS = {"friction_viscous": 0.0, "friction_coulomb": 0.0}
+
+
+def model_parameters(machine=None, params=None):
+    """One dict of the model's parameters by the FMUs' names from the
+    planner's two, `machine`'s value where both give one."""
+    return {**(params or {}), **(machine or {})}
+
+
 class InverseDynamics:
     """One model of the machine (pkm_create, then its parameters by the
-    FMUs' names): `params` and `machine` override the defaults (e.g.
-    {"g": 0.0}; screw_lead, rotor_inertia, friction_viscous, ...), the
-    payload `payload_mass` kg at P. ValueError naming the parameter if the C
-    API refuses one."""
+    FMUs' names): `params` and `machine`, both by those names, override the
+    defaults (e.g. {"g": 0.0}; screw_lead, rotor_inertia, friction_viscous,
+    ...), `machine` where both give one; the payload `payload_mass` kg at P.
+    ValueError naming the parameter if the C API refuses one.
 
-    def __init__(self, payload_mass=0.0, machine=None, params=None, build=None):
-        values = {**(params or {}), **(machine or {}), "payload_mass": float(payload_mass)}
+    screw_lead (m) and friction (friction_viscous N s/m, friction_coulomb
+    N) are read back from the model as given; `frictionless` then zeroes
+    its friction (FRICTIONLESS) in the forces it computes."""
+
+    def __init__(self, payload_mass=0.0, machine=None, params=None, build=None, frictionless=False):
+        values = {**model_parameters(machine, params), "payload_mass": float(payload_mass)}
         try:
-            self._plant = capi.Plant(_library(build), **values)
+            self._plant = capi.Plant(capi.load(capi.library_path(build)), **values)
+            self.screw_lead = self._plant.get("screw_lead")
+            self.friction = (self._plant.get("friction_viscous"), self._plant.get("friction_coulomb"))
+            if frictionless:
+                self._plant.set(**FRICTIONLESS)
         except (capi.PkmError, TypeError) as e:
             raise ValueError(str(e)) from None
         self.rho_limits = (self._plant.get("rho_min"), self._plant.get("rho_max"))

@@ -7,14 +7,13 @@ from typing import List, Optional
 
 import numpy as np
 
-from .. import spec
+from .. import interface, spec
 from .limits import Limits, check_value
 from .paths import Arch
 from .segment import DT, GRID, Segment, check_path, grid_points, plan_segment
 
 # The columns of cycle.csv, in order (SI units).
-COLUMNS = (["t", "x", "y", "z", "phi", "dx", "dy", "dz", "dphi", "ddx", "ddy", "ddz", "ddphi"]
-           + [f"F[{i}]" for i in range(1, 5)] + ["payload_mass"])
+COLUMNS = ["t"] + interface.POSE + interface.VEL + interface.ACC + interface.F + ["payload_mass"]
 
 
 @dataclass
@@ -70,10 +69,12 @@ def plan_cycle(payload=spec.CYCLE_PAYLOAD, f_max=spec.CYCLE_F_MAX, v_max=spec.CY
     (m, rad): `payload` kg carried from A (s = 0) to B (s = 1), back empty;
     abs(F_i) <= f_max (N), abs(drho_i/dt) <= v_max (m/s), optionally the motors'
     torque_max (N m) and motor_speed_max (rad/s) through the screw. The
-    defaults are the standard cycle. machine: pkm_machine_params fields
-    (screw_lead, rotor_inertia, friction_viscous, friction_coulomb, ...);
-    params: pkm_params fields. Returns a Cycle; PlanningError (its
-    subclasses) says why and where when there is none."""
+    defaults are the standard cycle. machine and params: the model's
+    parameters by the FMUs' names, either dict taking any of them (machine's
+    where both give one), e.g. machine={"screw_lead": ..., "rotor_inertia":
+    ..., "friction_viscous": ..., "friction_coulomb": ...}, params={"g": 0.0}.
+    Returns a Cycle; PlanningError (its subclasses) says why and where when
+    there is none."""
     payload = check_value("payload", payload, unit=" kg")
     path = arch(a, h, z0, theta)
     limits = Limits(f_max, v_max, torque_max, motor_speed_max)

@@ -7,8 +7,10 @@ Friction is not of the form a sdd + b sd^2 + c (it goes with sign(drho) and
 drho, not sd^2), so the plan keeps the friction-free forces within the
 force limit less a bound on friction, abs(F_fric,i) <= b v_lim + F_c (b
 friction_viscous, F_c friction_coulomb, v_lim the speed limit), and the
-samples are then checked with friction (the C API's machine inverse
-dynamics). With friction off, the default, nothing is taken off.
+samples are then checked with friction (the C API's inverse dynamics).
+The screw lead and the friction are the model's (the C API's parameters,
+given by the FMUs' names in `machine` or `params`). With friction off, the
+default, nothing is taken off.
 """
 import math
 from dataclasses import dataclass, field
@@ -23,8 +25,6 @@ GRID = 2000  # grid intervals per segment (docs/pick_and_place.md: the time's gr
 DT = 1e-4  # s, the samples' spacing
 ACTIVE_TOLERANCE = 1e-6  # a limit within this fraction of its value is active (toppra keeps ~1e-8 from it)
 SAMPLE_TOLERANCE = 1e-3  # the samples may pass a limit by this fraction (the grid's interpolation error)
-FRICTIONLESS = {"friction_viscous": 0.0, "friction_coulomb": 0.0}
-DEFAULT_SCREW_LEAD = 0.004  # m, pkm_default_machine_params
 
 
 def shown_s(path, s):
@@ -40,12 +40,21 @@ def where(path, s):
 
 
 def dynamics(payload_mass, machine, params, build):
-    """capi_adapter.InverseDynamics without friction; BadValue naming a
-    parameter the C API refuses."""
+    """capi_adapter.InverseDynamics without friction (its screw_lead and
+    friction: the model's as given); BadValue naming a parameter the C API
+    refuses."""
     try:
-        return InverseDynamics(payload_mass, {**(machine or {}), **FRICTIONLESS}, params, build)
+        return InverseDynamics(payload_mass, machine, params, build, frictionless=True)
     except ValueError as e:
         raise BadValue(str(e)) from None
+
+
+def speed_bound(speed_limit, drho_ds):
+    """x_max, the slider-speed limit on sd^2 at each grid point:
+    speed_limit^2 / max_i (drho_i/ds)^2 (inf where no slider moves)."""
+    den = (drho_ds ** 2).max(axis=1)
+    with np.errstate(divide="ignore"):
+        return np.where(den > 0, speed_limit ** 2 / den, np.inf)
 
 
 def grid_points(grid):
@@ -73,9 +82,9 @@ def check_path(path, s, machine=None, params=None, build=None, name="the path"):
 class Segment:
     """A planned traversal. Grid (N + 1 points s, N intervals): x = sd^2,
     u = sdd (constant on each interval), t_grid; a, b, c (F = a sdd + b sd^2
-    + c, friction-free) and drho_ds at the grid points. Samples every dt
-    (and at the end): t, pose, velocity, acceleration (each (n, 4)), F
-    (friction included), rho, drho. SI units."""
+    + c, friction-free), drho_ds and the bound x_max (speed_bound) at the
+    grid points. Samples every dt (and at the end): t, pose, velocity,
+    acceleration (each (n, 4)), F (friction included), rho, drho. SI units."""
     name: str
     payload_mass: float
     path: object
@@ -91,6 +100,7 @@ class Segment:
     b: np.ndarray
     c: np.ndarray
     drho_ds: np.ndarray
+    x_max: np.ndarray
     t: np.ndarray = field(default=None, repr=False)
     pose: np.ndarray = field(default=None, repr=False)
     velocity: np.ndarray = field(default=None, repr=False)
@@ -138,18 +148,13 @@ class Segment:
         end = self.a[1:] * u + self.b[1:] * self.x[1:, None] + self.c[1:]
         return start, end
 
-    def x_max(self):
-        """The speed limit on sd^2 at each grid point (inf where no slider moves)."""
-        with np.errstate(divide="ignore"):
-            return self.speed_limit ** 2 / (self.drho_ds ** 2).max(axis=1)
-
     def activity(self):
         """Per interval, the largest use of the force limit (abs(F_i) over the
         limit less the friction bound) and of the speed limit (x over x_max)
         at its two ends."""
         start, end = self.grid_forces()
         f = np.maximum(np.abs(start).max(axis=1), np.abs(end).max(axis=1)) / (self.force_limit - self.friction_bound)
-        xm = self.x_max()
+        xm = self.x_max
         with np.errstate(invalid="ignore"):
             v = np.nan_to_num(np.maximum(self.x[:-1] / xm[:-1], self.x[1:] / xm[1:]))
         return f, v
@@ -186,31 +191,31 @@ def plan_segment(path, payload_mass=0.0, limits=None, machine=None, params=None,
                  build=None, check_workspace=True):
     """The fastest rest-to-rest traversal of `path` (p(s), s in [0, 1]; see
     paths.Arch) carrying `payload_mass` kg at P, within `limits` (a
-    limits.Limits), for the machine `machine` and model `params` (the FMUs'
-    parameter names, e.g. rotor_inertia, screw_lead, friction_viscous, g),
-    on `grid` intervals of s, sampled every `dt` s. PlanningError (its
-    subclasses) when it cannot be planned, saying why and where;
-    extras.MissingExtra without toppra (the extra `planning`)."""
+    limits.Limits), for the model's parameters `machine` and `params` (both
+    by the FMUs' names, e.g. rotor_inertia, screw_lead, friction_viscous, g;
+    `machine` where both give one), on `grid` intervals of s, sampled every
+    `dt` s. PlanningError (its subclasses) when it cannot be planned, saying
+    why and where; extras.MissingExtra without toppra (the extra
+    `planning`)."""
     extras.require("pkm4puu.plan_cycle", "toppra")
     from . import topp  # toppra's classes at its module level
     limits = limits or Limits()
     payload_mass = check_value("payload_mass", payload_mass, unit=" kg")
     s = grid_points(grid)
     dt = check_value("dt", dt, strict=True, unit=" s")
-    machine = dict(machine or {})
     if not np.any(path(s, 1)):
         raise BadValue(f"{name} does not move: its start and end poses coincide and nothing between differs")
     if check_workspace:
         check_path(path, s, machine, params, build, name)
-    lead = machine.get("screw_lead", DEFAULT_SCREW_LEAD)
-    f_lim, f_src = limits.force(lead)
-    v_lim, v_src = limits.speed(lead)
-    friction = machine.get("friction_viscous", 0.0) * v_lim + machine.get("friction_coulomb", 0.0)
-    f_eff = f_lim - friction
-    if f_eff <= 0:
-        raise Infeasible(f"{f_src} leaves nothing once friction is allowed for "
-                         f"(|F_fric| <= b v_lim + F_c = {friction:.4g} N)", "friction takes the whole force limit")
     with dynamics(payload_mass, machine, params, build) as dyn:
+        f_lim, f_src = limits.force(dyn.screw_lead)
+        v_lim, v_src = limits.speed(dyn.screw_lead)
+        viscous, coulomb = dyn.friction
+        friction = viscous * v_lim + coulomb
+        f_eff = f_lim - friction
+        if f_eff <= 0:
+            raise Infeasible(f"{f_src} leaves nothing once friction is allowed for "
+                             f"(|F_fric| <= b v_lim + F_c = {friction:.4g} N)", "friction takes the whole force limit")
         a, b, c, drho_ds = topp.path_coefficients(dyn, path, s)
     need = np.abs(c) - f_eff
     k, i = np.unravel_index(np.argmax(need), need.shape)
@@ -219,17 +224,14 @@ def plan_segment(path, payload_mass=0.0, limits=None, machine=None, params=None,
         raise Infeasible(f"{name}: holding the {payload_mass:g} kg payload at rest at {where(path, s[k])} needs "
                          f"F[{i + 1}] = {c[k, i]:.4g} N, beyond {f_src}{less}",
                          f"F[{i + 1}] = {c[k, i]:.3g} N to hold at s = {shown_s(path, s[k]):.2f}")
-    den = (drho_ds ** 2).max(axis=1)
-    with np.errstate(divide="ignore"):
-        x_max = np.where(den > 0, v_lim ** 2 / den, np.inf)
-    finite = x_max[np.isfinite(x_max)]
-    x_max = np.minimum(x_max, 1e6 * finite.max() if finite.size else 1e12)
+    x_max = speed_bound(v_lim, drho_ds)
     try:
         x, u = topp.solve(s, a, b, c, f_eff, x_max)
     except topp.NoTraversal as e:
         raise Infeasible(f"{name}: no rest-to-rest traversal within {f_src} and {v_src} (toppra: {e})",
                          "no traversal found") from None
-    seg = Segment(name, payload_mass, path, f_lim, f_src, v_lim, v_src, friction, s, x, u, a, b, c, drho_ds)
+    seg = Segment(name, payload_mass, path, f_lim, f_src, v_lim, v_src, friction, s, x, u, a, b, c, drho_ds,
+                  x_max)
     sample(seg, dt, machine, params, build)
     return seg
 

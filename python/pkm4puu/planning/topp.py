@@ -96,9 +96,13 @@ class NoTraversal(RuntimeError):
 def solve(s, a, b, c, force_limit, x_max):
     """The fastest rest-to-rest traversal: x = sd^2 at the grid points (N+1)
     and u = sdd on the intervals (N), with abs(F_i) <= force_limit and
-    sd^2 <= x_max. Time is rescaled for toppra so that its variables are
-    of order SCALE: its forward pass steps each x back by an absolute 1e-8
-    (to stay within the controllable sets), which is then 1e-10 of x."""
+    sd^2 <= x_max (inf where no slider moves, where toppra, which needs a
+    finite bound, gets one far above the others). Time is rescaled for
+    toppra so that its variables are of order SCALE: its forward pass steps
+    each x back by an absolute 1e-8 (to stay within the controllable sets),
+    which is then 1e-10 of x."""
+    finite = x_max[np.isfinite(x_max)]
+    x_max = np.minimum(x_max, 1e6 * finite.max() if finite.size else 1e12)
     with np.errstate(divide="ignore"):
         u_scale = np.median(force_limit / np.abs(a).max(axis=1))
     k2 = min(np.median(x_max), u_scale if np.isfinite(u_scale) else np.inf) / SCALE

@@ -42,9 +42,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import spec
+from .. import interface
 from ..closed_loop import closed_loop
-from .capi_adapter import InverseDynamics
+from .capi_adapter import InverseDynamics, model_parameters
 from .segment import sample_times
 
 BANDWIDTH = 50.0  # Hz, the feedback's
@@ -52,8 +52,8 @@ LOOP_STEP = 1e-4  # s: the loop's sampling, 10 kHz
 TRACKING_BOUND = 1e-4  # m: |p - p_ref| of P in closed loop
 ENERGY = ["kinetic_energy", "potential_energy", "actuator_work", "dissipated_energy"]
 # The columns of closed_loop.csv, in order (SI units).
-COLUMNS = (["t", "x", "y", "z", "phi", "x_ref", "y_ref", "z_ref", "phi_ref"] + [f"F[{i}]" for i in range(1, 5)]
-           + [f"F_ff[{i}]" for i in range(1, 5)] + ["payload_mass"] + ENERGY)
+COLUMNS = (["t"] + interface.POSE + [f"{name}_ref" for name in interface.POSE] + interface.F
+           + interface.indexed_names("F_ff", 4) + ["payload_mass"] + ENERGY)
 
 
 @dataclass(frozen=True)
@@ -185,8 +185,8 @@ def track_cycle(cycle, plant_fmu=None, step=LOOP_STEP, f_c=BANDWIDTH, zeta=1.0, 
     masses = np.linalg.eigvalsh(0.5 * (M_rho + M_rho.transpose(0, 2, 1)))
     gains = Gains(f_c, zeta, (float(masses.min()), float(masses.max())))
     kp, kd = gains.w ** 2, 2 * zeta * gains.w
-    start = {**(cycle.params or {}), **(cycle.machine or {}), "solver": 1, "rk4_step": float(np.diff(t).max()),
-             **dict(zip(("x0", "y0", "z0", "phi0"), (float(v) for v in there.pose[0])))}
+    start = {**model_parameters(cycle.machine, cycle.params), **interface.RK4, "rk4_step": float(np.diff(t).max()),
+             **interface.start_pose(there.pose[0])}
     energy = np.empty((len(t), len(ENERGY)))
     booked = []
     grasps = {0: there.payload_mass, k_release: back.payload_mass}
@@ -204,6 +204,7 @@ def track_cycle(cycle, plant_fmu=None, step=LOOP_STEP, f_c=BANDWIDTH, zeta=1.0, 
     with Fmu(plant_fmu, start=start, instance_name="plant") as plant:
         vr_energy = plant.vrs(ENERGY)
         vr_payload = plant.vrs(["payload_mass"])
+        phi_bound = TRACKING_BOUND / float(plant.get(["r_Q"])[0])  # the plant's r_Q, from either dict
 
         def at_sample(r, k):
             energy[k] = plant.fmu.getReal(vr_energy)
@@ -215,7 +216,6 @@ def track_cycle(cycle, plant_fmu=None, step=LOOP_STEP, f_c=BANDWIDTH, zeta=1.0, 
             loop = closed_loop(plant, t, reference, control, progress, log, "closed loop", at_sample)
         except FMICallException as e:
             raise RuntimeError(f"the closed loop through {Path(plant_fmu).name} stopped: {e}") from None
-    phi_bound = TRACKING_BOUND / (cycle.params or {}).get("r_Q", spec.R_Q)
     return Tracking(loop, payload, energy, booked, gains, cycle, phi_bound)
 
 
