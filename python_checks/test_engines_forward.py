@@ -24,10 +24,10 @@ import numpy as np
 import pytest
 
 from conftest import command_help, promised_files
-from pkm4puu.cli.engine_comparison import (CAPI_SOLVERS, TIMES, TOL_CONSTRAINT, TOL_FMU_PHI, TOL_FMU_POS,
-                                           TOL_PHI, TOL_POS, TOL_REF_PHI, TOL_REF_POS, capi_run, deviation,
-                                           fmu_runs, load_capi, mujoco_run, pinocchio_reference, pinocchio_rk4,
-                                           write_results)
+from pkm4puu.cli.engine_comparison import (CAPI_SOLVERS, TIMES, TOL_CONSTRAINT, TOL_FMU_PHI, TOL_FMU_POS, TOL_PHI,
+                                           TOL_POS, TOL_REF_PHI, TOL_REF_POS, capi_run, deviation, fmu_runs, load_capi,
+                                           mujoco_run, pinocchio_reference, pinocchio_rk4)
+from pkm4puu.cli.engine_report import write_results
 
 
 @pytest.fixture(scope="module")

@@ -35,12 +35,12 @@ import math
 import numpy as np
 import pytest
 
-from pkm4puu.cli.engine_comparison import (AUTOTEST_TIMES, CAPI_SOLVERS, EFFECT_FACTOR,
-                                           MUJOCO_MACHINE_CONSTRAINT, STOP_MARGIN, TOL_CONSTRAINT,
-                                           TOL_MACHINE_ID, TOL_MACHINE_PHI, TOL_MACHINE_POS, TOL_PHI, TOL_POS,
-                                           TOL_REF_PHI, TOL_REF_POS, capi_inverse_machine, deviation,
-                                           format_machine_table, load_capi, machine_cases, machine_run,
+from pkm4puu.cli.engine_comparison import (AUTOTEST_TIMES, CAPI_SOLVERS, EFFECT_FACTOR, MUJOCO_MACHINE_CONSTRAINT,
+                                           STOP_MARGIN, TOL_CONSTRAINT, TOL_MACHINE_ID, TOL_MACHINE_PHI,
+                                           TOL_MACHINE_POS, TOL_PHI, TOL_POS, TOL_REF_PHI, TOL_REF_POS,
+                                           capi_inverse_machine, deviation, load_capi, machine_cases, machine_run,
                                            pinocchio_inverse_machine)
+from pkm4puu.cli.engine_report import format_machine_table
 from pkm4puu import capi as pkm_capi, spec
 from pkm4puu.references.pinocchio_model import LEG_ROWS, PinocchioPKM
 

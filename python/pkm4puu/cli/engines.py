@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """pkm4puu engines: validation against Pinocchio and MuJoCo models of the
 same mechanism: inverse dynamics along the auto-test, the comparison test,
-the machine's terms (engine_comparison.py runs them). Prints the tables,
-writes engines_comparison.csv and the figures to --out DIR, exits 1 when a
-bound is not met. Needs the extra `references` (Pinocchio, MuJoCo, SciPy);
+the machine's terms (engine_comparison.py runs them, engine_report.py
+reports them). Prints the tables, writes engines_comparison.csv and the
+figures to --out DIR, exits 1 when a bound is not met. Needs the extra `references` (Pinocchio, MuJoCo, SciPy);
 the figures the extra `plots`.
 """
 
@@ -32,7 +32,7 @@ def main(argv=None):
     import mujoco
     import pinocchio
 
-    from . import engine_comparison as ec
+    from . import engine_comparison as ec, engine_report
     log = prefixed_log(ap.prog)
     try:
         plant, inverse = (find_fmu(model, 2, args.build) for model in ("PKM4PUU", "PKM4PUU_Inverse"))
@@ -48,10 +48,10 @@ def main(argv=None):
     if not args.no_sweep:
         log("MuJoCo constraint settings")
         sweep = ec.run_sweep(r["ref_held"])
-    print(ec.format_tables(r, sweep), flush=True)
-    for path in ec.write_results(r, args.out, figures):
+    print(engine_report.format_tables(r, sweep), flush=True)
+    for path in engine_report.write_results(r, args.out, figures):
         log(f"wrote {path}")
-    bad = ec.check(r)
+    bad = engine_report.check(r)
     for msg in bad:
         log(f"FAILED: {msg}")
     return 1 if bad else 0
