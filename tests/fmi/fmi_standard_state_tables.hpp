@@ -25,52 +25,57 @@ struct Row {
   const char* clause;    // where the standard says so
 };
 
-/// A condition of a cell, in the tables it belongs to ("2.0": both FMI 2.0
-/// tables; 8 is another condition in each).
-/// `state_allows`: the state allows the call, for the variables (or with the
-/// caveat) the condition names; else a property of the FMU or of its
-/// instantiation decides, per FMU.
+/// A condition of a cell. `state_allows`: the state allows the call, for
+/// the variables (or with the caveat) the condition names; else a property
+/// of the FMU or of its instantiation decides, per FMU.
 struct Condition {
-  const char* table;  // "2.0 ME", "2.0 CS", "2.0" (both), "3.0"
   char id;
   bool state_allows;
   const char* text;  // the standard's words
 };
+/// FMI 2.0's conditions, in the tables they belong to ("2.0": both; 8 is
+/// another condition in each).
+struct Condition2 {
+  const char* table;  // "2.0 ME", "2.0 CS", "2.0"
+  Condition condition;
+};
 
 // clang-format off
-inline constexpr Condition kConditions[] = {
+inline constexpr Condition2 kFmi2Conditions[] = {
   // FMI 2.0.4 below the tables of sections 3.2.3 (Model Exchange) and 4.2.4
   // (Co-Simulation): the same words where both tables have a number.
-  {"2.0", '1', true, "for a variable with variability != \"constant\" that has initial = \"exact\" or \"approx\""},
-  {"2.0", '2', true, "for a variable with causality = \"output\" or variables listed under "
-                     "<ModelStructure><InitialUnknowns>"},
-  {"2.0", '3', true, "for a variable with variability != \"constant\" that has initial = \"exact\", or causality = "
-                     "\"input\""},
-  {"2.0 ME", '4', true, "for a variable with causality = \"input\", or (causality = \"parameter\" and variability = "
-                        "\"tunable\")"},
-  {"2.0 ME", '5', true, "for a variable with causality = \"input\" and variability = \"continuous\", and for a "
-                        "continuous-time state variable"},
-  {"2.0 CS", '6', true, "for a variable with causality = \"input\" or (causality = \"parameter\" and variability = "
-                        "\"tunable\")"},
-  {"2.0", '7', true, "always, but retrieved values are usable for debugging only"},
-  {"2.0 ME", '8', false, "only for a Pure Discrete-Time FMU. This exits the current event mode and sets the time "
-                         "for the next event instant"},
-  {"2.0 CS", '8', true, "always, but if status is other than fmi2Terminated, retrieved values are useable for "
-                        "debugging only"},
+  {"2.0", {'1', true, "for a variable with variability != \"constant\" that has initial = \"exact\" or \"approx\""}},
+  {"2.0", {'2', true, "for a variable with causality = \"output\" or variables listed under "
+                      "<ModelStructure><InitialUnknowns>"}},
+  {"2.0", {'3', true, "for a variable with variability != \"constant\" that has initial = \"exact\", or causality = "
+                      "\"input\""}},
+  {"2.0 ME", {'4', true, "for a variable with causality = \"input\", or (causality = \"parameter\" and variability = "
+                         "\"tunable\")"}},
+  {"2.0 ME", {'5', true, "for a variable with causality = \"input\" and variability = \"continuous\", and for a "
+                         "continuous-time state variable"}},
+  {"2.0 CS", {'6', true, "for a variable with causality = \"input\" or (causality = \"parameter\" and variability = "
+                         "\"tunable\")"}},
+  {"2.0", {'7', true, "always, but retrieved values are usable for debugging only"}},
+  {"2.0 ME", {'8', false, "only for a Pure Discrete-Time FMU. This exits the current event mode and sets the time "
+                          "for the next event instant"}},
+  {"2.0 CS", {'8', true, "always, but if status is other than fmi2Terminated, retrieved values are useable for "
+                         "debugging only"}},
+};
+inline constexpr Condition kFmi3Conditions[] = {
   // FMI 3.0.2, the text of each state's allowed calls (letters are this file's).
-  {"3.0", 's', true, "Instantiated: get variable start values as defined in modelDescription.xml (2.3.2)"},
-  {"3.0", 'a', true, "Instantiated: variables with variability != constant and with initial = exact or approx (2.3.2)"},
-  {"3.0", 'b', true, "Initialization Mode: variables with variability != constant and with initial = exact; inputs "
-                     "included (2.3.3)"},
-  {"3.0", 'c', true, "Event Mode: causality = input, causality = parameter and variability = tunable, and "
-                     "continuous-time states with reinit = false (2.3.5)"},
-  {"3.0", 'd', true, "Continuous-Time Mode: only for variables with causality = input and variability = continuous, "
-                     "and continuous-time states (3.2.1)"},
-  {"3.0", 'e', true, "Step Mode: causality = input, or causality = parameter and variability = tunable (4.2.1)"},
-  {"3.0", 'v', false, "fmi3EnterEventMode in Step Mode: must not be called if fmi3InstantiateCoSimulation signaled "
-                      "eventModeUsed = fmi3False, which can be forced by the FMU with hasEventMode = false (4.2.1)"},
-  {"3.0", 'z', false, "fmi3EnterConfigurationMode: must not be called if the FMU contains no structural parameters "
-                      "(2.3.2, 2.3.5, 4.2.1)"},
+  {'s', true, "Instantiated: get variable start values as defined in modelDescription.xml (2.3.2)"},
+  {'a', true, "Instantiated: variables with variability != constant and with initial = exact or approx (2.3.2)"},
+  {'b', true, "Initialization Mode: variables with variability != constant and with initial = exact; inputs "
+              "included (2.3.3)"},
+  {'c', true, "Event Mode: causality = input, causality = parameter and variability = tunable, and "
+              "continuous-time states with reinit = false (2.3.5)"},
+  {'d', true, "Continuous-Time Mode: only for variables with causality = input and variability = continuous, "
+              "and continuous-time states (3.2.1)"},
+  {'e', true, "Step Mode: causality = input, or causality = parameter and variability = tunable (4.2.1)"},
+  {'v', false, "fmi3EnterEventMode in Step Mode: must not be called if fmi3InstantiateCoSimulation signaled "
+               "eventModeUsed = fmi3False, which can be forced by the FMU with hasEventMode = false (4.2.1)"},
+  {'z', false, "fmi3EnterConfigurationMode: must not be called if the FMU contains no structural parameters "
+               "(2.3.2, 2.3.5, 4.2.1)"},
 };
 
 // FMI 2.0.4: the table of section 3.2.3, "FMI 2.0 for Model Exchange", and

@@ -86,8 +86,13 @@ void bring_to(Any& a, std::uint32_t state) {
 namespace standard = pkm_test::standard;
 
 const standard::Condition* condition_of(const std::string& table, char cell) {
-  for (const standard::Condition& c : standard::kConditions)
-    if (c.id == cell && table.rfind(c.table, 0) == 0) return &c;  // "2.0" is both "2.0 ME" and "2.0 CS"
+  if (table == "3.0") {
+    for (const standard::Condition& c : standard::kFmi3Conditions)
+      if (c.id == cell) return &c;
+    return nullptr;
+  }
+  for (const standard::Condition2& c : standard::kFmi2Conditions)
+    if (c.condition.id == cell && table.rfind(c.table, 0) == 0) return &c.condition;  // "2.0": "2.0 ME", "2.0 CS"
   return nullptr;
 }
 
