@@ -240,6 +240,7 @@ TEST(StateTable, TheTableMatchesTheStandardsCellByCell) {
           continue;
         }
         const CallRule& rule = pkm_fmi::call_rule(call);
+        const char* row = t.version == 2 ? rule.fmi2 : rule.fmi3;
         const std::uint32_t allowed = (rule.interfaces & mine) ? pkm_fmi::allowed_states(call, t.version) : 0u;
         std::vector<std::pair<std::uint32_t, std::size_t>> cells;  // state, column
         for (std::size_t k = 0; k < t.states.size(); ++k)
@@ -253,7 +254,7 @@ TEST(StateTable, TheTableMatchesTheStandardsCellByCell) {
           EXPECT_EQ((allowed & state) != 0, expected)
               << "FMI " << t.version << (t.me ? " ME " : " CS ") << r.function << " in "
               << pkm_fmi::mode_name(state) << " (column \"" << t.columns[k] << "\", cell '" << cell << "', "
-              << r.clause << "): the FMU's row " << (rule.fmi2 ? rule.fmi2 : rule.fmi3) << " says "
+              << r.clause << "): the FMU's row " << (row ? row : "(none)") << " says "
               << ((allowed & state) ? "allowed" : "not allowed");
           ++compared;
         }
