@@ -186,6 +186,7 @@ PKM_FMI3_GET_SET(Int32, fmi3Int32, get_integer, set_integer)
 fmi3Status fmi3GetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean values[],
                           size_t nValues) {
   return scalar_call(c, "fmi3GetBoolean", nvr, nValues, [&](Instance& i) {
+    if (nvr == 0) return i.get_boolean(vr, 0, nullptr);  // the state check alone
     Status s = Status::OK;
     for (size_t k = 0; k < nvr && pkm_fmi::succeeded(s); ++k) {
       int v = 0;
@@ -199,6 +200,7 @@ fmi3Status fmi3GetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t 
 fmi3Status fmi3SetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Boolean values[],
                           size_t nValues) {
   return scalar_call(c, "fmi3SetBoolean", nvr, nValues, [&](Instance& i) {
+    if (nvr == 0) return i.set_boolean(vr, 0, nullptr);  // the state check alone
     Status s = Status::OK;
     for (size_t k = 0; k < nvr && pkm_fmi::succeeded(s); ++k) {
       const int v = values && values[k] ? 1 : 0;

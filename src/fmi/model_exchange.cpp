@@ -61,6 +61,14 @@ Status Instance::completed_integrator_step(bool* enter_event_mode, bool* termina
 Status Instance::set_time(double t) {
   const char* fn = PKM_FN(SetTime);
   if (!allowed(Call::SetTime, fn)) return Status::Error;
+  // FMI 2.0.4 3.2.3, condition 8: in Event Mode "only for a Pure
+  // Discrete-Time FMU", one without continuous states.
+  if (mode_ == kEventMode && def_.n_states > 0) {
+    log_.error("%s: not allowed in state %s for an FMU with continuous states (only a pure discrete-time FMU sets "
+               "the time in Event Mode); the call has no effect",
+               fn, mode_name(mode_));
+    return Status::Error;
+  }
   if (!std::isfinite(t)) {
     log_.error("%s: time = %g is not finite; the call has no effect", fn, t);
     return Status::Error;
@@ -72,7 +80,7 @@ Status Instance::set_time(double t) {
   // within one internal step, and nothing in this model depends on it. No
   // upper bound in Continuous-Time Mode: a trial evaluation past stopTime
   // computes nothing that is kept (past_stop_time, instance.cpp); in Event
-  // Mode (FMI 2.0) the time is the event's.
+  // Mode (FMI 2.0, a pure discrete-time FMU) the time is the next event's.
   if (mode_ == kEventMode && past_stop_time(fn, t, "the event")) return Status::Error;
   if (t < time_floor_) {
     log_.error("%s: time = %.17g lies before %.17g (%s); the call has no effect", fn, t, time_floor_,

@@ -5,8 +5,9 @@
 // common states, section 3.2 Model Exchange, section 4.2 Co-Simulation),
 // read literally. ME and CS states are distinct bits; a row also says which
 // interfaces have the function. Instance::allowed() checks a call against
-// its row; tests/fmi/state_table.cpp calls every row's function in every
-// state and expects exactly what the row says.
+// its row; tests/fmi/state_table.cpp compares the rows, and the FMU's answer
+// to every function in every state, with the standards' tables transcribed
+// apart from this one (tests/fmi/fmi_standard_state_tables.hpp).
 #pragma once
 
 #include "fmi/instance.hpp"
@@ -31,6 +32,7 @@ enum class Call : unsigned {
   Reset,
   Get,
   Set,
+  SetNonReal,  // the setters of the other types: FMI 2.0 has no Continuous-Time Mode row for them
   FmuState,
   PartialDerivative,
   NotProvided,  // functions this FMU does not provide: Error with the reason, in any state
@@ -84,6 +86,12 @@ inline constexpr CallRule kCallRules[] = {
   {Call::Set, "fmi2SetReal", "fmi3SetFloat64", kInstantiated | kInitializationMode | kRunning,
    kInstantiated | kInitializationMode | kRunning, kForBoth,
    "2.0.4 3.2.3/4.2.4: not after a failed step or termination; 3.0.2 2.3.2-2.3.5, 3.2.1, 4.2.1"},
+  // FMI 3.0.2 3.2.1 allows fmi3Set{VariableType} in Continuous-Time Mode for
+  // continuous inputs and states, which only Float64 variables can be.
+  {Call::SetNonReal, "fmi2SetInteger", "fmi3SetInt32", kInstantiated | kInitializationMode | kEventMode | kStepMode,
+   kInstantiated | kInitializationMode | kRunning, kForBoth,
+   "2.0.4 3.2.3: fmi2SetInteger/Boolean/String not in Continuous-Time Mode, 4.2.4 as fmi2SetReal; 3.0.2 as "
+   "fmi3SetFloat64"},
   {Call::FmuState, "fmi2GetFMUstate", "fmi3GetFMUState", kAlive, kAlive, kForBoth,
    "2.0.4 3.2.3/4.2.4: every state but fatal; 3.0.2 2.3.1: super state FMUStateSettable"},
   {Call::PartialDerivative, "fmi2GetDirectionalDerivative", "fmi3GetDirectionalDerivative",
@@ -108,8 +116,9 @@ inline constexpr CallRule kCallRules[] = {
    kEventMode, kForME, "2.0.4 3.2.3: Event Mode; 3.0.2 2.3.4: Event Mode"},
   {Call::CompletedIntegratorStep, "fmi2CompletedIntegratorStep", "fmi3CompletedIntegratorStep", kContinuousTimeMode,
    kContinuousTimeMode, kForME, "2.0.4 3.2.3: Continuous-Time Mode; 3.0.2 3.2.1: Continuous-Time Mode"},
+  // In Event Mode only for a pure discrete-time FMU (Instance::set_time).
   {Call::SetTime, "fmi2SetTime", "fmi3SetTime", kEventMode | kContinuousTimeMode, kContinuousTimeMode, kForME,
-   "2.0.4 3.2.3: Event and Continuous-Time Mode; 3.0.2 3.2.1: Continuous-Time Mode only"},
+   "2.0.4 3.2.3: Continuous-Time Mode, Event Mode (condition 8); 3.0.2 3.2.1: Continuous-Time Mode only"},
   {Call::SetContinuousStates, "fmi2SetContinuousStates", "fmi3SetContinuousStates", kContinuousTimeMode,
    kContinuousTimeMode, kForME, "2.0.4 3.2.3: Continuous-Time Mode; 3.0.2 3.2.1: Continuous-Time Mode"},
   {Call::GetContinuousStates, "fmi2GetContinuousStates", "fmi3GetContinuousStates",
@@ -117,20 +126,20 @@ inline constexpr CallRule kCallRules[] = {
    kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError, kForME,
    "2.0.4 3.2.3: not in instantiated; 3.0.2 2.3.3-2.3.5, 3.2.1"},
   {Call::GetDerivatives, "fmi2GetDerivatives", "fmi3GetContinuousStateDerivatives",
-   kEventMode | kContinuousTimeMode | kTerminated | kError,
+   kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError,
    kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError, kForME,
-   "2.0.4 3.2.3: not in Initialization Mode; 3.0.2 2.3.3: also Initialization Mode"},
+   "2.0.4 3.2.3: not in instantiated (Initialization Mode since 2.0.1); 3.0.2 2.3.3, 2.3.5, 3.2.1, 2.3.8"},
   {Call::GetEventIndicators, "fmi2GetEventIndicators", "fmi3GetEventIndicators",
    kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError,
    kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError, kForME,
    "2.0.4 3.2.3: not in instantiated; 3.0.2 2.3.3-2.3.5, 3.2.1"},
   {Call::GetNominals, "fmi2GetNominalsOfContinuousStates", "fmi3GetNominalsOfContinuousStates",
-   kInstantiated | kEventMode | kContinuousTimeMode | kTerminated | kError,
+   kInstantiated | kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError,
    kInitializationMode | kEventMode | kContinuousTimeMode | kTerminated | kError, kForME,
-   "2.0.4 3.2.3: instantiated, not Initialization Mode; 3.0.2 2.3.3 Initialization Mode, super state Initialized, "
-   "2.3.5 Terminated"},
-  {Call::GetNumberOf, nullptr, "fmi3GetNumberOfContinuousStates", 0, kAlive, kForME,
-   "3.0.2 2.3.2: \"can only be called in Model Exchange\""},
+   "2.0.4 3.2.3: every state but start and fatal; 3.0.2 2.3.3 Initialization Mode, 2.3.4 super state "
+   "Initialized, 2.3.8 Terminated"},
+  {Call::GetNumberOf, nullptr, "fmi3GetNumberOfContinuousStates", 0, kInstantiated | kEventMode, kForME,
+   "3.0.2 2.3.2: Instantiated, \"can only be called in Model Exchange\"; 2.3.5: Event Mode"},
 };
 // clang-format on
 

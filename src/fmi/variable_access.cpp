@@ -72,7 +72,7 @@ Status Instance::get_values(const char* function, VarType type, const std::uint3
 template <class T>
 Status Instance::set_values(const char* function, VarType type, const std::uint32_t vr[], std::size_t n,
                             const T value[]) {
-  if (!allowed(Call::Set, function)) return Status::Error;
+  if (!allowed(type == VarType::Real ? Call::Set : Call::SetNonReal, function)) return Status::Error;
   if (n == 0) return Status::OK;
   if (!vr || !value) {
     log_.error("%s: NULL value reference or value array", function);
@@ -189,7 +189,7 @@ Status Instance::set_boolean(const std::uint32_t vr[], std::size_t n, const int 
 
 Status Instance::no_variables_of_type(const char* function, const char* type, const std::uint32_t vr[],
                                       std::size_t n, bool setter) {
-  if (!allowed(setter ? Call::Set : Call::Get, function)) return Status::Error;
+  if (!allowed(setter ? Call::SetNonReal : Call::Get, function)) return Status::Error;
   if (n == 0) return Status::OK;
   log_.error("%s: unknown value reference %u (this FMU has no %s variables)", function,
              vr ? static_cast<unsigned>(vr[0]) : 0u, type);
