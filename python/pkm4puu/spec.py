@@ -114,6 +114,7 @@ def constraint_residual(q16):
 SCREW_LEAD = 0.004  # m per revolution
 FRICTION_VELOCITY = 1e-3  # m/s, v_s of the tanh regularisation
 RHO_MIN, RHO_MAX = 0.0, 0.15  # m, end stops
+STOP_STIFFNESS, STOP_DAMPING = 1e5, 100.0  # N/m, N s/m: the compliant stops' k and d
 
 
 class Machine:
