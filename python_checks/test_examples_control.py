@@ -7,7 +7,7 @@ given it, and without feed-forward at all."""
 import numpy as np
 import pytest
 
-from pkm4puu.spec import G, M_PLATFORM, M_ROD, M_SLIDER, TOTAL_WEIGHT
+from pkm4puu.spec import G, TOTAL_WEIGHT, vertical_momentum as spec_momentum
 from example_scripts import load_example
 
 clc = load_example("closed_loop_control")
@@ -21,14 +21,8 @@ def runs(plant_fmu, inverse_fmu):
 
 
 def vertical_momentum(drho, dz):
-    """The machine's vertical momentum (kg m/s) from the actuator rates and
-    the platform's vertical rate (docs/model.md "Bodies"): sliders move with
-    drho_i; each rod's centre is the midpoint of O2 (height rho_i + h) and
-    O3, and O3 is at the platform's height (Q = O3 + h' z3 with z3
-    horizontal), so it moves with (drho_i + dz) / 2; platform and payload
-    with dz."""
-    return ((M_SLIDER + M_ROD / 2) * drho.sum(axis=1)
-            + (2 * M_ROD + M_PLATFORM + PARAMS["payload_mass"]) * dz)
+    """The machine's vertical momentum (kg m/s), the payload's included."""
+    return spec_momentum(drho, dz, payload_mass=PARAMS["payload_mass"])
 
 
 def test_friction_compensation_cuts_the_rms_error(runs, results_dir):
