@@ -120,5 +120,10 @@ def test_command_line(plant_fmu, tmp_path):
     assert rc == 0
     for name in ("closed_loop.csv", "closed_loop_tracking.png", "closed_loop_run.csv"):
         assert (tmp_path / name).stat().st_size > 0, name
+    # At t = 0 the desired motion is at rest at P0 (no friction at rest): the
+    # written feed-forward carries the machine's and the payload's weight.
+    table = np.genfromtxt(tmp_path / "closed_loop.csv", delimiter=",", names=True)
+    first = sum(table[f"F_ff{i}_N"][0] for i in range(1, 5))
+    assert abs(first - (TOTAL_WEIGHT + PARAMS["payload_mass"] * G)) <= 4 * 5e-10, first  # written to 1e-9 N
     assert clc.main(["--build", str(tmp_path / "nowhere"), "--out", str(tmp_path)]) == 1
     assert clc.main(["--build", str(plant_fmu.parent), "--out", str(tmp_path), "--coulomb", "-1"]) == 2

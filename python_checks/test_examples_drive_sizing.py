@@ -111,5 +111,17 @@ def test_command_line(inverse_fmu, tmp_path):
     assert rc == 0
     for name in ("drive_sizing.csv", "drive_sizing.png"):
         assert (tmp_path / name).stat().st_size > 0, name
+    # Each move starts and ends at rest: the written torques at its start hold
+    # the machine's and the payload's weight through the screw, the speeds
+    # at both ends are 0 (written to 10 digits).
+    table = np.genfromtxt(tmp_path / "drive_sizing.csv", delimiter=",", names=True)
+    assert sorted(set(table["T_s"])) == [0.5, 2.0]
+    for T in (0.5, 2.0):
+        move = table[table["T_s"] == T]
+        tau = np.column_stack([move[f"tau{i}_Nm"] for i in range(1, 5)])
+        omega = np.column_stack([move[f"omega{i}_rad_s"] for i in range(1, 5)])
+        hold = (TOTAL_WEIGHT + M["payload_mass"] * G) * P / (2 * math.pi)
+        assert tau[0].sum() == pytest.approx(hold, rel=1e-9), (T, tau[0].sum(), hold)
+        assert np.abs(omega[[0, -1]]).max() <= 1e-9, (T, omega[[0, -1]])
     assert ds.main(["--build", str(tmp_path / "nowhere"), "--out", str(tmp_path)]) == 1
     assert ds.main(["--build", str(inverse_fmu.parent), "--out", str(tmp_path), "--durations", "0"]) == 2
