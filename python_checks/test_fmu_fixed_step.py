@@ -31,7 +31,7 @@ import pytest
 from fmpy.fmi1 import FMICallException
 
 from pkm4puu.fmu import Fmu
-from fixed_step_outcomes import expected
+from fixed_step_outcomes import expected, expected_long_step
 
 H = 1e-3
 REFERENCE = {"solver": 0, "cvode_method": 1, "rtol": 1e-10, "atol": 1e-12}
@@ -238,12 +238,14 @@ def test_one_long_step_at_the_stiffest_stops_ends_within_its_cap(solver, archive
     stops (1e9 N/m, 1e6 N.s/m, a 1 mg slider), F = 0. Before, RK4 spent 14-17 s
     and 205 s in them. Every call's work is capped (docs/solvers.md "The work
     budget"; tests/core/fixed_step.cpp asserts the evaluations counted): each
-    answers OK or Discard with the reason. The wall times are printed."""
-    params = {"solver": solver, "stop_stiffness": 1e9, "stop_damping": 1e6, "m_slider": 1e-6}
+    answers OK or Discard as fixed_step_outcomes.expected_long_step derives,
+    a Discard naming the cap and its reason, not before the impact. The wall
+    times are printed."""
+    stiffest = {"stop_stiffness": 1e9, "stop_damping": 1e6, "m_slider": 1e-6}
     lines = []
     for span in (10.0, 100.0):
         capfd.readouterr()
-        with Fmu(request.getfixturevalue(archive), start=params) as fmu:
+        with Fmu(request.getfixturevalue(archive), start={"solver": solver, **stiffest}) as fmu:
             fmu.set(["F[1]", "F[2]", "F[3]", "F[4]"], [0.0] * 4)
             t0 = time.perf_counter()
             try:
@@ -254,7 +256,12 @@ def test_one_long_step_at_the_stiffest_stops_ends_within_its_cap(solver, archive
             seconds = time.perf_counter() - t0
         log = capfd.readouterr().out
         lines.append(f"{archive}, solver {solver}, doStep(0, {span:g} s): {status} in {seconds:.3f} s")
-        if status != "OK":
-            assert status == 2, f"a capped step answers Discard, not {status}"
-            assert "per call" in log or "the most one call may take" in log, log[-1500:]
+        reason, earliest = expected_long_step(stiffest, solver, span)
+        if reason == "OK":
+            assert status == "OK", f"solver {solver}, {span:g} s: {status}, derived OK: {log[-1500:]}"
+            continue
+        assert status == 2, f"solver {solver}, {span:g} s: a capped step answers Discard, not {status}"
+        assert "at most 100000 per call" in log and reason in log, log[-1500:]
+        when = re.search(r"at t = (\S+) s the work budget", log)
+        assert when and earliest <= float(when.group(1)) <= earliest + 2 * H, (earliest, log[-1500:])
     print("\n" + "\n".join(lines))
