@@ -17,9 +17,10 @@ h |lambda| <= 0.1 on the bound
    initialisation ("unstable at every step");
  - else, in a contact, a communication step of grid steps g gets
    work_budget H / g inner steps; the contact's part T of it needs
-   T r_contact / 0.1 of them, besides one per grid step and the bisection that locates the impact
-   (30 halvings take 1 ms to 1e-12 s; BISECTION allows twice that). More:
-   Discard in the step of the impact ("ran out in an end-stop contact").
+   T r_contact / 0.1 of them, besides one per grid step and the bisection
+   that locates the impact (30 halvings take 1 ms to 1e-12 s; BISECTION
+   allows twice that). More: Discard in the step of the impact ("ran out
+   in an end-stop contact").
    T is what is left of the impact's step, or the whole contact if it ends
    sooner: half a period pi / omega_d of the stop against the quarter of
    the moving mass each stop holds (damping ratio zeta < 1); with zeta >= 1
