@@ -115,3 +115,12 @@ def test_write_results(ref, ref_held, capi, fmu, mujoco_result, results_dir):
     for path in paths:
         assert path.stat().st_size > 0, f"{path} is empty"
     assert {p.name for p in paths} == promised_files(command_help("engines"))
+    # What the CSV says, read back: this model (C API, CVODE) against Pinocchio
+    # within the bounds above, on the times of the comparison test.
+    table = np.genfromtxt(paths[0], delimiter=",", names=True)
+    np.testing.assert_allclose(table["t"], TIMES, rtol=0, atol=5e-7)  # written to 1 us
+    d_pos = max(np.abs(table[f"capi_cvode_{n}"] - table[f"pinocchio_{n}"]).max()
+                for n in ("x", "y", "z", "delta_rho1"))
+    d_phi = np.abs(table["capi_cvode_phi"] - table["pinocchio_phi"]).max()
+    assert d_pos <= TOL_POS and d_phi <= TOL_PHI, (d_pos, d_phi)
+    assert table["capi_cvode_constraint"].max() <= TOL_CONSTRAINT

@@ -12,6 +12,8 @@ About 99% of each force is static weight and the dynamic part is ~0.013 N
 import numpy as np
 import pytest
 
+from pkm4puu.spec import STATIC_FORCE_P0, TOTAL_WEIGHT
+
 from pkm4puu.cli.engine_comparison import (AUTOTEST_TIMES, TOL_ID, capi_inverse, fmu_inverse, load_capi,
                                            pinocchio_inverse)
 
@@ -26,8 +28,15 @@ def capi(pkm_library):
     return capi_inverse(load_capi(pkm_library.parent.parent))
 
 
-def test_samples():
-    assert len(AUTOTEST_TIMES) == 2001 and AUTOTEST_TIMES[0] == 0.0 and abs(AUTOTEST_TIMES[-1] - 2.0) < 1e-15
+def test_the_samples_start_and_end_at_rest(capi, pinocchio):
+    """The samples span the whole rest-to-rest motion: at the first, P0 at
+    rest, every force is the spec's holding force (docs/model.md "A check
+    anyone can derive", 2.655616050 N, given to 1e-9 N); at the last, at rest
+    at P1, the four carry the whole weight, 10.622464200 N."""
+    for name, (F, _) in (("C API", capi), ("Pinocchio", pinocchio)):
+        print(f"\n{name}: F at t = 0 {F[0]}, sum at t = {AUTOTEST_TIMES[-1]:g} s {F[-1].sum():.10f} N")
+        np.testing.assert_allclose(F[0], STATIC_FORCE_P0, rtol=0, atol=1e-9, err_msg=name)
+        assert abs(F[-1].sum() - TOTAL_WEIGHT) <= 1e-9, name
 
 
 def test_forces_are_dynamic(pinocchio):

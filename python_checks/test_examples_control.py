@@ -7,7 +7,7 @@ given it, and without feed-forward at all."""
 import numpy as np
 import pytest
 
-from pkm4puu.spec import G, M_PLATFORM, M_ROD, M_SLIDER, TOTAL_WEIGHT
+from pkm4puu.spec import G, TOTAL_WEIGHT, vertical_momentum as spec_momentum
 from example_scripts import load_example
 
 clc = load_example("closed_loop_control")
@@ -21,14 +21,8 @@ def runs(plant_fmu, inverse_fmu):
 
 
 def vertical_momentum(drho, dz):
-    """The machine's vertical momentum (kg m/s) from the actuator rates and
-    the platform's vertical rate (docs/model.md "Bodies"): sliders move with
-    drho_i; each rod's centre is the midpoint of O2 (height rho_i + h) and
-    O3, and O3 is at the platform's height (Q = O3 + h' z3 with z3
-    horizontal), so it moves with (drho_i + dz) / 2; platform and payload
-    with dz."""
-    return ((M_SLIDER + M_ROD / 2) * drho.sum(axis=1)
-            + (2 * M_ROD + M_PLATFORM + PARAMS["payload_mass"]) * dz)
+    """The machine's vertical momentum (kg m/s), the payload's included."""
+    return spec_momentum(drho, dz, payload_mass=PARAMS["payload_mass"])
 
 
 def test_friction_compensation_cuts_the_rms_error(runs, results_dir):
@@ -85,20 +79,26 @@ def test_without_compensation_the_pd_carries_the_friction(runs):
 
 
 def test_settled_pd_force_carries_exactly_what_the_feed_forward_left_out(runs):
-    """At rest after the motion the vertical momentum hardly changes, so the
-    sum of the actuator forces is the weight plus the friction at the
-    measured rates (which fades as the loop settles). The feed-forward with
-    the payload supplies the weight: its PD carries only the friction; PD
-    only carries the machine's weight and the payload's as well."""
+    """At rest after the motion the feed-forward with the payload supplies
+    the weight, so its PD carries only the friction; PD only carries the
+    machine's weight and the payload's as well. Exactly, over the last held
+    step [t_k, t_k+1] (vertical momentum P, docs/model.md "Bodies"):
+        sum F_pd = expected weight + mean friction + (P(t_k+1) - P(t_k)) / h,
+    the friction's mean over the step within |f(t_k+1) - f(t_k)| of its
+    value at t_k (it changes monotonically as the loop settles)."""
     runs, _ = runs
     w = TOTAL_WEIGHT + PARAMS["payload_mass"] * G
     for mode, expected_weight in (("ff", 0.0), ("ff_nofric", 0.0), ("pd", w)):
         r = runs[mode]
         k = len(r.t) - 2  # the last step's force
+        h = r.t[k + 1] - r.t[k]
         carried = r.F_pd[k].sum()
-        expected = expected_weight + clc.friction(PARAMS, r.drho[k]).sum()
-        print(f"\n{mode}: settled sum F_pd = {carried:.6f} N, expected {expected:.6f} N")
-        assert carried == pytest.approx(expected, abs=1e-4 * w)
+        fric = clc.friction(PARAMS, r.drho[k:k + 2]).sum(axis=1)
+        momentum = vertical_momentum(r.drho[k:k + 2], r.dpose[k:k + 2, 2])
+        expected = expected_weight + fric[0] + (momentum[1] - momentum[0]) / h
+        bound = abs(fric[1] - fric[0]) + 1e-12 * w
+        print(f"\n{mode}: settled sum F_pd = {carried:.9f} N, expected {expected:.9f} N (bound {bound:.1e} N)")
+        assert abs(carried - expected) <= bound
 
 
 def test_compensated_error_is_the_zero_order_hold(runs):
@@ -120,5 +120,10 @@ def test_command_line(plant_fmu, tmp_path):
     assert rc == 0
     for name in ("closed_loop.csv", "closed_loop_tracking.png", "closed_loop_run.csv"):
         assert (tmp_path / name).stat().st_size > 0, name
+    # At t = 0 the desired motion is at rest at P0 (no friction at rest): the
+    # written feed-forward carries the machine's and the payload's weight.
+    table = np.genfromtxt(tmp_path / "closed_loop.csv", delimiter=",", names=True)
+    first = sum(table[f"F_ff{i}_N"][0] for i in range(1, 5))
+    assert abs(first - (TOTAL_WEIGHT + PARAMS["payload_mass"] * G)) <= 4 * 5e-10, first  # written to 1e-9 N
     assert clc.main(["--build", str(tmp_path / "nowhere"), "--out", str(tmp_path)]) == 1
     assert clc.main(["--build", str(plant_fmu.parent), "--out", str(tmp_path), "--coulomb", "-1"]) == 2

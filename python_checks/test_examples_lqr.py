@@ -106,5 +106,11 @@ def test_command_line(plant_fmu, tmp_path):
     assert rc == 0
     for name in ("linearize_lqr.csv", "linearize_lqr.png"):
         assert (tmp_path / name).stat().st_size > 0, name
+    # Both loops start OFFSET off the path along (1, 1, 1)/sqrt 3, phi on it
+    # (written to 7 digits).
+    table = np.genfromtxt(tmp_path / "linearize_lqr.csv", delimiter=",", names=True)
+    for loop in ("lqr", "pd"):
+        assert table[f"{loop}_pos_err_m"][0] == pytest.approx(ll.OFFSET, rel=1e-6), loop
+        assert table[f"{loop}_phi_err_rad"][0] == 0.0, loop
     assert ll.main(["--build", str(tmp_path / "nowhere"), "--out", str(tmp_path)]) == 1
     assert ll.main(["--build", str(plant_fmu.parent), "--out", str(tmp_path), "--offset", "-1"]) == 2

@@ -7,7 +7,10 @@ platform (the DH chain from the FMU's joint outputs against the pose)."""
 import numpy as np
 import pytest
 
+from pkm4puu.cli.autotest import BOUNDS
 from pkm4puu.drawing import read_run_csv, RUN_COLUMNS, write_run_csv
+from pkm4puu.interface import POSE
+from pkm4puu.spec import P0, P1, T_MOVE, constraint_residual
 from example_scripts import load_example
 
 rr = load_example("render_robot")
@@ -76,6 +79,16 @@ def test_command_line(plant_fmu, tmp_path):
                     "--size", "120"]) == 0
     for name in ("robot_run.csv", "robot_motion.gif", "robot_frames.png"):
         assert (tmp_path / name).stat().st_size > 0, name
+    # The written run is the midpoint-held auto-test: from P0 to P1 within
+    # the auto-test's bounds, and every row's joints close the spec's loops
+    # (Eq. 15) to the 13 digits written.
+    t, rows = read_run_csv(tmp_path / "robot_run.csv")
+    pose = np.array([[r[c] for c in POSE] for r in rows])
+    assert t[-1] == pytest.approx(T_MOVE) and np.array_equal(pose[0], P0)
+    assert np.linalg.norm(pose[-1, :3] - P1[:3]) <= BOUNDS.position and abs(pose[-1, 3] - P1[3]) <= BOUNDS.phi
+    q = [[r[f"{n}[{i}]"] for i in range(1, 5) for n in ("rho", "theta1", "theta2")] + [r[c] for c in POSE]
+         for r in rows]
+    assert max(np.abs(constraint_residual(qk)).max() for qk in q) <= 1e-12
     # rendering a given CSV
     out2 = tmp_path / "again"
     assert rr.main(["--csv", str(tmp_path / "robot_run.csv"), "--out", str(out2), "--frames", "2",

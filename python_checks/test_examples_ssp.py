@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """examples/ssp_cosim.py: the auto-test as an SSP system (inverse.F ->
 plant.F) loaded and run by libcosim (libcosimpy)."""
+import csv
 import xml.etree.ElementTree as ET
 import zipfile
 
@@ -10,6 +11,7 @@ import pytest
 from pkm4puu.cli.autotest import BOUNDS
 from pkm4puu.fmu import Fmu, inverse_forces, run
 from pkm4puu.interface import F, POSE
+from pkm4puu.motions import pose_at
 from example_scripts import load_example
 
 ssp_cosim = load_example("ssp_cosim")
@@ -91,3 +93,15 @@ def test_command_line(plant_fmu, tmp_path):
     assert ssp_cosim.main(["--build", str(plant_fmu.parent), "--out", str(tmp_path), "--solver", "rk4"]) == 0
     for name in ("PKM4PUU_autotest.ssp", "ssp_autotest.csv", "ssp_autotest_errors.png"):
         assert (tmp_path / name).stat().st_size > 0, name
+    # The compensated run's written pose against the spec's prescribed motion:
+    # within the midpoint-held auto-test's bounds.
+    with open(tmp_path / "ssp_autotest.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    run = next(k for k in rows[0] if k.endswith("_x_m"))[:-len("_x_m")]  # the first run written
+    assert "compensated" in run, run
+    t = np.array([float(r["t_s"]) for r in rows])
+    pose = np.array([[float(r[f"{run}_{q}"]) for q in ("x_m", "y_m", "z_m", "phi_rad")] for r in rows])
+    prescribed = np.array([pose_at(tk) for tk in t])
+    assert t[-1] == pytest.approx(N * H)
+    assert np.linalg.norm(pose[:, :3] - prescribed[:, :3], axis=1).max() <= BOUNDS.position
+    assert np.abs(pose[:, 3] - prescribed[:, 3]).max() <= BOUNDS.phi

@@ -104,3 +104,11 @@ def test_write_results(runs, half_step_table, inverse_fmu, results_dir):
     for path in paths:
         assert path.stat().st_size > 0, f"{path} is empty"
     assert {p.name for p in paths} | {"fmu_autotest_checks.csv"} == promised_files(command_help("autotest"))
+    # What the CSV says, read back: the bounded modes' residuals within
+    # BOUNDS with every solver, none at the start (rest at P0, exactly).
+    table = np.genfromtxt(paths[0], delimiter=",", names=True)
+    for mode in BOUNDED_MODES:
+        for solver in SOLVERS:
+            pos, phi = table[f"{mode}_{solver}_pos_err_m"], table[f"{mode}_{solver}_phi_err_rad"]
+            assert pos.max() <= TOL_POS and phi.max() <= TOL_PHI, (mode, solver, pos.max(), phi.max())
+            assert pos[0] == 0.0 and phi[0] == 0.0, (mode, solver)

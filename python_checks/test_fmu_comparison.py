@@ -16,12 +16,14 @@ Checked facts, each following from the model rather than from a past run:
   step RK4) agree.
 The bounds are the report's (BOUNDS), which the main job's verdict uses too.
 """
+import numpy as np
 import pytest
 
 from conftest import command_help, promised_files
 from pkm4puu.cli.comparison import (BOUNDS, checks, format_table, max_constraint_residual, max_delta_rho1,
                                     nonfinite_outputs, run_all, solver_difference, vertical_com_drift,
                                     write_results)
+from pkm4puu.spec import P0, leg_inverse_kinematics
 
 TOL_POS, TOL_PHI, TOL_CONSTRAINT, MIN_DELTA_RHO1 = BOUNDS
 
@@ -84,3 +86,15 @@ def test_write_results(runs, results_dir):
     for path in paths:
         assert path.stat().st_size > 0, f"{path} is empty"
     assert {p.name for p in paths} | {"comparison_checks.csv"} == promised_files(command_help("comparison"))
+    # What the CSV says, read back: every row's rho_i is the spec's closed-form
+    # inverse kinematics of its pose, to the 13 digits written (5e-13 of
+    # 0.1 m, a few times over through the kinematics), and delta_rho1 is
+    # rho1 - rho1(0); the first row is P0.
+    table = np.genfromtxt(paths[0], delimiter=",", names=True)
+    pose = np.column_stack([table[n] for n in ("x", "y", "z", "phi")])
+    rho = np.column_stack([table[f"rho{i}"] for i in range(1, 5)])
+    ik = np.array([leg_inverse_kinematics(p)[:, 0] for p in pose])
+    written = 5e-13 * 0.1
+    assert np.abs(rho - ik).max() <= 10 * written, np.abs(rho - ik).max()
+    assert np.abs(table["delta_rho1"] - (rho[:, 0] - rho[0, 0])).max() <= 2 * written
+    np.testing.assert_allclose(pose[0], P0, rtol=0, atol=written)

@@ -13,29 +13,38 @@ there. Checked here:
   without, bit for bit (a ramp of values and slopes, FMI 2.0, and held
   inputs, FMI 3.0, which has no input derivatives);
 - a state saved where the history continues restores into a run that
-  restarts CVODE there: within CVODE's tolerance of the original, not bit
-  for bit; saved where the inputs jump (the original restarts there too)
-  it restores bit for bit;
+  restarts CVODE there: within one restart's error of the original (one
+  step's error weight, ONE_STEP), not bit for bit; saved where the inputs
+  jump (the original restarts there too) it restores bit for bit;
 - the continuation happens: the same run restarted at every step (a
-  setFMUState of the state just taken) is not bit-identical to it, and all
-  agree with a reference integrated at rtol 1e-12 to within what rtol 1e-8
-  allows.
+  setFMUState of the state just taken) is not bit-identical to it; the
+  continued run stays within one step's error weight (ONE_STEP) of a
+  reference integrated at rtol 1e-12, the restarted one within what rtol
+  1e-8 allows over N steps (BOUND).
 """
 import numpy as np
 import pytest
 
 from pkm4puu.fmu import Fmu
 from pkm4puu.interface import F, POSE, VEL
-from pkm4puu.spec import STATIC_FORCE_P0
+from pkm4puu.spec import SOLVER_DEFAULTS, STATIC_FORCE_P0
 
 H = 1e-3
 N = 600
 OUT = POSE + VEL
-RTOL = 1e-8  # the FMU's default rtol
+RTOL, ATOL = SOLVER_DEFAULTS["rtol"], SOLVER_DEFAULTS["atol"]  # the FMU's defaults
 # rtol on positions of ~0.05 m, accumulated over N steps: a deviation of
 # N x rtol x 0.05 m = 3e-7 m would be the solver's whole error budget; every
 # run must stay within it of the reference, and so of each other.
 BOUND = N * RTOL * 0.05
+# CVODE's error test keeps each internal step's local error within its weight
+# rtol |y| + atol: 6e-10 m on z ~ 0.05 m. A run that continues its history is
+# one integration of a smooth, slow motion, which adds no error of its own at
+# a communication point: it stays within one step's weight. A restart starts
+# again at order 1 with a first step sized for an error near that weight
+# (CVODE's initial step estimate), so N restarts add N such errors and lose
+# the bound (measured: 1.2e-8 m restarted at every step, 20 times it).
+ONE_STEP = RTOL * 0.05 + ATOL
 
 SLOPES = [0.4, -0.3, 0.2, -0.1]  # N/s
 
@@ -117,11 +126,13 @@ def test_restored_run_restarts_cvode(archive, ramp, k_save, exact, request):
     moved = np.abs(first[-1, :3] - first[0, :3]).max()
     assert moved > 1e-5, f"the platform barely moved ({moved:.2e} m): the check would be trivial"
     dev = np.abs(replay[:, :3] - first[:, :3]).max()
-    print(f"\n{archive}, saved after step {k_save}: max |replay - original| = {dev:.3e} m (bound {BOUND:.1e} m)")
+    print(f"\n{archive}, saved after step {k_save}: max |replay - original| = {dev:.3e} m "
+          f"(bound {ONE_STEP:.1e} m)")
     if exact:
         same = first == replay
         assert same.all(), f"{(~same).sum()} values differ after the restore; largest difference {dev:.3e}"
-    assert dev <= BOUND, f"the restored run is {dev:.3e} m from the original, beyond CVODE's budget {BOUND:.1e} m"
+    assert dev <= ONE_STEP, (f"the restored run, which restarts once, is {dev:.3e} m from the original, beyond "
+                             f"one step's error weight {ONE_STEP:.1e} m")
 
 
 def test_continuation_happens_and_keeps_accuracy(plant_fmu):
@@ -132,7 +143,7 @@ def test_continuation_happens_and_keeps_accuracy(plant_fmu):
     with Fmu(plant_fmu, start={"solver": 0, "rtol": 1e-12, "atol": 1e-14}, instance_name="reference") as fmu:
         reference = run(fmu, 0, N, True, between=restart_here)
     assert not (continued == restarted).all(), "no difference: CVODE restarted at every step anyway"
-    for name, rows in (("continued", continued), ("restarted", restarted)):
+    for name, rows, bound in (("continued", continued, ONE_STEP), ("restarted", restarted, BOUND)):
         dev = np.abs(rows[:, :3] - reference[:, :3]).max()
-        print(f"\n{name}: max |x, y, z - reference| = {dev:.3e} m (bound {BOUND:.1e} m)")
-        assert dev <= BOUND, f"{name}: {dev:.3e} m from the rtol 1e-12 reference, bound {BOUND:.1e} m"
+        print(f"\n{name}: max |x, y, z - reference| = {dev:.3e} m (bound {bound:.1e} m)")
+        assert dev <= bound, f"{name}: {dev:.3e} m from the rtol 1e-12 reference, bound {bound:.1e} m"

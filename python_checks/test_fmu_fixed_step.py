@@ -6,10 +6,12 @@ over the declared parameter ranges.
 
 The scene: F = 0 at the home pose, the platform sinks under gravity (onto
 the lower stops after about 95 ms, then bounces until it rests), 1 ms
-communication steps. The reference is CVODE (BDF) at rtol 1e-10. Each run
-either completes every step with dz within the bound of the reference at
-every step, or is refused (at initialisation, or a step answers Discard)
-with a message naming why.
+communication steps. The reference is CVODE (BDF) at rtol 1e-10, and it
+completes every run. Each run has the outcome derived for it from the
+parameters and the stability bound (fixed_step_outcomes.py): it completes
+every step with dz within the bound of the reference at every step, or it
+is refused where derived (at initialisation, or a step answers Discard at
+the impact) with its own message stating the derived bound.
 
 The bounds (docs/solvers.md, "Accuracy"): RK4 keeps h |lambda| <= 0.1 on
 its stiff modes: at most (0.1)^5/120 = 8.3e-8 of their amplitude per
@@ -20,6 +22,7 @@ error estimate keeps every step within its tolerance. Before, ROS2 answered
 the default drop 9.07 % off at the second impact.
 """
 import math
+import re
 import time
 
 import fmpy.fmi3
@@ -28,6 +31,7 @@ import pytest
 from fmpy.fmi1 import FMICallException
 
 from pkm4puu.fmu import Fmu
+from fixed_step_outcomes import expected, expected_long_step
 
 H = 1e-3
 REFERENCE = {"solver": 0, "cvode_method": 1, "rtol": 1e-10, "atol": 1e-12}
@@ -80,30 +84,63 @@ def run(archive, start, steps):
     return np.array(dz), status, slowest, first_contact
 
 
+# What each refusal's message says: its reason, and the bound it states.
+REFUSAL = {"init": ("solver = 1 (RK4) is unstable at every step", r"\(m_slider \+ reflected mass\) = (\S+) 1/s"),
+           "contact": ("ran out in an end-stop contact", r"bound the contact's rate at (\S+) 1/s")}
+
+
+def refusal_problems(want, status, log):
+    """What is wrong with a refused run's status and message against the
+    Outcome `want` derived for it (fixed_step_outcomes.py)."""
+    reason, bound = REFUSAL[want.refusal]
+    problems = []
+    if want.refusal == "init" and status != ("init", 3):
+        problems.append(f"refused with {status}, not an Error at initialisation")
+    if want.refusal == "contact" and status != 2:
+        problems.append(f"refused with {status}, not a Discard")
+    if reason not in log:
+        problems.append(f"the message does not say {reason!r}")
+    stated = re.search(bound, log)
+    if not stated or not math.isclose(float(stated.group(1)), want.rate, rel_tol=1e-3):
+        problems.append(f"the message does not state the bound {want.rate:.4g} 1/s")
+    when = re.search(r"at t = (\S+) s the work budget", log)
+    if want.refusal == "contact" and not (when and want.earliest <= float(when.group(1)) <= (want.ok_steps + 1) * H):
+        problems.append(f"the budget ran out outside the impact's step [{want.earliest:.6f}, "
+                        f"{(want.ok_steps + 1) * H:g}] s")
+    return problems
+
+
 def check(archive, params, solver, steps, capfd, rk4_step=H):
-    """One run against the reference: every OK step within the bound, every
-    refusal with a message; returns a one-line summary."""
+    """One run against the reference and against the outcome derived for it
+    (fixed_step_outcomes.expected): the reference completes; the run answers
+    OK exactly as many steps as derived, every one within the bound, and a
+    refusal is the one derived, with its own message stating the bound.
+    Returns a one-line summary and the problems found."""
     ref, ref_status, _, contact = run(archive, {**params, **REFERENCE}, steps)
     capfd.readouterr()
     dz, status, slowest, _ = run(archive, {**params, "solver": solver, "rk4_step": rk4_step}, steps)
     log = capfd.readouterr().out
-    if status is not None:
-        assert log.strip(), f"{params}, solver {solver}: refused ({status}) without a message"
-        if isinstance(status, tuple):
-            assert "solver = 2" in log or "rk4_step" in log, log[-1500:]
-        else:
-            assert status == 2, f"{params}, solver {solver}: a failed step must be a Discard, not {status}"
-            assert "work budget" in log or "could not" in log or "beyond" in log or "energy" in log, log[-1500:]
+    want = expected({**params, "rk4_step": rk4_step}, solver, steps)
+    problems = []
+    if ref_status is not None or len(ref) != steps:
+        problems.append(f"the reference answered {len(ref)} of {steps} steps ({ref_status})")
+    if len(dz) != want.ok_steps:
+        problems.append(f"{len(dz)} OK steps, derived {want}")
+    if want.refusal:
+        problems += refusal_problems(want, status, log) if status is not None else [f"not refused, derived {want}"]
+    elif status is not None:
+        problems.append(f"refused ({status}), derived {want}: {log.strip()[-800:]}")
     n = min(len(dz), len(ref))
     worst = 0.0
     if n > 0:
         scale = np.abs(ref[:n]).max()
         worst = np.abs(dz[:n] - ref[:n]).max() / scale if scale > 0 else 0.0
-        assert worst <= BOUND[solver], (f"{params}, solver {solver}, rk4_step {rk4_step}: an OK step is "
-                                        f"{worst:.3g} of max |dz| off CVODE (bound {BOUND[solver]})")
+        if not worst <= BOUND[solver]:
+            problems.append(f"an OK step is {worst:.3g} of max |dz| off CVODE (bound {BOUND[solver]})")
     impact = f", impact at step {contact + 1}" if contact is not None else ""
-    return (f"{len(dz)}/{steps} OK, error {worst:.2g} (reference {len(ref)} OK{impact}), "
-            f"slowest doStep {slowest * 1e3:.2f} ms, {'refused ' + str(status) if status else 'all OK'}")
+    summary = (f"{len(dz)}/{steps} OK, error {worst:.2g} (reference {len(ref)} OK{impact}), "
+               f"slowest doStep {slowest * 1e3:.2f} ms, {'refused ' + str(status) if status else 'all OK'}")
+    return summary, [f"{params}, solver {solver}, rk4_step {rk4_step}: {p}" for p in problems]
 
 
 @pytest.mark.parametrize("archive", ["plant_fmu", "plant_fmu3"])
@@ -112,9 +149,9 @@ def test_the_default_drop_is_right_at_every_impact(solver, archive, request, cap
     """Issue 37 item 1: FMI 2.0 and 3.0 CS, all else default, F = 0, 300
     steps of 1 ms (three impacts): before, ROS2 answered every step OK while
     9.07 % of max |dz| off CVODE at the second impact (t = 0.183 s)."""
-    summary = check(request.getfixturevalue(archive), {}, solver, 300, capfd)
+    summary, problems = check(request.getfixturevalue(archive), {}, solver, 300, capfd)
     print(f"\n{archive}, the default drop, solver {solver}: {summary}")
-    assert "all OK" in summary
+    assert not problems, "\n".join(problems)
 
 
 @pytest.mark.parametrize("archive", ["plant_fmu", "plant_fmu3"])
@@ -122,8 +159,9 @@ def test_the_default_drop_is_right_at_every_impact(solver, archive, request, cap
 @pytest.mark.parametrize("case", list(CASES))
 def test_issue_28_cases_are_right_or_refused(case, solver, archive, request, capfd):
     steps = 150 if "stops" in case else 40
-    summary = check(request.getfixturevalue(archive), CASES[case], solver, steps, capfd)
+    summary, problems = check(request.getfixturevalue(archive), CASES[case], solver, steps, capfd)
     print(f"\n{archive}, {case}, solver {solver}: {summary}")
+    assert not problems, "\n".join(problems)
 
 
 def log_spaced(lo, hi, n=2):
@@ -147,17 +185,18 @@ RK4_STEPS = [1e-6, 3e-5, 1e-3, 1.0]
 
 
 def test_sweep_over_the_declared_ranges(plant_fmu, capfd):
-    """Every point, both fixed-step solvers: right or refused with a message."""
-    rows = []
+    """Every point, both fixed-step solvers: the outcome derived for it,
+    right where it completes, refused with its own message where not."""
+    rows, problems = [], []
     t0 = time.perf_counter()
-    for params in SWEEP:
-        for solver in (1, 2):
-            rows.append(f"{params} solver {solver}: " + check(plant_fmu, params, solver, 120, capfd))
-    for rk4_step in RK4_STEPS:
-        for solver in (1, 2):
-            rows.append(f"rk4_step {rk4_step} solver {solver}: "
-                        + check(plant_fmu, {}, solver, 120, capfd, rk4_step=rk4_step))
+    runs = [(params, solver, H) for params in SWEEP for solver in (1, 2)]
+    runs += [({}, solver, rk4_step) for rk4_step in RK4_STEPS for solver in (1, 2)]
+    for params, solver, rk4_step in runs:
+        summary, wrong = check(plant_fmu, params, solver, 120, capfd, rk4_step=rk4_step)
+        rows.append(f"{params} solver {solver} rk4_step {rk4_step}: {summary}")
+        problems += wrong
     print("\n" + "\n".join(rows) + f"\n{len(rows)} runs in {time.perf_counter() - t0:.1f} s")
+    assert not problems, "\n".join(problems)
 
 
 def test_c_api_has_the_rosenbrock_solver_and_the_step_checks(pkm_library):
@@ -199,12 +238,14 @@ def test_one_long_step_at_the_stiffest_stops_ends_within_its_cap(solver, archive
     stops (1e9 N/m, 1e6 N.s/m, a 1 mg slider), F = 0. Before, RK4 spent 14-17 s
     and 205 s in them. Every call's work is capped (docs/solvers.md "The work
     budget"; tests/core/fixed_step.cpp asserts the evaluations counted): each
-    answers OK or Discard with the reason. The wall times are printed."""
-    params = {"solver": solver, "stop_stiffness": 1e9, "stop_damping": 1e6, "m_slider": 1e-6}
+    answers OK or Discard as fixed_step_outcomes.expected_long_step derives,
+    a Discard naming the cap and its reason, not before the impact. The wall
+    times are printed."""
+    stiffest = {"stop_stiffness": 1e9, "stop_damping": 1e6, "m_slider": 1e-6}
     lines = []
     for span in (10.0, 100.0):
         capfd.readouterr()
-        with Fmu(request.getfixturevalue(archive), start=params) as fmu:
+        with Fmu(request.getfixturevalue(archive), start={"solver": solver, **stiffest}) as fmu:
             fmu.set(["F[1]", "F[2]", "F[3]", "F[4]"], [0.0] * 4)
             t0 = time.perf_counter()
             try:
@@ -215,7 +256,12 @@ def test_one_long_step_at_the_stiffest_stops_ends_within_its_cap(solver, archive
             seconds = time.perf_counter() - t0
         log = capfd.readouterr().out
         lines.append(f"{archive}, solver {solver}, doStep(0, {span:g} s): {status} in {seconds:.3f} s")
-        if status != "OK":
-            assert status == 2, f"a capped step answers Discard, not {status}"
-            assert "per call" in log or "the most one call may take" in log, log[-1500:]
+        reason, earliest = expected_long_step(stiffest, solver, span)
+        if reason == "OK":
+            assert status == "OK", f"solver {solver}, {span:g} s: {status}, derived OK: {log[-1500:]}"
+            continue
+        assert status == 2, f"solver {solver}, {span:g} s: a capped step answers Discard, not {status}"
+        assert "at most 100000 per call" in log and reason in log, log[-1500:]
+        when = re.search(r"at t = (\S+) s the work budget", log)
+        assert when and earliest <= float(when.group(1)) <= earliest + 2 * H, (earliest, log[-1500:])
     print("\n" + "\n".join(lines))

@@ -14,7 +14,7 @@ import pytest
 from pkm4puu.fmu import Fmu, inverse_forces
 from pkm4puu.interface import indexed_names, F, POSE
 from pkm4puu.motions import pose_at
-from pkm4puu.spec import G, M_PLATFORM, M_ROD, M_SLIDER, P0, STATIC_FORCE_P0, T_MOVE
+from pkm4puu.spec import G, M_PLATFORM, M_ROD, M_SLIDER, P0, STATIC_FORCE_P0, STOP_STIFFNESS, T_MOVE
 
 SCREW_LEAD = 0.004  # m, the default
 MACHINE = {
@@ -99,7 +99,7 @@ def test_energy_audit_is_constant_with_every_term_on(plant_fmu, machine_forces, 
 # 1/2 (4k) delta^2 = W (h0 + delta), so
 #     delta_max <= (W + sqrt(W^2 + 8 k W h0)) / (4 k)           (about 1.56 mm)
 # At rest each slider carries a quarter of the weight: delta_static = W / (4 k).
-K_STOP, RHO_P0 = 1e5, 0.0443193423
+K_STOP, RHO_P0 = STOP_STIFFNESS, 0.0443193423
 W = (M_PLATFORM + 4 * M_SLIDER + 4 * M_ROD) * G
 DELTA_MAX = (W + math.sqrt(W**2 + 8 * K_STOP * W * RHO_P0)) / (4 * K_STOP)
 DELTA_STATIC = W / (4 * K_STOP)

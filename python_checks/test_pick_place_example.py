@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from example_scripts import load_example
+from pkm4puu.spec import CYCLE_F_MAX, CYCLE_V_MAX
 
 pp = load_example("pick_and_place")
 
@@ -44,4 +45,16 @@ def test_command_line(tmp_path):
         header = f.readline().strip().split(",")
         cycles = {line.split(",", 1)[0] for line in f}
     assert header[:2] == ["cycle", "t_s"] and cycles == {"spec", "drives"}
+    # The cycle planned for the spec's limits keeps them at every written
+    # point, |F_i| = 2 pi |tau_i| / p <= 10 N and |drho_i| = p |omega_i| / 2 pi
+    # <= 0.5 m/s, up to the excess between the planner's grid points (second
+    # order in their spacing, test_pick_place_topp.py; 1e-5 as in
+    # test_pick_place_cycle.py).
+    rows = np.genfromtxt(tmp_path / "pick_and_place.csv", delimiter=",", names=True, dtype=None, encoding=None)
+    spec_rows = rows[rows["cycle"] == "spec"]
+    lead = pp.drives()[0]["screw_lead"]
+    force = np.abs([spec_rows[f"tau{i}_Nm"] for i in range(1, 5)]) * 2 * math.pi / lead
+    speed = np.abs([spec_rows[f"omega{i}_rad_s"] for i in range(1, 5)]) * lead / (2 * math.pi)
+    assert force.max() <= CYCLE_F_MAX * (1 + 1e-5) and speed.max() <= CYCLE_V_MAX * (1 + 1e-5)
+    assert force.max() >= 0.9 * CYCLE_F_MAX or speed.max() >= 0.9 * CYCLE_V_MAX  # time-optimal: a limit is reached
     assert pp.main(["--out", str(tmp_path), "--payload", "-1"]) == 2

@@ -109,11 +109,25 @@ def constraint_residual(q16):
                            for i in range(4)])
 
 
+def vertical_momentum(drho, dz, payload_mass=0.0, reflected_mass=0.0):
+    """The machine's vertical momentum (kg m/s) from the actuator rates drho
+    (..., 4) and the platform's vertical rate dz: the sliders (with the
+    rotors' reflected mass) move with drho_i; each rod's centre is the
+    midpoint of O2 (height rho_i + h) and O3, which is at the platform's
+    height (Q = O3 + h' z3 with z3 horizontal), so it moves with
+    (drho_i + dz) / 2; platform and payload with dz. All actuator axes are
+    vertical: its rate is sum F - weight - sum friction (no stop acting)."""
+    drho = np.asarray(drho, dtype=float)
+    return ((M_SLIDER + reflected_mass + M_ROD / 2) * drho.sum(axis=-1)
+            + (2 * M_ROD + M_PLATFORM + payload_mass) * np.asarray(dz, dtype=float))
+
+
 # --- The machine around the mechanism (docs/model.md "The machine around the mechanism") ----------
 # Defaults of the spec; every one leaves the paper's ideal machine unchanged.
 SCREW_LEAD = 0.004  # m per revolution
 FRICTION_VELOCITY = 1e-3  # m/s, v_s of the tanh regularisation
 RHO_MIN, RHO_MAX = 0.0, 0.15  # m, end stops
+STOP_STIFFNESS, STOP_DAMPING = 1e5, 100.0  # N/m, N s/m: the compliant stops' k and d
 
 
 class Machine:
