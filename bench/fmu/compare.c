@@ -25,26 +25,27 @@ typedef struct {
   int fmu, solver;             /* through the plant FMU, else the C API; PKM_SOLVER_RK4 or _CVODE */
   double rtol;                 /* atol: rtol / 100 */
   int one_call, outputs, ramp; /* C API: the second in one call; FMU: outputs read (-1 all), F as a ramp */
+  double target;               /* bench/engines_bench.py's: at least this many times MuJoCo's mj_step (0: none) */
 } Case;
 
 #define RK4 PKM_SOLVER_RK4
 #define CVODE PKM_SOLVER_CVODE
 static Case cases[] = {
-    {"capi_rk4", "C API: RK4, 1 ms", 0, RK4, 1e-8, 0, 0, 0},
-    {"capi_cvode", "C API: CVODE (default rtol 1e-8), stop every 1 ms", 0, CVODE, 1e-8, 0, 0, 0},
-    {"capi_cvode_tight", "C API: CVODE (rtol 1e-12), stop every 1 ms", 0, CVODE, 1e-12, 0, 0, 0},
-    {"capi_rk4_one_call", "C API: RK4, 1 ms, one call per second", 0, RK4, 1e-8, 1, 0, 0},
-    {"capi_cvode_one_call", "C API: CVODE (rtol 1e-12), own steps, one call", 0, CVODE, 1e-12, 1, 0, 0},
-    {"fmu_rk4_step", "plant FMU: RK4, 1 ms, no output", 1, RK4, 1e-8, 0, 0, 0},
-    {"fmu_rk4", "plant FMU: RK4, 1 ms, + get x, y, z, phi", 1, RK4, 1e-8, 0, 4, 0},
-    {"fmu_rk4_ctrl12", "plant FMU: RK4, 1 ms, + get 12 controller outputs", 1, RK4, 1e-8, 0, 12, 0},
-    {"fmu_rk4_all", "plant FMU: RK4, 1 ms, + get every Real output", 1, RK4, 1e-8, 0, -1, 0},
-    {"fmu_cvode_step", "plant FMU: CVODE (rtol 1e-8), no output", 1, CVODE, 1e-8, 0, 0, 0},
-    {"fmu_cvode", "plant FMU: CVODE (rtol 1e-8), + get x, y, z, phi", 1, CVODE, 1e-8, 0, 4, 0},
-    {"fmu_cvode_ctrl12", "plant FMU: CVODE (rtol 1e-8), + get 12 controller outputs", 1, CVODE, 1e-8, 0, 12, 0},
-    {"fmu_cvode_all", "plant FMU: CVODE (rtol 1e-8), + get every Real output", 1, CVODE, 1e-8, 0, -1, 0},
+    {"capi_rk4", "C API: RK4, 1 ms", 0, RK4, 1e-8, 0, 0, 0, 10},
+    {"capi_cvode", "C API: CVODE (default rtol 1e-8), stop every 1 ms", 0, CVODE, 1e-8, 0, 0, 0, 10},
+    {"capi_cvode_tight", "C API: CVODE (rtol 1e-12), stop every 1 ms", 0, CVODE, 1e-12, 0, 0, 0, 10},
+    {"capi_rk4_one_call", "C API: RK4, 1 ms, one call per second", 0, RK4, 1e-8, 1, 0, 0, 0},
+    {"capi_cvode_one_call", "C API: CVODE (rtol 1e-12), own steps, one call", 0, CVODE, 1e-12, 1, 0, 0, 10},
+    {"fmu_rk4_step", "plant FMU: RK4, 1 ms, no output", 1, RK4, 1e-8, 0, 0, 0, 0},
+    {"fmu_rk4", "plant FMU: RK4, 1 ms, + get x, y, z, phi", 1, RK4, 1e-8, 0, 4, 0, 0},
+    {"fmu_rk4_ctrl12", "plant FMU: RK4, 1 ms, + get 12 controller outputs", 1, RK4, 1e-8, 0, 12, 0, 15},
+    {"fmu_rk4_all", "plant FMU: RK4, 1 ms, + get every Real output", 1, RK4, 1e-8, 0, -1, 0, 0},
+    {"fmu_cvode_step", "plant FMU: CVODE (rtol 1e-8), no output", 1, CVODE, 1e-8, 0, 0, 0, 0},
+    {"fmu_cvode", "plant FMU: CVODE (rtol 1e-8), + get x, y, z, phi", 1, CVODE, 1e-8, 0, 4, 0, 0},
+    {"fmu_cvode_ctrl12", "plant FMU: CVODE (rtol 1e-8), + get 12 controller outputs", 1, CVODE, 1e-8, 0, 12, 0, 0},
+    {"fmu_cvode_all", "plant FMU: CVODE (rtol 1e-8), + get every Real output", 1, CVODE, 1e-8, 0, -1, 0, 0},
     {"fmu_cvode_ramp_ctrl12", "plant FMU: CVODE (rtol 1e-8), continued, + get 12 controller outputs", 1, CVODE, 1e-8,
-     0, 12, 1}};
+     0, 12, 1, 10}};
 #define N_CASES (sizeof cases / sizeof cases[0])
 typedef struct {
   double median, min, max_c; /* s per simulated second; m */
@@ -85,13 +86,6 @@ static void input_callback(void* user, double t, double u[PKM_PLANT_INPUTS]) {
   }
 }
 
-#define PKM_CHECK(call)                                                           \
-  if ((call) != PKM_OK) {                                                         \
-    fprintf(stderr, "pkm_fmu_bench compare: %s: %s\n", #call, pkm_last_error(m)); \
-    pkm_destroy(m);                                                               \
-    return 0;                                                                     \
-  }
-
 static int run_capi(int batches, const char* dir, const Case* c, Result* r) {
   static const char* const names[] = {"g", "solver", "rk4_step", "rtol", "atol"};
   const double values[] = {0.0, c->solver, STEP, c->rtol, c->rtol / 100.0};
@@ -99,32 +93,29 @@ static int run_capi(int batches, const char* dir, const Case* c, Result* r) {
   pkm_outputs o = {.size = sizeof(pkm_outputs)};
   pkm_state state = {.size = sizeof(pkm_state)};
   double per[MAX_BATCHES], u[PKM_PLANT_INPUTS] = {0.0};
-  int n = 0;
-  if (pkm_create(&m) != PKM_OK) return fprintf(stderr, "pkm_fmu_bench compare: pkm_create failed\n"), 0;
-  PKM_CHECK(pkm_set_parameters(m, 5, names, values));
-  for (int b = -1; b < batches; ++b) { /* one warm-up, then the batches */
-    PKM_CHECK(pkm_init_pose(m, 0.0, P0, NULL));
+  int n = 0, ok = pkm_create(&m) == PKM_OK && pkm_set_parameters(m, 5, names, values) == PKM_OK;
+  for (int b = -1; ok && b < batches; ++b) { /* one warm-up, then the batches */
+    ok = pkm_init_pose(m, 0.0, P0, NULL) == PKM_OK;
     const double t0 = bench_now();
-    for (int k = c->one_call ? STEPS_TIMED - 1 : 0; k < STEPS_TIMED; ++k) {
-      PKM_CHECK(pkm_advance_fn(m, (k + 1) * STEP, input_callback, NULL, 1));
-      PKM_CHECK(pkm_get_state(m, &state));
-    }
+    for (int k = c->one_call ? STEPS_TIMED - 1 : 0; ok && k < STEPS_TIMED; ++k)
+      ok = pkm_advance_fn(m, (k + 1) * STEP, input_callback, NULL, 1) == PKM_OK && pkm_get_state(m, &state) == PKM_OK;
     if (b >= 0) per[b] = bench_now() - t0;
   }
-  r->median = bench_median(per, (size_t)batches, &r->min);
-  PKM_CHECK(pkm_init_pose(m, 0.0, P0, NULL));
-  for (int k = 0; k <= STEPS_TEST; k += c->one_call ? STEPS_TEST / 3 : 1, ++n) {
-    if (k > 0) PKM_CHECK(pkm_advance_fn(m, k * STEP, input_callback, NULL, 1));
+  if (ok) r->median = bench_median(per, (size_t)batches, &r->min);
+  ok = ok && pkm_init_pose(m, 0.0, P0, NULL) == PKM_OK;
+  for (int k = 0; ok && k <= STEPS_TEST; k += c->one_call ? STEPS_TEST / 3 : 1, ++n) {
     forces(k * STEP, u);
-    PKM_CHECK(pkm_get_outputs(m, u, &o));
+    ok = (k == 0 || pkm_advance_fn(m, k * STEP, input_callback, NULL, 1) == PKM_OK) &&
+         pkm_get_outputs(m, u, &o) == PKM_OK;
     times[n] = k * STEP;
     memcpy(rows[n], o.pose, sizeof o.pose);
     rows[n][4] = o.rho[0];
     rows[n][5] = o.constraint_residual;
     r->max_c = fmax(r->max_c, o.constraint_residual);
   }
+  if (!ok) fprintf(stderr, "pkm_fmu_bench compare: %s: %s\n", c->name, m ? pkm_last_error(m) : "pkm_create failed");
   pkm_destroy(m);
-  return write_rows(dir, c->name, n);
+  return ok && write_rows(dir, c->name, n);
 }
 
 static double held[STEPS_TEST][4], ramp[STEPS_TEST][4], slope[STEPS_TEST][4];
@@ -193,10 +184,10 @@ static int compare_run(const Plant* plant, const Options* o) {
   if (o->out) {
     FILE* fp = open_csv(o->out, "summary");
     if (!fp) return 0;
-    fprintf(fp, "case,what,forces,median_s_per_sim_s,min_s_per_sim_s,max_constraint_residual\n");
+    fprintf(fp, "case,what,forces,median_s_per_sim_s,min_s_per_sim_s,max_constraint_residual,target_vs_mujoco\n");
     for (i = 0; i < N_CASES; ++i)
-      fprintf(fp, "%s,\"%s\",%s,%.6e,%.6e,%.6e\n", cases[i].name, cases[i].what, forces_of(&cases[i]),
-              results[i].median, results[i].min, results[i].max_c);
+      fprintf(fp, "%s,\"%s\",%s,%.6e,%.6e,%.6e,%g\n", cases[i].name, cases[i].what, forces_of(&cases[i]),
+              results[i].median, results[i].min, results[i].max_c, cases[i].target);
     fclose(fp);
   }
   return 1;
