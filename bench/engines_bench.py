@@ -7,8 +7,6 @@ mujoco.rollout's C loop, and in a Python loop) and Pinocchio
 its difference from Pinocchio's tight reference, the rounds interleaved; then
 the inverse FMU's tick against mj_inverse (`pkm_fmu_bench inverse`). Targets
 (docs/performance.md) printed, never asserted.
-
-usage: python bench/engines_bench.py [--build DIR] [--rounds R] [--batches B] [--quick]
 """
 import argparse
 import csv
@@ -31,10 +29,16 @@ from pkm4puu import motions, spec
 from pkm4puu.cli.engine_comparison import deviation, mujoco_run, pinocchio_reference, pinocchio_rk4
 from pkm4puu.references import mujoco_model
 from pkm4puu.references.pinocchio_model import PinocchioPKM
+from timer import timed
 
 H = 1e-3
 STEPS_TIMED = 1000  # one simulated second
 PROGRAM = Path("bench") / "pkm_fmu_bench"  # in the build directory
+OTHERS = {  # the other engines' rows: key -> (label, how the forces reach the integrator)
+    "mujoco_rollout": ("MuJoCo: mj_step, RK4, 1 ms (mujoco.rollout, C loop)", "midpoint-held"),
+    "mujoco_loop": ("MuJoCo: mj_step, RK4, 1 ms (Python loop)", "midpoint-held"),
+    "pinocchio_rk4": ("Pinocchio: constraintDynamics, RK4, 1 ms (Python loop)", "at stage times"),
+    "pinocchio_bare": ("Pinocchio: the 4000 constraintDynamics calls alone (4000 x one call below)", "")}
 
 
 def log(msg):
@@ -46,18 +50,6 @@ def run_program(program, args):
     if proc.returncode != 0:
         raise RuntimeError(f"{program} {' '.join(args)} failed:\n{proc.stdout}\n{proc.stderr}")
     return proc.stdout
-
-
-def timed(run, batches, setup=None):
-    """The wall time of each of `batches` calls of run(), setup() called untimed before each."""
-    per = []
-    for _ in range(batches):
-        if setup:
-            setup()
-        t0 = time.perf_counter()
-        run()
-        per.append(time.perf_counter() - t0)
-    return per
 
 
 def c_cases(program, batches):
@@ -173,9 +165,9 @@ def main(argv=None):
         first, c_out = first or cases, c_out or out
         for key, c in cases.items():
             add(key, c["median_s_per_sim_s"], c["min_s_per_sim_s"])
-        per = {"mujoco_rollout": timed(mj.rollout, args.batches),
-               "mujoco_loop": timed(mj.python_loop, args.batches, setup=mj.reset),
-               "pinocchio_rk4": timed(lambda: pb.run(STEPS_TIMED), 1)}
+        per = {"mujoco_rollout": timed(mj.rollout, args.batches)[0],
+               "mujoco_loop": timed(mj.python_loop, args.batches, setup=mj.reset)[0],
+               "pinocchio_rk4": timed(lambda: pb.run(STEPS_TIMED), 1)[0]}
         per["pinocchio_dynamics_call"], per["pinocchio_derivatives_call"] = pb.derivatives()
         per["pinocchio_bare"] = 4 * STEPS_TIMED * per["pinocchio_dynamics_call"]  # RK4's calls, at that cost
         for key, v in per.items():
@@ -191,16 +183,12 @@ def main(argv=None):
         idx = np.rint(np.asarray(run["t"]) / H).astype(int)
         return deviation(run, {n: ref[n][idx] for n in ("x", "y", "z", "phi", "delta_rho1")})
 
-    mj_run, pin_run = mujoco_run(), pinocchio_rk4(h=H)  # the whole test, untimed
+    runs = {"mujoco_rollout": mujoco_run(), "pinocchio_rk4": pinocchio_rk4(h=H)}  # the whole test, untimed
     rows = [(f"this project, {c['what']}", key, float(c["max_constraint_residual"]), dev(c["run"]), c["forces"])
             for key, c in first.items()]
-    rows += [("MuJoCo: mj_step, RK4, 1 ms (mujoco.rollout, C loop)", "mujoco_rollout", mj_run["constraint"].max(),
-              dev(mj_run), "midpoint-held"),
-             ("MuJoCo: mj_step, RK4, 1 ms (Python loop)", "mujoco_loop", None, None, "midpoint-held"),
-             ("Pinocchio: constraintDynamics, RK4, 1 ms (Python loop)", "pinocchio_rk4",
-              pin_run["constraint"].max(), dev(pin_run), "at stage times"),
-             ("Pinocchio: the 4000 constraintDynamics calls alone (4000 x one call below)", "pinocchio_bare", None,
-              None, "")]
+    for key, (label, forces) in OTHERS.items():
+        run = runs.get(key)
+        rows.append((label, key, run and run["constraint"].max(), run and dev(run), forces))
     t_mj = median["mujoco_rollout"]
     lines = ["| | time per simulated second, median (best) | MuJoCo's time / this | max ‖C(q)‖ (m) "
              "| max difference from the reference, position (m) / φ (rad) | forces |", "|---|---|---|---|---|---|"]
