@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// pkm_bench: what its parts share (main.cpp defines it): how long each figure
-// is measured, the loops that time them, the one loop of the Plant's 1-ms steps.
+// pkm_bench: what its parts (pkm_bench.cpp, ticks.cpp) share: how long each
+// figure is measured, the loops that time them, the Plant's 1-ms steps.
 #ifndef PKM_BENCH_CORE_BENCH_HPP
 #define PKM_BENCH_CORE_BENCH_HPP
 
@@ -92,7 +92,6 @@ StepRun plant_steps(const Model& m, const SolverSettings& st, const Pose& p0, co
   return r;
 }
 
-int core_part();                 // core.cpp
 int ticks_part(bool parseable);  // ticks.cpp
 
 }  // namespace pkm::bench

@@ -15,9 +15,6 @@
 #include "fmu_harness.h"
 #include "timer.h"
 
-#define STATIC_FORCE 2.655616050 /* N, the holding force at home (docs/model.md "Bodies") */
-#define PI 3.14159265358979323846
-
 typedef struct {
   const char *so, *xml, *out, *mjcf, *state; /* --fmu, --xml, --out (compare), --mjcf, --state (inverse) */
   int batches;
@@ -76,12 +73,7 @@ typedef struct {
 double run_ticks(const Plant* plant, fmi2Component c, const Ticks* ticks, double t0);
 
 /* Returns 0 from the calling function, after a message, when an FMI call (or an || of them) does not return OK. */
-#define FMI_CHECK(call)                                                \
-  do {                                                                 \
-    if ((call) != 0) {                                                 \
-      fprintf(stderr, "pkm_fmu_bench: %s did not return OK\n", #call); \
-      return 0;                                                        \
-    }                                                                  \
-  } while (0)
+#define FMI_CHECK(call) \
+  do { if ((call) != 0) return fprintf(stderr, "pkm_fmu_bench: %s did not return OK\n", #call), 0; } while (0)
 
 #endif /* PKM_BENCH_FMU_BENCH_H */

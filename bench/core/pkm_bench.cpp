@@ -1,8 +1,12 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// pkm_bench core: one state derivative per formulation, the analytic
-// derivatives and the regressor beside what they stand for, the inverse
-// dynamics along the stage-time grid, the 2-s auto-test per solver; each
-// table with its ratios to a baseline measured in the same run.
+// pkm_bench [core|ticks] [--quick] [--parseable]: the core's timing figures as
+// tables, each with its ratios to a baseline measured in the same run (never a
+// pass/fail exit code). core (here): the state derivative, its analytic
+// derivatives, the regressor, the inverse dynamics, the 2-s auto-test; ticks
+// (ticks.cpp): 1-ms steps of the Plant per solver and input, then the stiff
+// cases. --quick: short batches (the documentation build's run); --parseable
+// (ticks): one line a run, tick;<run>;<us/step>;<x>;<y>;<z>;<phi>, the pose
+// after 1 s (tests/platform_ticks.py).
 #include <cstdio>
 #include <string>
 
@@ -20,10 +24,12 @@
 #include "pkm4puu/kinematics/servo_kinematics.hpp"
 
 namespace pkm::bench {
+
+Effort effort;
+
 namespace {
 
 volatile double g_sink = 0;  // results go here so that no call is optimised away
-
 
 std::string fmt_time(double s) {  // "123 ns", "1.234 us", "1.234 ms", "1.234 s"
   char buf[32];
@@ -167,7 +173,6 @@ Figure time_checked(Core& b, const char* what, Body&& body) {
   b.check(bad, what);
   return summarise(per_call);
 }
-
 
 /// time_checked of one expression: `call` gives a Status, `result` a number kept from it.
 #define PKM_TIMED(b, what, call, result) \
@@ -431,8 +436,6 @@ void autotest_section(Core& b, const Figure& sd, const Figure& stages) {
   rule();
 }
 
-}  // namespace
-
 int core_part() {
   Core b;
   if (!set_up(b)) return 1;
@@ -445,4 +448,26 @@ int core_part() {
   return b.failures ? 1 : 0;
 }
 
+}  // namespace
 }  // namespace pkm::bench
+
+int main(int argc, char** argv) {
+  using namespace pkm::bench;
+  bool core = false, ticks = false, parseable = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "core") core = true;
+    else if (a == "ticks") ticks = true;
+    else if (a == "--parseable") parseable = true;
+    else if (a == "--quick") effort = Effort{7, 2e-3, 7, 3, 1.0, 3};
+    else {
+      std::fprintf(stderr, "pkm_bench: unknown argument %s (usage: pkm_bench [core|ticks] [--quick] [--parseable])\n",
+                   argv[i]);
+      return 2;
+    }
+  }
+  if (!core && !ticks) core = !parseable, ticks = true;  // no part named: both (--parseable: the ticks)
+  int status = core ? core_part() : 0;
+  if (ticks) status |= ticks_part(parseable);
+  return status;
+}
