@@ -38,21 +38,6 @@ static int parse_options(const Subcommand* sub, int argc, char** argv, Options* 
   return 0;
 }
 
-/* The model description that goes with the binary `so`: the build's staged one, or that of the unpacked FMU the .so
- * sits in (<so>/../../../modelDescription.xml); the caller frees it. */
-static char* default_xml_path(const char* so, const Subcommand* sub) {
-  size_t n = strlen(so);
-  int slashes = 0;
-  char* path;
-  if (strcmp(so, sub->inverse ? PKM_FMU_INVERSE_SO : PKM_FMU_PLANT_SO) == 0)
-    return strdup(sub->inverse ? PKM_FMU_INVERSE_XML : PKM_FMU_PLANT_XML);
-  while (n > 0 && slashes < 3) slashes += so[--n] == '/';
-  if (slashes < 3 || !(path = malloc(n + 22))) return NULL;
-  memcpy(path, so, n + 1);
-  strcpy(path + n + 1, "modelDescription.xml");
-  return path;
-}
-
 /* The binary's functions and what the subcommand needs of its model description; 0 after a message. */
 static int load(const Subcommand* sub, const char* xml, Plant* p) {
   const char* root = p->text ? strstr(p->text, "<fmiModelDescription") : NULL;
@@ -74,7 +59,6 @@ int main(int argc, char** argv) {
   const Subcommand* sub = NULL;
   Options o = {NULL, NULL, NULL, NULL, NULL, 0, 3.0};
   Plant plant;
-  char* xml_path = NULL;
   int ok;
   if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
     FILE* fp = argc < 2 ? stderr : stdout;
@@ -83,7 +67,7 @@ int main(int argc, char** argv) {
       fprintf(fp, "  %-9s %s\n            --batches 1..%d (default %d)%s%s\n", subcommands[i]->name,
               subcommands[i]->summary, subcommands[i]->max_batches, subcommands[i]->default_batches,
               *subcommands[i]->options ? "; " : "", subcommands[i]->options);
-    fprintf(fp, "\n--fmu: default the build's binary; --xml: default the model description that goes with it\n");
+    fprintf(fp, "\n--fmu: default the build's binary; --xml: its model description (the build's with the build's binary)\n");
     return argc < 2 ? 2 : 0;
   }
   for (size_t i = 0; i < N_SUBCOMMANDS; ++i)
@@ -92,11 +76,13 @@ int main(int argc, char** argv) {
   o.batches = sub->default_batches;
   o.so = sub->inverse ? PKM_FMU_INVERSE_SO : PKM_FMU_PLANT_SO;
   if (parse_options(sub, argc, argv, &o) != 0) return 2;
+  if (!o.xml && strcmp(o.so, sub->inverse ? PKM_FMU_INVERSE_SO : PKM_FMU_PLANT_SO) != 0)
+    return usage_error("--fmu other than the build's needs --xml", o.so);
+  if (!o.xml) o.xml = sub->inverse ? PKM_FMU_INVERSE_XML : PKM_FMU_PLANT_XML;
   memset(&plant, 0, sizeof plant);
   plant.so = o.so;
-  if (!o.xml) o.xml = xml_path = default_xml_path(o.so, sub);
-  plant.text = o.xml ? read_text(o.xml) : NULL;
-  ok = load(sub, o.xml ? o.xml : "(none beside the binary: give --xml)", &plant);
+  plant.text = read_text(o.xml);
+  ok = load(sub, o.xml, &plant);
   if (ok) {
     printf("pkm_fmu_bench %s: %s\n", sub->name, sub->summary);
     bench_print_machine();
@@ -105,7 +91,6 @@ int main(int argc, char** argv) {
   ok = ok && sub->run(&plant, &o);
   if (plant.fmu.handle) dlclose(plant.fmu.handle);
   free((char*)plant.text);
-  free(xml_path);
   if (!ok) fprintf(stderr, "pkm_fmu_bench %s: FAILED\n", sub->name);
   return ok ? 0 : 1;
 }
