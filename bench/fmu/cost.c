@@ -43,6 +43,15 @@ static double second(fmi2Component c, int j) {
   return run_ticks(plant, c, &t, 0.0);
 }
 
+static fmi2Component cells[N_SOLVERS * N_STEPS]; /* [solver][step] */
+static fmi2FMUstate homes[N_SOLVERS * N_STEPS];
+
+/* One second of a cell from its state after initialisation (restored untimed). */
+static double cell_second(void* ctx, int i) {
+  (void)ctx;
+  return plant->fmu.fmi2SetFMUstate(cells[i], homes[i]) == fmi2OK ? second(cells[i], i % N_STEPS) : 0.0;
+}
+
 typedef struct {
   int solver, ok;
   double seconds, sim_seconds, cpu;
@@ -86,9 +95,7 @@ static double throughput(int n, int solver, double seconds, double* cores) {
 
 static int cost_run(const Plant* p, const Options* o) {
   static const char* const names[3] = {"rtol", "atol", "rk4_step"};
-  static double per[N_SOLVERS][N_STEPS][MAX_BATCHES];
-  fmi2Component c[N_SOLVERS][N_STEPS];
-  fmi2FMUstate home[N_SOLVERS][N_STEPS];
+  double med[N_SOLVERS * N_STEPS], mn[N_SOLVERS * N_STEPS];
   long cores = sysconf(_SC_NPROCESSORS_ONLN);
   int i, j, ok = lookup_value_references(p, names, 3, settings);
   plant = p;
@@ -100,26 +107,17 @@ static int cost_run(const Plant* p, const Options* o) {
     }
   printf("%d interleaved batches per cell (median, min in parentheses); throughput over %.1f s\n\n", o->batches,
          o->seconds);
-  /* one instance per cell; each batch restores the state after initialisation (untimed), times one second */
-  for (i = 0; i < N_SOLVERS; ++i)
-    for (j = 0; j < N_STEPS; ++j) ok = ok && (c[i][j] = instantiate_cell("cell", i, j, &home[i][j])) != NULL;
-  for (int b = -1; ok && b < o->batches; ++b)
-    for (i = 0; ok && i < N_SOLVERS; ++i)
-      for (j = 0; ok && j < N_STEPS; ++j) {
-        double s = -1.0;
-        ok = p->fmu.fmi2SetFMUstate(c[i][j], home[i][j]) == fmi2OK && (s = second(c[i][j], j)) >= 0.0;
-        if (b >= 0) per[i][j][b] = s;
-      }
+  for (i = 0; i < N_SOLVERS * N_STEPS; ++i)
+    ok = ok && (cells[i] = instantiate_cell("cell", i / N_STEPS, i % N_STEPS, &homes[i])) != NULL;
+  ok = ok && time_cases(N_SOLVERS * N_STEPS, o->batches, cell_second, NULL, med, mn);
+  for (i = 0; i < N_SOLVERS * N_STEPS; ++i)
+    if (cells[i] && !free_instance(p, FMI2_CS, cells[i], &homes[i])) ok = 0;
   if (!ok) return 0;
   printf("| wall time per simulated second (tick: SetReal + SetRealInputDerivatives + DoStep + GetReal of 12) "
          "| h = 0.1 ms | h = 1 ms | h = 10 ms |\n|---|---|---|---|\n");
   for (i = 0; i < N_SOLVERS; ++i) {
     printf("| %s |", solvers[i].name);
-    for (j = 0; j < N_STEPS; ++j) {
-      double mn, md = bench_median(per[i][j], (size_t)o->batches, &mn);
-      printf(" %.2f ms (%.2f) |", 1e3 * md, 1e3 * mn);
-      ok = free_instance(p, FMI2_CS, c[i][j], &home[i][j]) && ok;
-    }
+    for (j = 0; j < N_STEPS; ++j) printf(" %.2f ms (%.2f) |", 1e3 * med[i * N_STEPS + j], 1e3 * mn[i * N_STEPS + j]);
     printf("\n");
   }
   for (i = 0; ok && i < N_SOLVERS; i += 2) { /* RK4 and CVODE at its defaults */

@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
       fprintf(fp, "  %-9s %s\n            --batches 1..%d (default %d)%s%s\n", subcommands[i]->name,
               subcommands[i]->summary, subcommands[i]->max_batches, subcommands[i]->default_batches,
               *subcommands[i]->options ? "; " : "", subcommands[i]->options);
-    fprintf(fp, "\n--fmu: default the build's binary; --xml: its model description (the build's with the build's binary)\n");
+    fprintf(fp, "\n--fmu: default the build's binary; --xml: its model description (needed with another binary)\n");
     return argc < 2 ? 2 : 0;
   }
   for (size_t i = 0; i < N_SUBCOMMANDS; ++i)
@@ -152,6 +152,20 @@ int lookup_value_references(const Plant* plant, const char* const* names, size_t
   for (size_t i = 0; i < n; ++i)
     if (!lookup_value_reference(plant->text, names[i], &vr[i])) return 0;
   return 1;
+}
+
+int time_cases(int n, int batches, double (*batch)(void* ctx, int i), void* ctx, double* median, double* min) {
+  double* per = malloc(sizeof(double) * (size_t)n * (size_t)batches); /* [case][batch] */
+  int ok = per != NULL;
+  for (int b = -1; ok && b < batches; ++b)
+    for (int i = 0; ok && i < n; ++i) {
+      const double s = batch(ctx, i);
+      ok = s > 0.0;
+      if (b >= 0) per[i * batches + b] = s;
+    }
+  for (int i = 0; ok && i < n; ++i) median[i] = bench_median(per + i * batches, (size_t)batches, &min[i]);
+  free(per);
+  return ok;
 }
 
 double run_ticks(const Plant* plant, fmi2Component c, const Ticks* t, double t0) {
