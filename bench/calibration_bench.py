@@ -1,14 +1,10 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Speed of the identification (a benchmark, not a test): pkm4puu.identify on
---seconds (default 10) of a 1 kHz drive log, against the target of one
-second for 10 s, beside the regressor's own share measured in the same run
-(pkm_regressor_joints over the same samples: the C API's part); the first
-call (imports, library) and the median of --repeat later calls; the peak
-memory of one call (tracemalloc) against the stacked regressor's size (the
-regressor goes in blocks of calibration.identification.BLOCK samples, so the
-peak falls below it from a few blocks on: --seconds 100). The log: a random
-Fourier trajectory, the exact forces from the C API, 1 % force noise and
-1 um encoder quantisation.
+--seconds of a 1 kHz drive log (a random Fourier trajectory, the exact
+forces, 1 % force noise, 1 um encoder steps) against the target of one second
+for 10 s, beside the C API's regressor over the same samples; its peak memory
+against the stacked regressor's size (identify stacks it in blocks, so the
+peak falls below it from a few blocks on: --seconds 100).
 """
 import argparse
 import sys

@@ -1,12 +1,9 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Speed against independent multibody engines, in one run (a benchmark, not
-a test): one simulated second of the comparison test at a 1 ms step through
-this project (`pkm_fmu_bench compare`, in C), MuJoCo (mj_step in
-mujoco.rollout's C loop, and in a Python loop) and Pinocchio
-(constraintDynamics in an RK4 in Python), each with its largest ||C(q)|| and
-its difference from Pinocchio's tight reference, the rounds interleaved; then
-the inverse FMU's tick against mj_inverse (`pkm_fmu_bench inverse`). Targets
-(docs/performance.md) printed, never asserted.
+a test): one simulated second of the comparison test through this project
+(`pkm_fmu_bench compare`, in C), MuJoCo and Pinocchio, the rounds
+interleaved, each with its accuracy; then the inverse FMU's tick against
+mj_inverse (`pkm_fmu_bench inverse`). Targets printed, never asserted.
 """
 import argparse
 import csv

@@ -1,11 +1,9 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Speed of the pick-and-place planner (a benchmark, not a test):
 pkm4puu.plan_cycle on the standard cycle against the target of one second,
-beside the cycle time it plans and its parts measured in the same run: the
-C API's inverse dynamics along the grid, toppra's solve of both legs, and
-the sampling of the result every 0.1 ms. --grids: the cycle time on each
-grid against the finest and the Richardson extrapolate of the two finest
-(the error is first order in the grid step).
+beside its parts measured in the same run; --grids: the cycle time's
+convergence with the grid (first order: Richardson's extrapolate of the two
+finest).
 """
 import argparse
 import sys

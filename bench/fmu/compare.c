@@ -1,10 +1,9 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench compare: one simulated second of the comparison test at a
- * 1 ms step through the C API (pkm_advance_fn, the forces at the stage times
- * from a table as MuJoCo's from an array) and through the plant FMU (F held
- * at each tick's midpoint or as a ramp), the cases below. An untimed run of
- * the whole 1.5 s test records t, x, y, z, phi, rho1 and ||C(q)||: --out DIR
- * writes DIR/<case>.csv and DIR/summary.csv for bench/engines_bench.py. */
+ * 1 ms step through the C API (the forces at the stage times from a table, as
+ * MuJoCo's from an array) and the plant FMU (F held at each tick's midpoint or
+ * as a ramp); --out DIR: each case's untimed run of the whole test and the
+ * summary as CSV, for bench/engines_bench.py. */
 #include "fmu_bench.h"
 #include "pkm4puu/pkm.h"
 

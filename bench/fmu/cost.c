@@ -1,11 +1,9 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench cost: the plant FMU's cost in one Markdown table: the wall
- * time per simulated second against the communication step h and the solver
- * (the cells interleaved batch by batch), the heap in use per initialised
- * instance (glibc mallinfo2, over 64), instantiate + initialise (median of
- * 101), and the batch throughput of one thread per online core against one
- * thread, with the CPU time the threads got. From the home pose, the holding
- * forces plus 0.2 t N on F[1] as value and slope each tick (CVODE continues). */
+/* pkm_fmu_bench cost: the plant FMU's cost in one Markdown table: the time
+ * per simulated second per communication step h and solver, the heap per
+ * instance, instantiate + initialise, and the throughput of one thread per
+ * core against one. From the home pose, the holding forces plus 0.2 t N on
+ * F[1] as value and slope each tick (CVODE continues). */
 #include "fmu_bench.h"
 
 #include <malloc.h>

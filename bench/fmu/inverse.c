@@ -1,10 +1,8 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench inverse: the inverse FMU's tick (FMI 2.0 and 3.0, as a
- * computed-force controller drives it every 1 ms) against MuJoCo's mj_inverse
- * on the same mechanism, both timed here in C, the cases interleaved batch by
- * batch. The motion: a smooth loop about the home pose, tabulated (new inputs
- * every tick, so every get computes). mj_inverse where the program was built
- * with MuJoCo and given the MJCF and state bench/engines_bench.py writes. */
+ * computed-force controller drives it every 1 ms) along a smooth loop about
+ * the home pose against MuJoCo's mj_inverse on the same mechanism (built with
+ * MuJoCo, given the MJCF and state bench/engines_bench.py writes). */
 #include "fmu_bench.h"
 
 #if PKM_HAVE_MUJOCO

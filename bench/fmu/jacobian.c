@@ -1,10 +1,9 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench jacobian: the full Jacobian [A B] (8 x 20) of the state
- * derivative through fmi2GetDirectionalDerivative (Model Exchange, at an
- * off-centre, rotated, moving state with the holding forces) against the C
- * API's pkm_forward_derivatives, the cases below. Each evaluation moves x by
- * 1e-12 m * (k % 1024), so nothing is reused across them; at an unchanged
- * state the FMU evaluates the Jacobians once, which leaves the FMI overhead. */
+/* pkm_fmu_bench jacobian: the state derivative's full Jacobian [A B] (8 x 20)
+ * through fmi2GetDirectionalDerivative (Model Exchange) against the C API's
+ * pkm_forward_derivatives; each evaluation moves x by 1e-12 m * (k % 1024), so
+ * nothing is reused, and the same calls at an unchanged state leave the FMI
+ * overhead. */
 #include "fmu_bench.h"
 #include "pkm4puu/pkm.h"
 

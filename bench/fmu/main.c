@@ -1,10 +1,8 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench: the FMUs' benchmarks, one program with a subcommand each
- * (plain C11): the built binary loaded with dlopen and driven through the
- * raw FMI functions, as a master drives it. Each prints a table with its
- * ratios measured in the same run; the exit status says whether the runs
- * worked (1 if a call fails or a file cannot be read, 2 for a usage error),
- * never how fast they were. --help lists the subcommands and their options. */
+/* pkm_fmu_bench: the FMUs' benchmarks, a subcommand each (plain C11, the built
+ * binary through dlopen and the raw FMI functions, as a master drives it),
+ * each table with its ratios measured in the same run. Exit status: 1 if a
+ * call fails or a file cannot be read, 2 for a usage error, never how fast. */
 #include "fmu_bench.h"
 
 static const Subcommand* const subcommands[] = {&compare_subcommand, &cost_subcommand, &latency_subcommand,
