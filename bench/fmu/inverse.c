@@ -34,23 +34,23 @@ static double time_ticks(void* ctx, int kind) {
   fmi3Boolean event, terminate, early;
   fmi3Float64 reached;
   double F[4] = {0, 0, 0, 0}, *tk = &t[kind];
+  void* ci = kind < 4 ? c[kind] : NULL;
   const double t0 = bench_now();
   (void)ctx;
   for (int k = 0; k < REPEAT * TICKS; ++k, *tk += H, sum += F[0]) {
     const double* u = motion[k % TICKS];
     if (kind == FMI2_CS)
-      FMI_CHECK(f2->fmi2SetReal(c[kind], in, 12, u) || f2->fmi2DoStep(c[kind], *tk, H, fmi2True) ||
-                f2->fmi2GetReal(c[kind], out, 4, F));
+      FMI_CHECK(f2->fmi2SetReal(ci, in, 12, u) || f2->fmi2DoStep(ci, *tk, H, fmi2True) ||
+                f2->fmi2GetReal(ci, out, 4, F));
     if (kind == FMI2_ME)
-      FMI_CHECK(f2->fmi2SetTime(c[kind], *tk + H) || f2->fmi2SetReal(c[kind], in, 12, u) ||
-                f2->fmi2GetReal(c[kind], out, 4, F));
+      FMI_CHECK(f2->fmi2SetTime(ci, *tk + H) || f2->fmi2SetReal(ci, in, 12, u) || f2->fmi2GetReal(ci, out, 4, F));
     if (kind == FMI3_CS)
-      FMI_CHECK(f3->fmi3SetFloat64(c[kind], in, 12, u, 12) ||
-                f3->fmi3DoStep(c[kind], *tk, H, fmi3True, &event, &terminate, &early, &reached) ||
-                f3->fmi3GetFloat64(c[kind], out, 4, F, 4));
+      FMI_CHECK(f3->fmi3SetFloat64(ci, in, 12, u, 12) ||
+                f3->fmi3DoStep(ci, *tk, H, fmi3True, &event, &terminate, &early, &reached) ||
+                f3->fmi3GetFloat64(ci, out, 4, F, 4));
     if (kind == FMI3_ME)
-      FMI_CHECK(f3->fmi3SetTime(c[kind], *tk + H) || f3->fmi3SetFloat64(c[kind], in, 12, u, 12) ||
-                f3->fmi3GetFloat64(c[kind], out, 4, F, 4));
+      FMI_CHECK(f3->fmi3SetTime(ci, *tk + H) || f3->fmi3SetFloat64(ci, in, 12, u, 12) ||
+                f3->fmi3GetFloat64(ci, out, 4, F, 4));
 #if PKM_HAVE_MUJOCO
     if (kind == 4) mj_inverse(mm, md), F[0] = md->qfrc_inverse[0];
 #endif
