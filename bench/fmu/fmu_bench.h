@@ -40,7 +40,7 @@ typedef struct {
 typedef struct {
   const char *name, *summary;
   int (*run)(const Plant* plant, const Options* options);
-  int default_batches, max_batches;
+  int default_batches;
   const char* options; /* its own options beyond --fmu, --xml, --batches */
   int inverse;         /* drives the inverse FMU (PKM4PUU_Inverse) */
 } Subcommand;

@@ -122,4 +122,4 @@ static int inverse_run(const Plant* p, const Options* o) {
 }
 
 const Subcommand inverse_subcommand = {"inverse", "the inverse FMU's tick against MuJoCo's mj_inverse", inverse_run,
-                                       101, 1000, "--mjcf FILE --state FILE (MuJoCo's model and state)", 1};
+                                       101, "--mjcf FILE --state FILE (MuJoCo's model and state)", 1};

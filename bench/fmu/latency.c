@@ -64,4 +64,4 @@ static int latency_run(const Plant* plant, const Options* o) {
 }
 
 const Subcommand latency_subcommand = {"latency", "control ticks of the plant FMU (FMI 2.0 CS, 1 ms), each timed",
-                                       latency_run, 1000, 1000, "", 0};
+                                       latency_run, 1000, "", 0};
