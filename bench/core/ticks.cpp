@@ -44,13 +44,9 @@ StepRun tick_run(const Model& m, const SolverSettings& st, Inputs kind, bool con
 /// the median time per step and the steps answered OK; ROS2's deviation in dz
 /// from CVODE (BDF, rtol 1e-10) over the steps CVODE answered; the ratios.
 void stiff_cases(double rk4_tick_us) {
-  struct Setting {
-    const char* parameter;
-    double value;
-  };
   const struct {
     const char* name;
-    std::vector<Setting> set;  // beyond the defaults
+    std::vector<std::pair<const char*, double>> set;  // parameters beyond the defaults
   } cases[] = {{"friction_viscous 1000", {{"friction_viscous", 1000}}},
                {"friction_coulomb 5", {{"friction_coulomb", 5}}},
                {"friction_coulomb 10, v_s 1e-6", {{"friction_coulomb", 10}, {"friction_velocity", 1e-6}}},
@@ -78,7 +74,7 @@ void stiff_cases(double rk4_tick_us) {
               "ROS2/RK4", "/RK4 tick", "ROS2/CVODE", "ROS2 |ddz|");
   for (const auto& c : cases) {
     Configuration config;
-    for (const Setting& s : c.set) find_parameter(s.parameter)->set(config, s.value);
+    for (const auto& [parameter, value] : c.set) find_parameter(parameter)->set(config, value);
     Model m;
     if (make_model(config.params, m) != Status::Ok) continue;
     const Outcome cv = run(m, Solver::Cvode), r4 = run(m, Solver::Rk4), rb = run(m, Solver::Rosenbrock);
