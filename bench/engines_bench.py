@@ -23,7 +23,7 @@ import mujoco.rollout
 import pinocchio as pin
 
 from pkm4puu import motions, spec
-from pkm4puu.cli.engine_comparison import deviation, mujoco_run, pinocchio_reference, pinocchio_rk4
+from pkm4puu.cli.engine_comparison import deviation, mujoco_run, pinocchio_reference, pinocchio_rk4, rk4_on_manifold
 from pkm4puu.references import mujoco_model
 from pkm4puu.references.pinocchio_model import PinocchioPKM
 from timer import timed
@@ -97,17 +97,9 @@ class PinocchioBench:
         self.run(10)  # warm-up
 
     def run(self, n):
-        m, cd, tau, q, v = self.pm.model, self.cd, self.tau, self.q0, self.v0
-        for k in range(n):
-            a1 = cd(q, v, tau[2 * k])
-            v2 = v + a1 * (H / 2)
-            a2 = cd(pin.integrate(m, q, v * (H / 2)), v2, tau[2 * k + 1])
-            v3 = v + a2 * (H / 2)
-            a3 = cd(pin.integrate(m, q, v2 * (H / 2)), v3, tau[2 * k + 1])
-            v4 = v + a3 * H
-            a4 = cd(pin.integrate(m, q, v3 * H), v4, tau[2 * k + 2])
-            q = pin.integrate(m, q, (H / 6) * (v + 2 * v2 + 2 * v3 + v4))
-            v = v + (H / 6) * (a1 + 2 * a2 + 2 * a3 + a4)
+        pm, tau = self.pm, self.tau
+        rk4_on_manifold(pm.model, self.q0, self.v0, H, n, lambda q, v, k, stage: pin.constraintDynamics(
+            pm.model, pm.data, q, v, tau[2 * k + stage], pm._cm, pm._cd, pm._prox))
 
     def derivatives(self, calls=2000):
         """Per call: constraintDynamics, and it followed by computeConstraintDynamicsDerivatives."""
