@@ -44,7 +44,9 @@ std::string fmt_time(double s) {  // "123 ns", "1.234 us", "1.234 ms", "1.234 s"
 const char* ok_mark(double value, double target) { return value <= target ? "ok" : "OVER"; }
 void rule() { std::printf("%s\n", std::string(96, '-').c_str()); }
 
-const Formulation kFormulations[] = {Formulation::LegPartitioned, Formulation::NullSpaceQR, Formulation::Augmented};
+const std::pair<Formulation, const char*> kFormulations[] = {  // the rows: the enumerators' names
+    {Formulation::LegPartitioned, "LegPartitioned"}, {Formulation::NullSpaceQR, "NullSpaceQR"},
+    {Formulation::Augmented, "Augmented"}};
 constexpr double kDerivativeTarget = 0.25e-6;                  // s, one LegPartitioned state derivative
 constexpr double kInverseTarget = 1.0, kInverseStretch = 0.5;  // x one state derivative
 
@@ -203,8 +205,7 @@ Figure state_derivative_section(Core& b) {
   heading("1. Forward dynamics: one pkm::state_derivative at t = 1.000 s of the auto-test path\n"
           "   (y = path pose and velocity, f = inverse-dynamics forces there; y[0] += 1e-12*(k%1024) per call)",
           "vs LegP");
-  for (const Formulation formulation : kFormulations) {
-    const char* name = formulation_name(formulation);
+  for (const auto& [formulation, name] : kFormulations) {
     Vec8 yk = b.y_mid, ydot;
     long k = 0;
     const Figure f = PKM_TIMED(b, name, state_derivative(b.model, formulation, nudge(yk, b.y_mid, k++), b.f_mid, ydot),

@@ -110,8 +110,10 @@ static double batch(void* ctx, int i) {
   double t0;
   int ok;
   (void)ctx;
-  if (cases[i].fmu)
-    return plant->fmu.fmi2SetFMUstate(insts[i], homes[i]) == fmi2OK ? run_ticks(plant, insts[i], &ticks[i], 0.0) : 0.0;
+  if (cases[i].fmu) {
+    FMI_CHECK(plant->fmu.fmi2SetFMUstate(insts[i], homes[i]));
+    return run_ticks(plant, insts[i], &ticks[i], 0.0);
+  }
   ok = pkm_init_pose(models[i], 0.0, P0, NULL) == PKM_OK;
   t0 = bench_now();
   for (int k = cases[i].one_call ? STEPS_TIMED - 1 : 0; ok && k < STEPS_TIMED; ++k)

@@ -46,7 +46,8 @@ static fmi2FMUstate homes[N_SOLVERS * N_STEPS];
 /* One second of a cell from its state after initialisation (restored untimed). */
 static double cell_second(void* ctx, int i) {
   (void)ctx;
-  return plant->fmu.fmi2SetFMUstate(cells[i], homes[i]) == fmi2OK ? second(cells[i], i % N_STEPS) : 0.0;
+  FMI_CHECK(plant->fmu.fmi2SetFMUstate(cells[i], homes[i]));
+  return second(cells[i], i % N_STEPS);
 }
 
 typedef struct {
