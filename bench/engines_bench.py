@@ -133,7 +133,7 @@ def main(argv=None):
     ap.add_argument("--build", type=Path, default=Path(os.environ.get("PKM_BUILD_DIR", "build")),
                     help=f"the build directory holding {PROGRAM} (default $PKM_BUILD_DIR, else ./build)")
     ap.add_argument("--rounds", type=int, default=5, help="interleaved rounds of every case (default 5)")
-    ap.add_argument("--batches", type=int, default=5, help="batches of 1 simulated second per case and round (default 5)")
+    ap.add_argument("--batches", type=int, default=5, help="batches of 1 s simulated per case and round (default 5)")
     ap.add_argument("--quick", action="store_true", help="a short run (the documentation build's): few inverse batches")
     args = ap.parse_args(argv)
     program = args.build / PROGRAM
@@ -175,9 +175,8 @@ def main(argv=None):
     runs = {"mujoco_rollout": mujoco_run(), "pinocchio_rk4": pinocchio_rk4(h=H)}  # the whole test, untimed
     rows = [(f"this project, {c['what']}", key, float(c["max_constraint_residual"]), dev(c["run"]), c["forces"])
             for key, c in first.items()]
-    for key, (label, forces) in OTHERS.items():
-        run = runs.get(key)
-        rows.append((label, key, run and run["constraint"].max(), run and dev(run), forces))
+    rows += [(label, key, runs[key]["constraint"].max(), dev(runs[key]), forces) if key in runs
+             else (label, key, None, None, forces) for key, (label, forces) in OTHERS.items()]
     t_mj = median["mujoco_rollout"]
     lines = ["| | time per simulated second, median (best) | MuJoCo's time / this | max ‖C(q)‖ (m) "
              "| max difference from the reference, position (m) / φ (rad) | forces |", "|---|---|---|---|---|---|"]
