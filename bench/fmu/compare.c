@@ -68,14 +68,14 @@ static int write_rows(const char* dir, const char* name, int n) {
   return 1;
 }
 
-static double force_table[2 * STEPS_TEST + 1]; /* F1 at t_j = j h/2 */
+static double force_table[2 * STEPS_TEST + 1][4]; /* F at t_j = j h/2 */
 
 /* The inputs u[PKM_PLANT_INPUTS] (F[1..4], then the wrench and the torques: zero, as the library passes them). */
 static void input_callback(void* user, double t, double u[PKM_PLANT_INPUTS]) {
   const long j = lround(t / (0.5 * STEP));
   (void)user;
   if (j >= 0 && j <= 2 * STEPS_TEST && fabs(t / (0.5 * STEP) - (double)j) < 1e-9) {
-    u[0] = force_table[j], u[1] = u[2] = 0.0, u[3] = -force_table[j];
+    memcpy(u, force_table[j], sizeof force_table[j]);
   } else {
     forces(t, u); /* CVODE's own stage times */
   }
@@ -167,7 +167,7 @@ static int compare_run(const Plant* p, const Options* o) {
   size_t i;
   int ok = n_all > 0 && lookup_value_references(p, names, 11, vr);
   plant = p;
-  for (int k = 0; k <= 2 * STEPS_TEST; ++k) force_table[k] = 0.02 * sin(2.0 * PI * (0.5 * STEP * k) / 1.5);
+  for (int k = 0; k <= 2 * STEPS_TEST; ++k) forces(0.5 * STEP * k, force_table[k]);
   for (int k = 0; k < STEPS_TEST; ++k) {
     forces((k + 0.5) * STEP, held[k]);
     forces(k * STEP, ramp[k]);
