@@ -1,16 +1,10 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Speed of the identification (a benchmark, not a test): pkm4puu.identify on
---seconds (default 10) of a 1 kHz drive log, against the target of one
-second for 10 s, beside the regressor's own share measured in the same run
-(pkm_regressor_joints over the same samples: the C API's part); the first
-call (imports, library) and the median of --repeat later calls; the peak
-memory of one call (tracemalloc) against the stacked regressor's size (the
-regressor goes in blocks of calibration.identification.BLOCK samples, so the
-peak falls below it from a few blocks on: --seconds 100). The log: a random
-Fourier trajectory, the exact forces from the C API, 1 % force noise and
-1 um encoder quantisation.
-
-usage: calibration_bench.py [--build DIR] [--seconds S] [--repeat N]
+--seconds of a 1 kHz drive log (a random Fourier trajectory, the exact
+forces, 1 % force noise, 1 um encoder steps) against the target of one second
+for 10 s, beside the C API's regressor over the same samples; its peak memory
+against the stacked regressor's size (identify stacks it in blocks, so the
+peak falls below it from a few blocks on: --seconds 100).
 """
 import argparse
 import sys
@@ -22,6 +16,7 @@ import numpy as np
 from pkm4puu import capi
 from pkm4puu.calibration.parameters import make_plant
 from pkm4puu.locate import library_path
+from timer import timed
 
 TARGET = 1.0  # s for 10 s of 1 kHz data
 MODEL = {"friction_velocity": 0.005, "rotor_inertia": 1.5e-7, "friction_viscous": 5.0, "friction_coulomb": 0.6}
@@ -52,18 +47,10 @@ def main(argv=None):
     from pkm4puu.calibration import filtered_derivatives, identify
     r = identify(t, rho, F, model=MODEL, lib=lib)
     first = time.perf_counter() - t0
-    warm = []
-    for _ in range(args.repeat):
-        t0 = time.perf_counter()
-        identify(t, rho, F, model=MODEL, lib=lib)
-        warm.append(time.perf_counter() - t0)
+    warm = timed(lambda: identify(t, rho, F, model=MODEL, lib=lib), args.repeat)[0]
     r_, rd, rdd = filtered_derivatives(t, rho, 20.0)
-    reg = []
     with make_plant(lib, MODEL) as p:
-        for _ in range(max(args.repeat, 1)):
-            t0 = time.perf_counter()
-            p.regressor_joints(r_, rd, rdd)
-            reg.append(time.perf_counter() - t0)
+        reg = timed(lambda: p.regressor_joints(r_, rd, rdd), max(args.repeat, 1))[0]
     tracemalloc.start()
     identify(t, rho, F, model=MODEL, lib=lib)
     peak = tracemalloc.get_traced_memory()[1]

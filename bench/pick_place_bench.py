@@ -1,13 +1,9 @@
 # SPDX-License-Identifier: BSD-2-Clause
 """Speed of the pick-and-place planner (a benchmark, not a test):
 pkm4puu.plan_cycle on the standard cycle against the target of one second,
-beside the cycle time it plans and its parts measured in the same run: the
-C API's inverse dynamics along the grid, toppra's solve of both legs, and
-the sampling of the result every 0.1 ms. --grids: the cycle time on each
-grid against the finest and the Richardson extrapolate of the two finest
-(the error is first order in the grid step).
-
-usage: pick_place_bench.py [--build DIR] [--repeat N] [--grids N [N ...]]
+beside its parts measured in the same run; --grids: the cycle time's
+convergence with the grid (first order: Richardson's extrapolate of the two
+finest).
 """
 import argparse
 import sys
@@ -15,16 +11,14 @@ import time
 
 import numpy as np
 
+from timer import timed
+
 TARGET = 1.0  # s to plan the standard cycle
 
 
-def timed(fn, repeat):
-    """(the result, the median wall time of `repeat` calls)."""
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
+def median_timed(fn, repeat):
+    """(fn's result, the median wall time of `repeat` calls)."""
+    times, out = timed(fn, repeat)
     return out, float(np.median(times))
 
 
@@ -46,7 +40,7 @@ def main(argv=None):
     cycle = pkm4puu.plan_cycle(build=args.build)
     first = time.perf_counter() - t0
 
-    cycle, plan = timed(lambda: pkm4puu.plan_cycle(build=args.build), args.repeat)
+    cycle, plan = median_timed(lambda: pkm4puu.plan_cycle(build=args.build), args.repeat)
     path, s = arch(), np.linspace(0.0, 1.0, GRID + 1)
     legs = ((path, spec.CYCLE_PAYLOAD), (path.reversed(), 0.0))
 
@@ -57,14 +51,15 @@ def main(argv=None):
                 out.append(topp.path_coefficients(dyn, p, s))
         return out
 
-    coeffs, t_coeff = timed(coefficients, args.repeat)
+    coeffs, t_coeff = median_timed(coefficients, args.repeat)
 
     def solve():
         for a, b, c, drho_ds in coeffs:
             topp.solve(s, a, b, c, spec.CYCLE_F_MAX, spec.CYCLE_V_MAX ** 2 / (drho_ds ** 2).max(axis=1))
 
-    _, t_solve = timed(solve, args.repeat)
-    _, t_sample = timed(lambda: [segment.sample(seg, DT, build=args.build) for seg in cycle.segments], args.repeat)
+    _, t_solve = median_timed(solve, args.repeat)
+    _, t_sample = median_timed(lambda: [segment.sample(seg, DT, build=args.build) for seg in cycle.segments],
+                               args.repeat)
 
     print(f"pick-and-place planning: the standard cycle ({cycle.arch.describe()}, payload {spec.CYCLE_PAYLOAD:g} kg), "
           f"grid {GRID} intervals per leg, samples every {DT:g} s; median of {args.repeat} calls")

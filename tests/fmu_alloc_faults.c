@@ -40,7 +40,6 @@
 #define PKM_HARNESS_NAME "fmu_alloc_faults"
 #include "fmu_harness.h"
 
-#define STATIC_FORCE 2.655616050 /* N, docs/model.md */
 #define H 1e-3
 #define OTHER_STEPS 20
 #define KNOWN_SUNDIALS_CRASHES 2

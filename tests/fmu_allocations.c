@@ -33,8 +33,6 @@
 #define PKM_HARNESS_NAME "fmu_allocations"
 #include "fmu_harness.h"
 
-#define STATIC_FORCE 2.655616050 /* N, docs/model.md "Bodies" */
-#define PI 3.14159265358979323846
 #define STEPS 400
 #define H 1e-3
 #define MAX_OUTPUTS 256

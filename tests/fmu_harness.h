@@ -3,9 +3,9 @@
  * fmu_allocations and fmu_alloc_faults, and bench/fmu's pkm_fmu_bench):
  * loading it with dlopen, a logger that stays silent unless the FMU reports
  * an error, reading modelDescription.xml's attributes and value references,
- * the controller's output names. Static functions, one copy per file that
- * includes this; define PKM_HARNESS_NAME (the program's name, for messages)
- * first. */
+ * the controller's output names, the holding force. Static functions, one
+ * copy per file that includes this; define PKM_HARNESS_NAME (the program's
+ * name, for messages) first. */
 #ifndef PKM_TESTS_FMU_HARNESS_H
 #define PKM_TESTS_FMU_HARNESS_H
 
@@ -156,6 +156,9 @@ PKM_HARNESS_FN int lookup_value_reference(const char* text, const char* name, fm
   *vr = (fmi2ValueReference)v;
   return 1;
 }
+
+#define STATIC_FORCE 2.655616050 /* N, each slider's holding force at the home pose (docs/model.md "Bodies") */
+#define PI 3.14159265358979323846
 
 /* The 12 outputs a controller reads every tick: the pose, its rates and the
  * slider positions (an array initialiser). */

@@ -1,17 +1,14 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench cost: the plant FMU's cost in one Markdown table: the wall
- * time per simulated second against the communication step h and the solver
- * (the cells interleaved batch by batch), the heap in use per initialised
- * instance (glibc mallinfo2, over 64), instantiate + initialise (median of
- * 101), and the batch throughput of one thread per online core against one
- * thread, with the CPU time the threads got. From the home pose, the holding
- * forces plus 0.2 t N on F[1] as value and slope each tick (CVODE continues). */
+/* pkm_fmu_bench cost: the plant FMU's cost in one Markdown table: the time
+ * per simulated second per communication step h and solver, the heap per
+ * instance, instantiate + initialise, and the throughput of one thread per
+ * core against one. From the home pose, the holding forces plus 0.2 t N on
+ * F[1] as value and slope each tick (CVODE continues). */
 #include "fmu_bench.h"
 
 #include <malloc.h>
 #include <pthread.h>
 
-#define MAX_BATCHES 101
 #define N_STEPS 3
 #define N_SOLVERS 4
 #define N_MEMORY 64
@@ -41,6 +38,16 @@ static fmi2Component instantiate_cell(const char* name, int i, int j, fmi2FMUsta
 static double second(fmi2Component c, int j) {
   const Ticks t = {steps[j], (int)(1.0 / steps[j] + 0.5), F[j], dF[j], plant->control, 12, NULL, NULL};
   return run_ticks(plant, c, &t, 0.0);
+}
+
+static fmi2Component cells[N_SOLVERS * N_STEPS]; /* [solver][step] */
+static fmi2FMUstate homes[N_SOLVERS * N_STEPS];
+
+/* One second of a cell from its state after initialisation (restored untimed). */
+static double cell_second(void* ctx, int i) {
+  (void)ctx;
+  FMI_CHECK(plant->fmu.fmi2SetFMUstate(cells[i], homes[i]));
+  return second(cells[i], i % N_STEPS);
 }
 
 typedef struct {
@@ -86,9 +93,7 @@ static double throughput(int n, int solver, double seconds, double* cores) {
 
 static int cost_run(const Plant* p, const Options* o) {
   static const char* const names[3] = {"rtol", "atol", "rk4_step"};
-  static double per[N_SOLVERS][N_STEPS][MAX_BATCHES];
-  fmi2Component c[N_SOLVERS][N_STEPS];
-  fmi2FMUstate home[N_SOLVERS][N_STEPS];
+  double med[N_SOLVERS * N_STEPS], mn[N_SOLVERS * N_STEPS];
   long cores = sysconf(_SC_NPROCESSORS_ONLN);
   int i, j, ok = lookup_value_references(p, names, 3, settings);
   plant = p;
@@ -100,26 +105,17 @@ static int cost_run(const Plant* p, const Options* o) {
     }
   printf("%d interleaved batches per cell (median, min in parentheses); throughput over %.1f s\n\n", o->batches,
          o->seconds);
-  /* one instance per cell; each batch restores the state after initialisation (untimed), times one second */
-  for (i = 0; i < N_SOLVERS; ++i)
-    for (j = 0; j < N_STEPS; ++j) ok = ok && (c[i][j] = instantiate_cell("cell", i, j, &home[i][j])) != NULL;
-  for (int b = -1; ok && b < o->batches; ++b)
-    for (i = 0; ok && i < N_SOLVERS; ++i)
-      for (j = 0; ok && j < N_STEPS; ++j) {
-        double s = -1.0;
-        ok = p->fmu.fmi2SetFMUstate(c[i][j], home[i][j]) == fmi2OK && (s = second(c[i][j], j)) >= 0.0;
-        if (b >= 0) per[i][j][b] = s;
-      }
+  for (i = 0; i < N_SOLVERS * N_STEPS; ++i)
+    ok = ok && (cells[i] = instantiate_cell("cell", i / N_STEPS, i % N_STEPS, &homes[i])) != NULL;
+  ok = ok && time_cases(N_SOLVERS * N_STEPS, o->batches, cell_second, NULL, med, mn);
+  for (i = 0; i < N_SOLVERS * N_STEPS; ++i)
+    if (cells[i] && !free_instance(p, FMI2_CS, cells[i], &homes[i])) ok = 0;
   if (!ok) return 0;
   printf("| wall time per simulated second (tick: SetReal + SetRealInputDerivatives + DoStep + GetReal of 12) "
          "| h = 0.1 ms | h = 1 ms | h = 10 ms |\n|---|---|---|---|\n");
   for (i = 0; i < N_SOLVERS; ++i) {
     printf("| %s |", solvers[i].name);
-    for (j = 0; j < N_STEPS; ++j) {
-      double mn, md = bench_median(per[i][j], (size_t)o->batches, &mn);
-      printf(" %.2f ms (%.2f) |", 1e3 * md, 1e3 * mn);
-      ok = free_instance(p, FMI2_CS, c[i][j], &home[i][j]) && ok;
-    }
+    for (j = 0; j < N_STEPS; ++j) printf(" %.2f ms (%.2f) |", 1e3 * med[i * N_STEPS + j], 1e3 * mn[i * N_STEPS + j]);
     printf("\n");
   }
   for (i = 0; ok && i < N_SOLVERS; i += 2) { /* RK4 and CVODE at its defaults */
@@ -161,4 +157,4 @@ static int cost_run(const Plant* p, const Options* o) {
 
 const Subcommand cost_subcommand = {"cost",
                                     "the cost table: time per simulated second, memory, initialisation, throughput",
-                                    cost_run, 7, MAX_BATCHES, "--seconds S (throughput's wall time, default 3)", 0};
+                                    cost_run, 7, "--seconds S (throughput's wall time, default 3)", 0};

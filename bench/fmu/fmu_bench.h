@@ -15,9 +15,6 @@
 #include "fmu_harness.h"
 #include "timer.h"
 
-#define STATIC_FORCE 2.655616050 /* N, the holding force at home (docs/model.md "Bodies") */
-#define PI 3.14159265358979323846
-
 typedef struct {
   const char *so, *xml, *out, *mjcf, *state; /* --fmu, --xml, --out (compare), --mjcf, --state (inverse) */
   int batches;
@@ -43,7 +40,7 @@ typedef struct {
 typedef struct {
   const char *name, *summary;
   int (*run)(const Plant* plant, const Options* options);
-  int default_batches, max_batches;
+  int default_batches;
   const char* options; /* its own options beyond --fmu, --xml, --batches */
   int inverse;         /* drives the inverse FMU (PKM4PUU_Inverse) */
 } Subcommand;
@@ -75,13 +72,13 @@ typedef struct {
 /* The ticks from time t0: their wall time, or < 0 after a message when a call fails. */
 double run_ticks(const Plant* plant, fmi2Component c, const Ticks* ticks, double t0);
 
+/* The one loop of the timed batches: n cases interleaved batch by batch, one warm-up batch of each first;
+ * batch(ctx, i) runs a batch of case i and returns its time (<= 0 after a message on failure). The median and
+ * minimum over the batches per case in median[i], min[i]; 0 on failure. */
+int time_cases(int n, int batches, double (*batch)(void* ctx, int i), void* ctx, double* median, double* min);
+
 /* Returns 0 from the calling function, after a message, when an FMI call (or an || of them) does not return OK. */
-#define FMI_CHECK(call)                                                \
-  do {                                                                 \
-    if ((call) != 0) {                                                 \
-      fprintf(stderr, "pkm_fmu_bench: %s did not return OK\n", #call); \
-      return 0;                                                        \
-    }                                                                  \
-  } while (0)
+#define FMI_CHECK(call) \
+  do { if ((call) != 0) return fprintf(stderr, "pkm_fmu_bench: %s did not return OK\n", #call), 0; } while (0)
 
 #endif /* PKM_BENCH_FMU_BENCH_H */

@@ -1,10 +1,8 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench inverse: the inverse FMU's tick (FMI 2.0 and 3.0, as a
- * computed-force controller drives it every 1 ms) against MuJoCo's mj_inverse
- * on the same mechanism, both timed here in C, the cases interleaved batch by
- * batch. The motion: a smooth loop about the home pose, tabulated (new inputs
- * every tick, so every get computes). mj_inverse where the program was built
- * with MuJoCo and given the MJCF and state bench/engines_bench.py writes. */
+ * computed-force controller drives it every 1 ms) along a smooth loop about
+ * the home pose against MuJoCo's mj_inverse on the same mechanism (built with
+ * MuJoCo, given the MJCF and state bench/engines_bench.py writes). */
 #include "fmu_bench.h"
 
 #if PKM_HAVE_MUJOCO
@@ -20,29 +18,42 @@ static const char* const kind_names[4] = {"FMI 2.0 Co-Simulation", "FMI 2.0 Mode
                                           "FMI 3.0 Model Exchange"};
 static double motion[TICKS][12]; /* x, y on a circle of 2 mm, z +-5 mm, phi +-0.05 rad; rates, accelerations */
 static fmi2ValueReference in[12], out[4];
+static const Plant* plant;
+static void* c[4];
+static double t[5], sum; /* each case's time; the forces' sum keeps the loops' results alive */
+#if PKM_HAVE_MUJOCO
+static mjModel* mm;
+static mjData* md;
+#endif
 
-/* A batch of ticks of `kind` on instance c from time *t: the time per tick, < 0 after a message on failure. */
-static double time_ticks(const Plant* plant, int kind, void* c, double* t, double* sum) {
+/* A batch of ticks of instance `kind` (a batch of mj_inverse: kind 4): the time per tick, 0 after a message on
+ * failure. */
+static double time_ticks(void* ctx, int kind) {
   const Fmu* f2 = &plant->fmu;
   const Fmu3* f3 = &plant->fmu3;
   fmi3Boolean event, terminate, early;
   fmi3Float64 reached;
-  double F[4] = {0, 0, 0, 0};
+  double F[4] = {0, 0, 0, 0}, *tk = &t[kind];
+  void* ci = kind < 4 ? c[kind] : NULL;
   const double t0 = bench_now();
-  int k;
-  for (k = 0; k < REPEAT * TICKS; ++k, *t += H, *sum += F[0]) {
+  (void)ctx;
+  for (int k = 0; k < REPEAT * TICKS; ++k, *tk += H, sum += F[0]) {
     const double* u = motion[k % TICKS];
     if (kind == FMI2_CS)
-      FMI_CHECK(f2->fmi2SetReal(c, in, 12, u) || f2->fmi2DoStep(c, *t, H, fmi2True) || f2->fmi2GetReal(c, out, 4, F));
+      FMI_CHECK(f2->fmi2SetReal(ci, in, 12, u) || f2->fmi2DoStep(ci, *tk, H, fmi2True) ||
+                f2->fmi2GetReal(ci, out, 4, F));
     if (kind == FMI2_ME)
-      FMI_CHECK(f2->fmi2SetTime(c, *t + H) || f2->fmi2SetReal(c, in, 12, u) || f2->fmi2GetReal(c, out, 4, F));
+      FMI_CHECK(f2->fmi2SetTime(ci, *tk + H) || f2->fmi2SetReal(ci, in, 12, u) || f2->fmi2GetReal(ci, out, 4, F));
     if (kind == FMI3_CS)
-      FMI_CHECK(f3->fmi3SetFloat64(c, in, 12, u, 12) ||
-                f3->fmi3DoStep(c, *t, H, fmi3True, &event, &terminate, &early, &reached) ||
-                f3->fmi3GetFloat64(c, out, 4, F, 4));
+      FMI_CHECK(f3->fmi3SetFloat64(ci, in, 12, u, 12) ||
+                f3->fmi3DoStep(ci, *tk, H, fmi3True, &event, &terminate, &early, &reached) ||
+                f3->fmi3GetFloat64(ci, out, 4, F, 4));
     if (kind == FMI3_ME)
-      FMI_CHECK(f3->fmi3SetTime(c, *t + H) || f3->fmi3SetFloat64(c, in, 12, u, 12) ||
-                f3->fmi3GetFloat64(c, out, 4, F, 4));
+      FMI_CHECK(f3->fmi3SetTime(ci, *tk + H) || f3->fmi3SetFloat64(ci, in, 12, u, 12) ||
+                f3->fmi3GetFloat64(ci, out, 4, F, 4));
+#if PKM_HAVE_MUJOCO
+    if (kind == 4) mj_inverse(mm, md), F[0] = md->qfrc_inverse[0];
+#endif
   }
   return (bench_now() - t0) / (REPEAT * TICKS);
 }
@@ -64,47 +75,33 @@ static int load_mujoco(const char* mjcf, const char* state, mjModel** m, mjData*
 }
 #endif
 
-static int inverse_run(const Plant* plant, const Options* o) {
+static int inverse_run(const Plant* p, const Options* o) {
   static const char* const inputs[12] = {"x", "y", "z", "phi", "dx", "dy", "dz", "dphi", "ddx", "ddy", "ddz", "ddphi"};
   static const char* const outputs[4] = {"F[1]", "F[2]", "F[3]", "F[4]"};
-  const int n = o->batches;
-  double* per = malloc(sizeof(double) * 5 * (size_t)n); /* [case][batch]; case 4: mj_inverse */
-  double t[4] = {0.0, 0.0, 0.0, 0.0}, sum = 0.0, med[5] = {0}, mn[5] = {0};
-  void* c[4] = {NULL, NULL, NULL, NULL};
-  int b, k, have_mj = 0, ok = per && lookup_value_references(plant, inputs, 12, in) &&
-                               lookup_value_references(plant, outputs, 4, out);
+  double med[5] = {0}, mn[5] = {0}; /* the four instances, then mj_inverse */
+  int b, k, have_mj = 0, ok = lookup_value_references(p, inputs, 12, in) && lookup_value_references(p, outputs, 4, out);
+  plant = p;
 #if PKM_HAVE_MUJOCO
-  mjModel* mm = NULL;
-  mjData* md = NULL;
   if (ok && o->mjcf && o->state) ok = have_mj = load_mujoco(o->mjcf, o->state, &mm, &md);
 #endif
   for (k = 0; k < TICKS; ++k) { /* one period per table, with the exact rates and accelerations */
     const double w = 2.0 * PI, s = sin(w * k * H), co = cos(w * k * H), a[4] = {0.002, 0.002, 0.005, 0.05};
-    const double p[4] = {a[0] * s, a[1] * co, a[2] * s, a[3] * s}, v[4] = {a[0] * w * co, -a[1] * w * s, a[2] * w * co,
+    const double q[4] = {a[0] * s, a[1] * co, a[2] * s, a[3] * s}, v[4] = {a[0] * w * co, -a[1] * w * s, a[2] * w * co,
                                                                            a[3] * w * co};
     for (b = 0; b < 4; ++b)
-      motion[k][b] = p[b] + (b == 2 ? 0.05 : 0.0), motion[k][4 + b] = v[b], motion[k][8 + b] = -w * w * p[b];
+      motion[k][b] = q[b] + (b == 2 ? 0.05 : 0.0), motion[k][4 + b] = v[b], motion[k][8 + b] = -w * w * q[b];
   }
   printf("tick = set the 12 motion inputs, advance (CS: DoStep 1 ms; ME: SetTime), get F[1..4];\n"
          "median and min per call over %d batches of %d calls, the cases interleaved batch by batch\n\n",
-         n, REPEAT * TICKS);
-  for (k = 0; ok && k < 4; ++k) ok = (c[k] = instantiate(plant, k, kind_names[k], -1, 0, NULL, NULL, NULL)) != NULL;
-  for (b = 0; ok && b < n; ++b) {
-    for (k = 0; ok && k < 4; ++k) ok = (per[k * n + b] = time_ticks(plant, k, c[k], &t[k], &sum)) > 0.0;
-#if PKM_HAVE_MUJOCO
-    for (k = 0, per[4 * n + b] = bench_now(); ok && have_mj && k < REPEAT * TICKS; ++k)
-      mj_inverse(mm, md), sum += md->qfrc_inverse[0];
-    per[4 * n + b] = (bench_now() - per[4 * n + b]) / (REPEAT * TICKS);
-#endif
-  }
-  for (k = 0; ok && k < 4 + have_mj; ++k) med[k] = bench_median(per + k * n, (size_t)n, &mn[k]);
+         o->batches, REPEAT * TICKS);
+  for (k = 0; ok && k < 4; ++k) ok = (c[k] = instantiate(p, k, kind_names[k], -1, 0, NULL, NULL, NULL)) != NULL;
+  ok = ok && time_cases(4 + have_mj, o->batches, time_ticks, NULL, med, mn);
   for (k = 0; k < 4; ++k)
-    if (c[k]) free_instance(plant, k, c[k], NULL);
+    if (c[k]) free_instance(p, k, c[k], NULL);
 #if PKM_HAVE_MUJOCO
   if (md) mj_deleteData(md);
   if (mm) mj_deleteModel(mm);
 #endif
-  free(per);
   if (!ok) return 0;
   printf("   %-40s %12s %12s %15s\n", "evaluation", "median/call", "min/call", "/ mj_inverse");
   if (have_mj)
@@ -125,4 +122,4 @@ static int inverse_run(const Plant* plant, const Options* o) {
 }
 
 const Subcommand inverse_subcommand = {"inverse", "the inverse FMU's tick against MuJoCo's mj_inverse", inverse_run,
-                                       101, 1000, "--mjcf FILE --state FILE (MuJoCo's model and state)", 1};
+                                       101, "--mjcf FILE --state FILE (MuJoCo's model and state)", 1};

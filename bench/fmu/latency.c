@@ -1,11 +1,9 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench latency: the distribution of the control tick's time, each
- * tick timed on its own, each batch the same simulated second from the home
- * pose. F = the holding force, plus on F[1] with RK4 0.2 cos(2 pi 3 t) N held
- * over each tick, with CVODE the ramp 0.2 t N as value and slope. The model's
- * work at tick k is the same in every batch, bit for bit, while the machine's
- * interruptions fall on random ticks: the minimum over the batches of tick k
- * is the model's own time for it, and the spread above it is the machine's. */
+/* pkm_fmu_bench latency: the control tick's time, each tick timed on its own,
+ * every batch the same simulated second from the home pose, so the minimum
+ * over the batches of tick k is the model's own time for it (the spread above
+ * it is the machine's). F: the holding force, plus on F[1] with RK4
+ * 0.2 cos(2 pi 3 t) N held over each tick, with CVODE 0.2 t N as a ramp. */
 #include "fmu_bench.h"
 
 #define TICKS 1000 /* a batch: one simulated second */
@@ -66,4 +64,4 @@ static int latency_run(const Plant* plant, const Options* o) {
 }
 
 const Subcommand latency_subcommand = {"latency", "control ticks of the plant FMU (FMI 2.0 CS, 1 ms), each timed",
-                                       latency_run, 1000, 1000, "", 0};
+                                       latency_run, 1000, "", 0};

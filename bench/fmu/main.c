@@ -1,10 +1,8 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench: the FMUs' benchmarks, one program with a subcommand each
- * (plain C11): the built binary loaded with dlopen and driven through the
- * raw FMI functions, as a master drives it. Each prints a table with its
- * ratios measured in the same run; the exit status says whether the runs
- * worked (1 if a call fails or a file cannot be read, 2 for a usage error),
- * never how fast they were. --help lists the subcommands and their options. */
+/* pkm_fmu_bench: the FMUs' benchmarks, a subcommand each (plain C11, the built
+ * binary through dlopen and the raw FMI functions, as a master drives it),
+ * each table with its ratios measured in the same run. Exit status: 1 if a
+ * call fails or a file cannot be read, 2 for a usage error, never how fast. */
 #include "fmu_bench.h"
 
 static const Subcommand* const subcommands[] = {&compare_subcommand, &cost_subcommand, &latency_subcommand,
@@ -30,27 +28,12 @@ static int parse_options(const Subcommand* sub, int argc, char** argv, Options* 
     for (size_t k = 0; k < 5; ++k)
       if (strcmp(opt, names[k]) == 0) *targets[k] = value;
     if (strcmp(opt, "--batches") == 0 && ((o->batches = (int)strtol(value, &end, 10)), *end || o->batches < 1 ||
-                                          o->batches > sub->max_batches))
+                                          o->batches > 100000))
       return usage_error("--batches out of range", value);
     if (strcmp(opt, "--seconds") == 0 && (o->seconds = strtod(value, &end), *end || !(o->seconds > 0.0)))
       return usage_error("--seconds must be positive", value);
   }
   return 0;
-}
-
-/* The model description that goes with the binary `so`: the build's staged one, or that of the unpacked FMU the .so
- * sits in (<so>/../../../modelDescription.xml); the caller frees it. */
-static char* default_xml_path(const char* so, const Subcommand* sub) {
-  size_t n = strlen(so);
-  int slashes = 0;
-  char* path;
-  if (strcmp(so, sub->inverse ? PKM_FMU_INVERSE_SO : PKM_FMU_PLANT_SO) == 0)
-    return strdup(sub->inverse ? PKM_FMU_INVERSE_XML : PKM_FMU_PLANT_XML);
-  while (n > 0 && slashes < 3) slashes += so[--n] == '/';
-  if (slashes < 3 || !(path = malloc(n + 22))) return NULL;
-  memcpy(path, so, n + 1);
-  strcpy(path + n + 1, "modelDescription.xml");
-  return path;
 }
 
 /* The binary's functions and what the subcommand needs of its model description; 0 after a message. */
@@ -74,16 +57,15 @@ int main(int argc, char** argv) {
   const Subcommand* sub = NULL;
   Options o = {NULL, NULL, NULL, NULL, NULL, 0, 3.0};
   Plant plant;
-  char* xml_path = NULL;
   int ok;
   if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
     FILE* fp = argc < 2 ? stderr : stdout;
     fprintf(fp, "usage: pkm_fmu_bench SUBCOMMAND [--fmu SO] [--xml modelDescription.xml] [--batches N] [options]\n\n");
     for (size_t i = 0; i < N_SUBCOMMANDS; ++i)
-      fprintf(fp, "  %-9s %s\n            --batches 1..%d (default %d)%s%s\n", subcommands[i]->name,
-              subcommands[i]->summary, subcommands[i]->max_batches, subcommands[i]->default_batches,
-              *subcommands[i]->options ? "; " : "", subcommands[i]->options);
-    fprintf(fp, "\n--fmu: default the build's binary; --xml: default the model description that goes with it\n");
+      fprintf(fp, "  %-9s %s\n            --batches N (default %d)%s%s\n", subcommands[i]->name,
+              subcommands[i]->summary, subcommands[i]->default_batches, *subcommands[i]->options ? "; " : "",
+              subcommands[i]->options);
+    fprintf(fp, "\n--fmu: default the build's binary; --xml: its model description (needed with another binary)\n");
     return argc < 2 ? 2 : 0;
   }
   for (size_t i = 0; i < N_SUBCOMMANDS; ++i)
@@ -92,11 +74,13 @@ int main(int argc, char** argv) {
   o.batches = sub->default_batches;
   o.so = sub->inverse ? PKM_FMU_INVERSE_SO : PKM_FMU_PLANT_SO;
   if (parse_options(sub, argc, argv, &o) != 0) return 2;
+  if (!o.xml && strcmp(o.so, sub->inverse ? PKM_FMU_INVERSE_SO : PKM_FMU_PLANT_SO) != 0)
+    return usage_error("--fmu other than the build's needs --xml", o.so);
+  if (!o.xml) o.xml = sub->inverse ? PKM_FMU_INVERSE_XML : PKM_FMU_PLANT_XML;
   memset(&plant, 0, sizeof plant);
   plant.so = o.so;
-  if (!o.xml) o.xml = xml_path = default_xml_path(o.so, sub);
-  plant.text = o.xml ? read_text(o.xml) : NULL;
-  ok = load(sub, o.xml ? o.xml : "(none beside the binary: give --xml)", &plant);
+  plant.text = read_text(o.xml);
+  ok = load(sub, o.xml, &plant);
   if (ok) {
     printf("pkm_fmu_bench %s: %s\n", sub->name, sub->summary);
     bench_print_machine();
@@ -105,7 +89,6 @@ int main(int argc, char** argv) {
   ok = ok && sub->run(&plant, &o);
   if (plant.fmu.handle) dlclose(plant.fmu.handle);
   free((char*)plant.text);
-  free(xml_path);
   if (!ok) fprintf(stderr, "pkm_fmu_bench %s: FAILED\n", sub->name);
   return ok ? 0 : 1;
 }
@@ -167,6 +150,20 @@ int lookup_value_references(const Plant* plant, const char* const* names, size_t
   for (size_t i = 0; i < n; ++i)
     if (!lookup_value_reference(plant->text, names[i], &vr[i])) return 0;
   return 1;
+}
+
+int time_cases(int n, int batches, double (*batch)(void* ctx, int i), void* ctx, double* median, double* min) {
+  double* per = malloc(sizeof(double) * (size_t)n * (size_t)batches); /* [case][batch] */
+  int ok = per != NULL;
+  for (int b = -1; ok && b < batches; ++b)
+    for (int i = 0; ok && i < n; ++i) {
+      const double s = batch(ctx, i);
+      ok = s > 0.0;
+      if (b >= 0) per[i * batches + b] = s;
+    }
+  for (int i = 0; ok && i < n; ++i) median[i] = bench_median(per + i * batches, (size_t)batches, &min[i]);
+  free(per);
+  return ok;
 }
 
 double run_ticks(const Plant* plant, fmi2Component c, const Ticks* t, double t0) {

@@ -141,6 +141,25 @@ def pinocchio_reference(force_law="exact", machine=None, g=0.0, forces=motions.c
     return out
 
 
+def rk4_on_manifold(model, q, v, h, n, acc, after_step=None):
+    """n fixed RK4 steps of h on the model's configuration manifold from (q,
+    v): acc(q, v, k, stage) the accelerations at t_k + (0, h/2, h)[stage];
+    after_step(k, q) after step k (also bench/engines_bench.py's timed run)."""
+    for k in range(n):
+        a1 = acc(q, v, k, 0)
+        v2 = v + a1 * h / 2
+        a2 = acc(pin.integrate(model, q, v * h / 2), v2, k, 1)
+        v3 = v + a2 * h / 2
+        a3 = acc(pin.integrate(model, q, v2 * h / 2), v3, k, 1)
+        v4 = v + a3 * h
+        a4 = acc(pin.integrate(model, q, v3 * h), v4, k, 2)
+        q = pin.integrate(model, q, h / 6 * (v + 2 * v2 + 2 * v3 + v4))
+        v = v + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+        if after_step:
+            after_step(k, q)
+    return q, v
+
+
 def pinocchio_rk4(h=5e-4, machine=None, g=0.0, forces=motions.comparison_forces):
     """Cross-check of the reference: fixed-step RK4 at h on the manifold's
     coordinates, accelerations from pinocchio.constraintDynamics (Pinocchio's
@@ -148,25 +167,13 @@ def pinocchio_rk4(h=5e-4, machine=None, g=0.0, forces=motions.comparison_forces)
     the stage times. Same keys and arguments as pinocchio_reference."""
     pm = PinocchioPKM(g=g, machine=machine)
     pm.setup_constraint_dynamics()
-    m = pm.model
-    q, v = pm.q_from_pose(spec.P0), np.zeros(16)
+    q = pm.q_from_pose(spec.P0)
     sub = round(H / h)
     Q = [q]
     t0 = time.perf_counter()
-    for k in range(N * sub):
-        t = k * h
-        f0, fm, f1 = (forces(s) for s in (t, t + h / 2, t + h))
-        a1 = pm.constraint_dynamics(q, v, f0)
-        v2 = v + a1 * h / 2
-        a2 = pm.constraint_dynamics(pin.integrate(m, q, v * h / 2), v2, fm)
-        v3 = v + a2 * h / 2
-        a3 = pm.constraint_dynamics(pin.integrate(m, q, v2 * h / 2), v3, fm)
-        v4 = v + a3 * h
-        a4 = pm.constraint_dynamics(pin.integrate(m, q, v3 * h), v4, f1)
-        q = pin.integrate(m, q, h / 6 * (v + 2 * v2 + 2 * v3 + v4))
-        v = v + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
-        if (k + 1) % sub == 0:
-            Q.append(q)
+    rk4_on_manifold(pm.model, q, np.zeros(16), h, N * sub,
+                    lambda q, v, k, stage: pm.constraint_dynamics(q, v, forces(k * h + (0.0, h / 2, h)[stage])),
+                    lambda k, q: Q.append(q) if (k + 1) % sub == 0 else None)
     out = {"t": TIMES.copy(), "q": np.array(Q), **_rows_from_q(Q)}
     out["seconds"] = time.perf_counter() - t0
     return out

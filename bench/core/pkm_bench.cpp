@@ -1,22 +1,20 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // pkm_bench [core|ticks] [--quick] [--parseable]: the core's timing figures as
 // tables, each with its ratios to a baseline measured in the same run (never a
-// pass/fail exit code). core: the state derivative, its analytic derivatives,
-// the regressor, the inverse dynamics, the 2-s auto-test; ticks: 1-ms steps of
-// the Plant per solver and input, then the stiff cases. --quick: short batches
-// (the documentation build's run); --parseable (ticks): one line a run,
-// tick;<run>;<us/step>;<x>;<y>;<z>;<phi>, the pose after 1 s (tests/platform_ticks.py).
-#include <algorithm>
-#include <array>
-#include <cmath>
+// pass/fail exit code). core (here): the state derivative, its analytic
+// derivatives, the regressor, the inverse dynamics, the 2-s auto-test; ticks
+// (ticks.cpp): 1-ms steps of the Plant per solver and input, then the stiff
+// cases. --quick: short batches (the documentation build's run); --parseable
+// (ticks): one line a run, tick;<run>;<us/step>;<x>;<y>;<z>;<phi>, the pose
+// after 1 s (tests/platform_ticks.py).
 #include <cstdio>
 #include <string>
-#include <vector>
 
 #include <sundials/sundials_config.h>
 
 #include "apps/autotest.hpp"
 #include "apps/trajectory.hpp"
+#include "core/core_bench.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
@@ -24,68 +22,14 @@
 #include "pkm4puu/dynamics/regressor.hpp"
 #include "pkm4puu/dynamics/state_derivative.hpp"
 #include "pkm4puu/kinematics/servo_kinematics.hpp"
-#include "pkm4puu/sim/parameters.hpp"
-#include "pkm4puu/sim/plant.hpp"
-#include "timer.h"
 
-namespace pkm {
+namespace pkm::bench {
+
+Effort effort;
+
 namespace {
 
 volatile double g_sink = 0;  // results go here so that no call is optimised away
-
-/// How long each figure is measured: the defaults, or --quick.
-struct Effort {
-  int batches = 31;                 // batches per per-call figure
-  double batch_s = 4e-3;            // a per-call batch lasts at least this
-  int max_runs = 31, min_runs = 5;  // whole runs: at most, at least, and the wall-time budget
-  double runs_budget_s = 6.0;
-  int tick_runs = 15;  // runs of a simulated second per tick row
-} effort;
-
-struct Figure {
-  double median = NAN, min = NAN;  // s per call (per run)
-  int batches = 0;
-};
-
-Figure summarise(std::vector<double> v) {
-  Figure f;
-  if (!v.empty()) f.median = bench_median(v.data(), v.size(), &f.min), f.batches = static_cast<int>(v.size());
-  return f;
-}
-
-/// Per-call time of body(): N calls per batch, N grown until a batch lasts effort.batch_s.
-template <class Body>
-Figure time_per_call(Body&& body) {
-  long n = 1;
-  for (double dt = 0; n < (1L << 26); n = std::lround(n * std::clamp(1.2 * effort.batch_s / dt, 2.0, 10.0))) {
-    const double t0 = bench_now();
-    for (long k = 0; k < n; ++k) body();
-    if ((dt = bench_now() - t0) >= effort.batch_s) break;
-  }
-  std::vector<double> per_call;
-  for (int b = 0; b < effort.batches; ++b) {
-    const double t0 = bench_now();
-    for (long k = 0; k < n; ++k) body();
-    per_call.push_back((bench_now() - t0) / static_cast<double>(n));
-  }
-  return summarise(per_call);
-}
-
-/// Whole runs: run() returns the seconds it measured itself (set-up kept
-/// outside), < 0 on failure; one warm-up, then min..max runs within the budget.
-template <class Run>
-Figure time_runs(Run&& run, int min_runs = effort.min_runs, int max_runs = effort.max_runs) {
-  std::vector<double> v;
-  const double start = bench_now();
-  run();
-  for (int r = 0; r < max_runs; ++r) {
-    const double s = run();
-    if (!(s >= 0)) break;
-    v.push_back(s);
-    if (r + 1 >= min_runs && bench_now() - start > effort.runs_budget_s) break;
-  }
-  return summarise(v);
-}
 
 std::string fmt_time(double s) {  // "123 ns", "1.234 us", "1.234 ms", "1.234 s"
   char buf[32];
@@ -100,50 +44,7 @@ std::string fmt_time(double s) {  // "123 ns", "1.234 us", "1.234 ms", "1.234 s"
 const char* ok_mark(double value, double target) { return value <= target ? "ok" : "OVER"; }
 void rule() { std::printf("%s\n", std::string(96, '-').c_str()); }
 
-constexpr double kTick = 1e-3;  // s, the communication step of sections 3 and the ticks
-const Pose kHome(0, 0, 0.05, 0);
-
-/// Solver settings: CVODE's defaults (Adams) but these, RK4 and ROS2 at the 1-ms step.
-SolverSettings settings(Solver solver, double rtol = 1e-8, double atol = 1e-10,
-                        CvodeMethod method = CvodeMethod::Adams) {
-  SolverSettings st;
-  st.solver = solver, st.rk4_step = kTick, st.rtol = rtol, st.atol = atol, st.cvode_method = method;
-  return st;
-}
-
-struct StepRun {
-  double seconds = 0;  // the steps' wall time, up to the first failing step included
-  Status status = Status::Ok;
-  long ok_steps = 0, rhs = 0, rhs_max = 0, cvode_steps = 0;  // rhs_max: the most in one step
-  std::vector<Vec8> states;                                  // pose and rates after each step, the initial first
-};
-
-/// n steps of the Plant from (p0, pd0) at rest, set up outside the timing:
-/// step(plant, k) advances it to step k's end. The one loop of the 1-ms
-/// steps (section 3 and the ticks).
-template <class Step>
-StepRun plant_steps(const Model& m, const SolverSettings& st, const Pose& p0, const Pose& pd0, long n, Step&& step) {
-  StepRun r;
-  Plant plant(m);
-  r.status = plant.set_solver(st);
-  if (r.status == Status::Ok) r.status = plant.initialize(0.0, p0, pd0);
-  if (r.status != Status::Ok) return r;
-  r.states.reserve(static_cast<size_t>(n) + 1);
-  r.states.push_back(plant.state().head<8>());
-  const double t0 = bench_now();
-  for (; r.ok_steps < n; ++r.ok_steps) {
-    const long before = plant.rhs_evaluations();
-    if ((r.status = step(plant, r.ok_steps)) != Status::Ok) break;
-    r.rhs_max = std::max(r.rhs_max, plant.rhs_evaluations() - before);
-    r.states.push_back(plant.state().head<8>());
-  }
-  r.seconds = bench_now() - t0;
-  r.rhs = plant.rhs_evaluations();
-  r.cvode_steps = plant.cvode_steps();
-  return r;
-}
-
-const std::pair<Formulation, const char*> kFormulations[] = {
+const std::pair<Formulation, const char*> kFormulations[] = {  // the rows: the enumerators' names
     {Formulation::LegPartitioned, "LegPartitioned"}, {Formulation::NullSpaceQR, "NullSpaceQR"},
     {Formulation::Augmented, "Augmented"}};
 constexpr double kDerivativeTarget = 0.25e-6;                  // s, one LegPartitioned state derivative
@@ -245,19 +146,32 @@ void print_header() {
   rule();
 }
 
-/// Per-call time of body(acc) (returns a Status, adds a result to acc); a
-/// failed call is reported under `what`.
+/// Per-call time of body(acc) (returns a Status, adds a result to acc): N
+/// calls per batch, N grown until a batch lasts effort.batch_s; a failed call
+/// is reported under `what`.
 template <class Body>
 Figure time_checked(Core& b, const char* what, Body&& body) {
   double acc = 0;
   Status bad = Status::Ok;
-  const Figure f = time_per_call([&] {
+  auto call = [&] {
     const Status s = body(acc);
     if (s != Status::Ok) bad = s;
-  });
+  };
+  long n = 1;
+  for (double dt = 0; n < (1L << 26); n = std::lround(n * std::clamp(1.2 * effort.batch_s / dt, 2.0, 10.0))) {
+    const double t0 = bench_now();
+    for (long k = 0; k < n; ++k) call();
+    if ((dt = bench_now() - t0) >= effort.batch_s) break;
+  }
+  std::vector<double> per_call;
+  for (int i = 0; i < effort.batches; ++i) {
+    const double t0 = bench_now();
+    for (long k = 0; k < n; ++k) call();
+    per_call.push_back((bench_now() - t0) / static_cast<double>(n));
+  }
   g_sink = acc;
   b.check(bad, what);
-  return f;
+  return summarise(per_call);
 }
 
 /// time_checked of one expression: `call` gives a Status, `result` a number kept from it.
@@ -534,180 +448,18 @@ int core_part() {
   return b.failures ? 1 : 0;
 }
 
-constexpr long kTicks = 1000;  // 1 s
-
-/// F[1]'s perturbation beyond the static forces, given per step as a master
-/// gives it: ramp 0.2 t N (value and slope at each step start: continuous);
-/// sampled 0.2 cos(2 pi 3 t) N (value and slope: lines that miss each other
-/// by f'' h^2 / 2 at the step boundary); held (the same at the step's midpoint).
-enum class Inputs { Ramp, Sampled, Held };
-const char* const kInputNames[] = {"ramp", "sampled", "held"};
-
-LinearInputs step_inputs(Inputs kind, long k, const Vec4& F_static) {
-  constexpr double a = 0.2, w = 2.0 * 3.14159265358979323846 * 3.0;
-  const double t = static_cast<double>(k) * kTick;
-  LinearInputs in;
-  in.t0 = t;
-  in.F0 = F_static;
-  in.dF.setZero();
-  if (kind == Inputs::Ramp) in.F0[0] += a * t, in.dF[0] = a;
-  if (kind == Inputs::Sampled) in.F0[0] += a * std::cos(w * t), in.dF[0] = -a * w * std::sin(w * t);
-  if (kind == Inputs::Held) in.F0[0] += a * std::cos(w * (t + 0.5 * kTick));
-  return in;
-}
-
-StepRun tick_run(const Model& m, const SolverSettings& st, Inputs kind, bool cont, const Vec4& F_static) {
-  return plant_steps(m, st, kHome, Pose::Zero(), kTicks, [&](Plant& plant, long k) {
-    LinearInputs in = step_inputs(kind, k, F_static);
-    return plant.advance(static_cast<double>(k + 1) * kTick, in.signal(), cont && k > 0);
-  });
-}
-
-/// The stiff cases: F = 0 from the home pose, 200 steps of 1 ms; per solver
-/// the median time per step and the steps answered OK; ROS2's deviation in dz
-/// from CVODE (BDF, rtol 1e-10) over the steps CVODE answered; the ratios.
-void stiff_cases(double rk4_tick_us) {
-  struct Setting {
-    const char* parameter;
-    double value;
-  };
-  const struct {
-    const char* name;
-    std::vector<Setting> set;  // beyond the defaults
-  } cases[] = {{"friction_viscous 1000", {{"friction_viscous", 1000}}},
-               {"friction_coulomb 5", {{"friction_coulomb", 5}}},
-               {"friction_coulomb 10, v_s 1e-6", {{"friction_coulomb", 10}, {"friction_velocity", 1e-6}}},
-               {"stops 1e9/1e6", {{"stop_stiffness", 1e9}, {"stop_damping", 1e6}}},
-               {"stops, m_slider 1e-2", {{"stop_stiffness", 1e9}, {"stop_damping", 1e6}, {"m_slider", 1e-2}}},
-               {"stops, m_slider 1e-6", {{"stop_stiffness", 1e9}, {"stop_damping", 1e6}, {"m_slider", 1e-6}}}};
-  struct Outcome {
-    StepRun last;
-    double us;  // the median microseconds per step
-  };
-  auto run = [](const Model& m, Solver solver) {
-    const SolverSettings st = settings(solver, 1e-10, 1e-12, CvodeMethod::BDF);
-    std::vector<double> per_step;
-    StepRun r;
-    for (int i = 0; i < effort.tick_runs; ++i) {
-      r = plant_steps(m, st, kHome, Pose::Zero(), 200, [](Plant& plant, long k) {
-        return plant.advance(static_cast<double>(k + 1) * kTick, InputSignal{});
-      });
-      per_step.push_back(r.seconds / static_cast<double>(std::min(r.ok_steps + 1, 200L)));
-    }
-    return Outcome{r, 1e6 * summarise(per_step).median};
-  };
-  std::printf("\nthe stiff cases: F = 0 from the home pose, 1 ms steps, 200 steps; CVODE BDF rtol 1e-10 is the "
-              "reference\n(targets: ROS2 within 1 %% of CVODE, at most 3x an RK4 tick)\n");
-  std::printf("%-30s %14s %14s %14s %10s %10s %10s %12s\n", "case", "CVODE us/ok", "RK4 us/ok", "ROS2 us/ok",
-              "ROS2/RK4", "/RK4 tick", "ROS2/CVODE", "ROS2 |ddz|");
-  for (const auto& c : cases) {
-    Configuration config;
-    for (const Setting& s : c.set) find_parameter(s.parameter)->set(config, s.value);
-    Model m;
-    if (make_model(config.params, m) != Status::Ok) continue;
-    const Outcome cv = run(m, Solver::Cvode), r4 = run(m, Solver::Rk4), rb = run(m, Solver::Rosenbrock);
-    double dev = 0, scale = 0;
-    for (long k = 1; k <= std::min(cv.last.ok_steps, rb.last.ok_steps); ++k) {
-      dev = std::max(dev, std::fabs(rb.last.states[k][6] - cv.last.states[k][6]));
-      scale = std::max(scale, std::fabs(cv.last.states[k][6]));
-    }
-    std::printf("%-30s", c.name);
-    for (const Outcome* o : {&cv, &r4, &rb}) {
-      char cell[32];
-      std::snprintf(cell, sizeof cell, "%.2f/%ld", o->us, o->last.ok_steps);
-      std::printf(" %14s", cell);
-    }
-    std::printf(" %10.2f %10.2f %10.2f %11.2g%%\n", r4.last.ok_steps ? rb.us / r4.us : 0.0, rb.us / rk4_tick_us,
-                rb.us / cv.us, scale > 0 ? 100 * dev / scale : 0.0);
-  }
-  std::printf("us/ok: median microseconds per step (the failing step included) / steps answered OK; /RK4 tick: ROS2\n"
-              "against the held-input RK4 tick above (%.3f us, the default machine). RK4 refuses the stuck-friction\n"
-              "case at initialisation (0 steps) and runs out of its work budget at the stiff stops' impact; ROS2's\n"
-              "deviation covers the steps CVODE answered.\n",
-              rk4_tick_us);
-}
-
-/// 1 s of 1-ms steps of the Plant from the home pose, per input kind: CVODE
-/// restarted at every step and continued across them, RK4, ROS2; each row's
-/// deviation from the same inputs integrated at rtol 1e-12 (restarted at
-/// every step: exact for inputs smooth within each step).
-int ticks_part(bool parseable) {
-  Model model;
-  InverseDynamicsResult id;
-  if (make_model(Params{}, model) != Status::Ok ||
-      inverse_dynamics(model, kHome, Pose::Zero(), Pose::Zero(), Wrench::Zero(), id, false) != Status::Ok)
-    return 1;
-  const SolverSettings cvode = settings(Solver::Cvode), tight = settings(Solver::Cvode, 1e-12, 1e-14),
-                       rk4 = settings(Solver::Rk4), ros2 = settings(Solver::Rosenbrock);
-  const struct {
-    const char* name;
-    const SolverSettings& st;
-    bool cont;
-  } cases[] = {{"CVODE 1e-8, restart every step", cvode, false},
-               {"CVODE 1e-8, continued across steps", cvode, true},
-               {"RK4, rk4_step 1 ms", rk4, false},
-               {"Rosenbrock (ROS2), 1 ms", ros2, false}};
-  if (!parseable) {
-    std::printf("pkm_bench ticks: 1-ms communication steps of the core's Plant, 1 s from the home pose\n"
-                "inputs on F[1], beyond the static force: ramp 0.2 t N (value and slope per step); sampled 0.2 cos(2 pi "
-                "3 t) N\n(value and slope per step); held: the same at the step's midpoint\n\n");
-    std::printf("%-44s %9s %9s %9s %9s %12s\n", "run", "us/step", "rhs/step", "rhs max", "steps/step", "max|dxyz| m");
-  }
-  int failures = 0;
-  double rk4_us = 0, restart_us = 0;
-  for (const Inputs kind : {Inputs::Ramp, Inputs::Sampled, Inputs::Held}) {
-    const StepRun ref = parseable ? StepRun{} : tick_run(model, tight, kind, false, id.F);
-    for (const auto& c : cases) {
-      StepRun r;
-      const Figure f = time_runs(
-          [&] {
-            r = tick_run(model, c.st, kind, c.cont, id.F);
-            return r.status == Status::Ok ? r.seconds : -1.0;
-          },
-          effort.tick_runs, effort.tick_runs);
-      const double us = 1e6 * f.median / kTicks;
-      char name[64];
-      std::snprintf(name, sizeof name, "%s: %s", kInputNames[static_cast<int>(kind)], c.name);
-      if (r.status != Status::Ok) {
-        std::printf(parseable ? "tick;%s;FAILED\n" : "%-44s FAILED\n", name);
-        ++failures;
-        continue;
-      }
-      const Vec8& last = r.states.back();
-      if (parseable) {
-        std::printf("tick;%s;%.6f;%.17g;%.17g;%.17g;%.17g\n", name, us, last[0], last[1], last[2], last[3]);
-        continue;
-      }
-      double dev = 0;
-      for (size_t k = 0; k < r.states.size() && k < ref.states.size(); ++k)
-        dev = std::max(dev, (r.states[k].head<3>() - ref.states[k].head<3>()).lpNorm<Eigen::Infinity>());
-      std::printf("%-44s %9.3f %9.2f %9ld %9.2f %12.2e", name, us, static_cast<double>(r.rhs) / kTicks, r.rhs_max,
-                  static_cast<double>(r.cvode_steps) / kTicks, dev);
-      if (&c.st == &cvode && !c.cont) restart_us = us;
-      if (&c.st == &cvode && c.cont) std::printf("   %.1fx faster than restarting", restart_us / us);
-      if (&c.st == &rk4) rk4_us = us;
-      if (&c.st == &ros2) std::printf("   %.2fx RK4 (target <= 3x)", us / rk4_us);
-      std::printf("\n");
-    }
-  }
-  if (parseable) return failures ? 1 : 0;
-  std::printf("\nreference: CVODE rtol 1e-12, restarted every step, the same inputs. Continuing across the jumps of\n"
-              "sampled or held inputs costs accuracy: the FMU continues only where the inputs continue (pkm4puu.cpp).\n");
-  stiff_cases(rk4_us);
-  return failures ? 1 : 0;
-}
-
 }  // namespace
-}  // namespace pkm
+}  // namespace pkm::bench
 
 int main(int argc, char** argv) {
+  using namespace pkm::bench;
   bool core = false, ticks = false, parseable = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "core") core = true;
     else if (a == "ticks") ticks = true;
     else if (a == "--parseable") parseable = true;
-    else if (a == "--quick") pkm::effort = pkm::Effort{7, 2e-3, 7, 3, 1.0, 3};
+    else if (a == "--quick") effort = Effort{7, 2e-3, 7, 3, 1.0, 3};
     else {
       std::fprintf(stderr, "pkm_bench: unknown argument %s (usage: pkm_bench [core|ticks] [--quick] [--parseable])\n",
                    argv[i]);
@@ -715,7 +467,7 @@ int main(int argc, char** argv) {
     }
   }
   if (!core && !ticks) core = !parseable, ticks = true;  // no part named: both (--parseable: the ticks)
-  int status = core ? pkm::core_part() : 0;
-  if (ticks) status |= pkm::ticks_part(parseable);
+  int status = core ? core_part() : 0;
+  if (ticks) status |= ticks_part(parseable);
   return status;
 }
