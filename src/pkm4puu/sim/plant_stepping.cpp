@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 
 #include "pkm4puu/integrators/located_cvode.hpp"
 #include "pkm4puu/integrators/located_rk4.hpp"
