@@ -85,7 +85,7 @@ Status Plant::prepare_cvode() {
   // (fixed_step_stability.hpp), BDF with the analytic Jacobian.
   const Status s = cvode_.init(cvode_method_for(model_, settings_), settings_.rtol, cvode_atol(model_, settings_),
                                &Plant::cvode_rhs, this, kContactIndicators, &Plant::cvode_roots,
-                               &Plant::cvode_jacobian, cvode_min_step(stiff_rates(model_).contact));
+                               &Plant::cvode_jacobian, cvode_min_step(model_));
   if (s != Status::Ok) {
     error_ = "CVODE could not be set up: " + cvode_.last_error();
     return s == Status::InvalidArgument ? s : Status::SolverFailure;
