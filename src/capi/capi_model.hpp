@@ -29,6 +29,30 @@ namespace pkm_capi {
 
 inline pkm_status to_c(pkm::Status s) { return static_cast<pkm_status>(static_cast<int>(s)); }
 
+// pkm.h spells the core's enumerations as C constants: to_c and the integer
+// parameters (solver, cvode_method, formulation) pass their values through.
+#define PKM_CAPI_SAME(c, core) static_assert(static_cast<int>(c) == static_cast<int>(core), #c " is " #core)
+PKM_CAPI_SAME(PKM_OK, pkm::Status::Ok);
+PKM_CAPI_SAME(PKM_ERR_INVALID_ARGUMENT, pkm::Status::InvalidArgument);
+PKM_CAPI_SAME(PKM_ERR_INVALID_PARAMETER, pkm::Status::InvalidParameter);
+PKM_CAPI_SAME(PKM_ERR_NONFINITE, pkm::Status::NonFinite);
+PKM_CAPI_SAME(PKM_ERR_UNREACHABLE, pkm::Status::Unreachable);
+PKM_CAPI_SAME(PKM_ERR_SINGULAR, pkm::Status::Singular);
+PKM_CAPI_SAME(PKM_ERR_NOT_CONVERGED, pkm::Status::NotConverged);
+PKM_CAPI_SAME(PKM_ERR_SOLVER, pkm::Status::SolverFailure);
+PKM_CAPI_SAME(PKM_ERR_NOT_INITIALIZED, pkm::Status::NotInitialized);
+// The C API's own status, after the core's last.
+static_assert(PKM_ERR_OUT_OF_MEMORY == PKM_ERR_NOT_INITIALIZED + 1, "PKM_ERR_OUT_OF_MEMORY follows the core's statuses");
+PKM_CAPI_SAME(PKM_SOLVER_CVODE, pkm::Solver::Cvode);
+PKM_CAPI_SAME(PKM_SOLVER_RK4, pkm::Solver::Rk4);
+PKM_CAPI_SAME(PKM_SOLVER_ROSENBROCK, pkm::Solver::Rosenbrock);
+PKM_CAPI_SAME(PKM_CVODE_ADAMS, pkm::CvodeMethod::Adams);
+PKM_CAPI_SAME(PKM_CVODE_BDF, pkm::CvodeMethod::BDF);
+PKM_CAPI_SAME(PKM_FORM_AUGMENTED, pkm::Formulation::Augmented);
+PKM_CAPI_SAME(PKM_FORM_NULLSPACE_QR, pkm::Formulation::NullSpaceQR);
+PKM_CAPI_SAME(PKM_FORM_LEG_PARTITIONED, pkm::Formulation::LegPartitioned);
+#undef PKM_CAPI_SAME
+
 /// Records why `function` failed on the handle and returns the status.
 pkm_status fail(const pkm_model* m, pkm_status s, const std::string& function, const std::string& why);
 /// The same for a core status, with the plant's own message when it has one.
