@@ -39,7 +39,8 @@ struct PlantOde {
   /// evaluation gives all) at (t, x) under the held stops and the inputs at
   /// t, which `u` receives: the analytic Jacobian of ROS2 and of CVODE's
   /// BDF, counted as one evaluation. NonFinite: an input is not finite;
-  /// SolverFailure: t or the state is not.
+  /// SolverFailure: t or the state is not; Unreachable, Singular: a state
+  /// off the workspace.
   static Status derivative_jacobians(Plant& plant, double t, const Vec10& x, Inputs& u, Vec8& ydot, Mat8& A,
                                      Mat8x12& B, JointJacobians* joints = nullptr) {
     ++plant.rhs_count_;
