@@ -50,9 +50,9 @@
 #include "fmi3FunctionTypes.h"
 #include "fmi/fmi_functions.h"
 #include "fmi/fnv1a.hpp"
+#include "models/PKM4PUU/plant_state.hpp"
 #include "models/models.hpp"
 #include "pkm4puu/kinematics/workspace_guard.hpp"
-#include "pkm4puu/sim/solver_memory.hpp"
 
 // The two in-process FMUs' exported FMI 2.0 functions: fmi_functions.h.
 #define PKM_FUZZ_FMI2_FUNCTIONS PKM_FMI2_FUNCTIONS
@@ -231,12 +231,14 @@ constexpr int kMaxOps = 48;
 /// A forged serialised state: one bit flipped in a field the loader checks
 /// against the instance -- the mode and flags (bytes 32..38,
 /// fmu_state.hpp), the plant's contact mode and the integrators' memory at
-/// its end (plant_data.cpp) -- or anywhere, and the checksum recomputed (the
+/// its end (plant_state.hpp) -- or anywhere, and the checksum recomputed (the
 /// last 8 bytes, fnv1a.hpp), so that the forgery passes the header's checks
 /// and reaches those of the content.
 template <class Byte>
 void forge_field(std::vector<Byte>& b, FuzzedDataProvider& in) {
-  constexpr std::size_t kTail = 8 + sizeof(pkm::SolverMemory) + 4 + 4;  // contact mode, memory size, memory, checksum
+  // From the contact mode on: the mode, the memory's size, the memory, the checksum.
+  constexpr auto& layout = pkm_fmi::pkm4puu_model::kPlantStateLayout;
+  constexpr std::size_t kTail = layout.size - layout.stops + 8;
   if (b.size() < 40 + kTail) return;
   const std::size_t end = b.size() - 8;
   std::size_t at = 0;

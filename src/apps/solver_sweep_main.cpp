@@ -26,6 +26,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -34,6 +35,7 @@
 #include "apps/autotest.hpp"
 #include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/sim/fixed_step_stability.hpp"
+#include "pkm4puu/sim/parameters.hpp"
 #include "pkm4puu/sim/plant.hpp"
 
 namespace {
@@ -153,32 +155,39 @@ std::vector<Case> cases() {
   // The auto-test's inputs (the forces of the inverse dynamics along its path).
   add("auto-test, 2 s", Params{}, 2000, false, Drive::Autotest);
   add("auto-test, first 0.3 s", Params{}, 300, true, Drive::Autotest);
-  // One parameter at a time over its declared range (its ends and points
-  // between), the drop.
+  // One parameter at a time over its declared range (the parameter table's
+  // row: its upper end, its lower one unless that is the default, whose drop
+  // is a case above, and points between), the drop.
   struct Axis {
     const char* name;
-    const char* unit;
-    double Params::*field;
-    std::vector<double> values;
+    std::vector<double> between;
+    bool quick_at_hi;  // the run at the upper end is in the --quick sweep
   };
   const Axis axes[] = {
-      {"stop_stiffness", "N/m", &Params::stop_stiffness, {0.0, 1e3, 1e7, 1e9}},
-      {"stop_damping", "N.s/m", &Params::stop_damping, {0.0, 1.0, 1e4, 1e6}},
-      {"friction_viscous", "N.s/m", &Params::friction_viscous, {1.0, 1e3, 1e6}},
-      {"friction_coulomb", "N", &Params::friction_coulomb, {0.1, 5.0, 1e6}},
-      {"m_slider", "kg", &Params::m_slider, {1e-6, 1e-2, 1e2, 1e4}},
-      {"m_platform", "kg", &Params::m_platform, {1e-6, 1e2, 1e4}},
-      {"rotor_inertia", "kg.m2", &Params::rotor_inertia, {1e-6, 1e4}},
-      {"payload_mass", "kg", &Params::payload_mass, {10.0, 1e4}},
+      {"stop_stiffness", {1e3, 1e7}, true},
+      {"stop_damping", {1.0, 1e4}, false},
+      {"friction_viscous", {1.0, 1e3}, true},
+      {"friction_coulomb", {0.1, 5.0}, false},
+      {"m_slider", {1e-2, 1e2}, false},
+      {"m_platform", {1e2}, false},
+      {"rotor_inertia", {1e-6}, false},
+      {"payload_mass", {10.0}, false},
   };
   for (const Axis& a : axes) {
-    for (double v : a.values) {
-      p = {};
-      p.*a.field = v;
-      std::snprintf(name, sizeof name, "%s = %g %s", a.name, v, a.unit);
-      const bool quick = v == a.values.back() && (a.field == &Params::stop_stiffness ||
-                                                  a.field == &Params::friction_viscous);
-      add(name, p, 300, quick);
+    const pkm::Parameter* row = pkm::find_parameter(a.name);
+    if (!row) {
+      std::fprintf(stderr, "pkm_solver_sweep: no parameter '%s' in the parameter table\n", a.name);
+      std::exit(1);
+    }
+    std::vector<double> values;
+    if (row->lo != row->start()) values.push_back(row->lo);
+    values.insert(values.end(), a.between.begin(), a.between.end());
+    values.push_back(row->hi);
+    for (double v : values) {
+      pkm::Configuration config;
+      row->set(config, v);
+      std::snprintf(name, sizeof name, "%s = %g %s", a.name, v, row->unit);
+      add(name, config.params, 300, a.quick_at_hi && v == row->hi);
     }
   }
   // Stuck and viscous friction: the regularised Coulomb slope F_c / v_s at

@@ -29,6 +29,39 @@ namespace pkm_capi {
 
 inline pkm_status to_c(pkm::Status s) { return static_cast<pkm_status>(static_cast<int>(s)); }
 
+/// Whether each of pkm.h's C constants has the value of the core's
+/// enumerator paired with it: to_c and the integer parameters (solver,
+/// cvode_method, formulation) pass the values through.
+template <class Core, std::size_t N>
+constexpr bool same_values(const std::pair<int, Core> (&pairs)[N]) {
+  for (const auto& p : pairs)
+    if (p.first != static_cast<int>(p.second)) return false;
+  return true;
+}
+static_assert(same_values<pkm::Status>({{PKM_OK, pkm::Status::Ok},
+                                        {PKM_ERR_INVALID_ARGUMENT, pkm::Status::InvalidArgument},
+                                        {PKM_ERR_INVALID_PARAMETER, pkm::Status::InvalidParameter},
+                                        {PKM_ERR_NONFINITE, pkm::Status::NonFinite},
+                                        {PKM_ERR_UNREACHABLE, pkm::Status::Unreachable},
+                                        {PKM_ERR_SINGULAR, pkm::Status::Singular},
+                                        {PKM_ERR_NOT_CONVERGED, pkm::Status::NotConverged},
+                                        {PKM_ERR_SOLVER, pkm::Status::SolverFailure},
+                                        {PKM_ERR_NOT_INITIALIZED, pkm::Status::NotInitialized}}),
+              "pkm_status is pkm::Status");
+// The C API's own status, after the core's last.
+static_assert(PKM_ERR_OUT_OF_MEMORY == PKM_ERR_NOT_INITIALIZED + 1, "PKM_ERR_OUT_OF_MEMORY follows the core's statuses");
+static_assert(same_values<pkm::Solver>({{PKM_SOLVER_CVODE, pkm::Solver::Cvode},
+                                        {PKM_SOLVER_RK4, pkm::Solver::Rk4},
+                                        {PKM_SOLVER_ROSENBROCK, pkm::Solver::Rosenbrock}}),
+              "PKM_SOLVER_* are pkm::Solver");
+static_assert(same_values<pkm::CvodeMethod>(
+                  {{PKM_CVODE_ADAMS, pkm::CvodeMethod::Adams}, {PKM_CVODE_BDF, pkm::CvodeMethod::BDF}}),
+              "PKM_CVODE_* are pkm::CvodeMethod");
+static_assert(same_values<pkm::Formulation>({{PKM_FORM_AUGMENTED, pkm::Formulation::Augmented},
+                                             {PKM_FORM_NULLSPACE_QR, pkm::Formulation::NullSpaceQR},
+                                             {PKM_FORM_LEG_PARTITIONED, pkm::Formulation::LegPartitioned}}),
+              "PKM_FORM_* are pkm::Formulation");
+
 /// Records why `function` failed on the handle and returns the status.
 pkm_status fail(const pkm_model* m, pkm_status s, const std::string& function, const std::string& why);
 /// The same for a core status, with the plant's own message when it has one.

@@ -165,14 +165,14 @@ pkm_status pkm_set_state(pkm_model* m, const pkm_state* state) {
   const pkm_status a = struct_argument(m, fn, "state", "pkm_state", state, kStateSize);
   if (a != PKM_OK) return a;
   // pkm_get_state settled the energy balance (energy_integrals()), so the
-  // integrators' memory is a restarted one's: the run continues bit for bit.
+  // integrators' memory is a restarted one's, the snapshot's default
+  // (SolverMemory{}): the run continues bit for bit.
   pkm::PlantSnapshot snap;
   snap.t = state->t;
   snap.y = Eigen::Map<const pkm::Vec8>(state->y);
   snap.theta1_ref = vec4(state->theta1_ref);
   snap.energy = {state->actuator_work, state->dissipated_energy};
   snap.stops = state->stops;
-  snap.memory = pkm::restarted_solver_memory();
   const pkm::Status s = m->plant->restore(snap);
   if (s != pkm::Status::Ok) return fail(m, s, fn);
   m->run_ended.clear();

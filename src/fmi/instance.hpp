@@ -57,8 +57,10 @@ enum Mode : std::uint32_t {
   kFatal = 1u << 8,
 };
 const char* mode_name(std::uint32_t mode);
+/// The states in which the model runs: Model Exchange's Event and Continuous-Time Modes, Co-Simulation's Step Mode.
+constexpr std::uint32_t kRunning = kEventMode | kContinuousTimeMode | kStepMode;
 /// The states past a successful ExitInitializationMode, Error aside: the model is built.
-constexpr std::uint32_t kInitializedModes = kEventMode | kContinuousTimeMode | kStepMode | kStepFailed | kTerminated;
+constexpr std::uint32_t kInitializedModes = kRunning | kStepFailed | kTerminated;
 
 struct SavedState;  // fmu_state.cpp
 enum class Call : unsigned;  // state_machine.hpp

@@ -14,9 +14,7 @@
 
 namespace pkm_fmi {
 
-constexpr std::uint32_t kAlive = kInstantiated | kInitializationMode | kEventMode | kContinuousTimeMode | kStepMode |
-                                 kStepFailed | kTerminated | kError;
-constexpr std::uint32_t kRunning = kEventMode | kContinuousTimeMode | kStepMode;
+constexpr std::uint32_t kAlive = kInstantiated | kInitializationMode | kInitializedModes | kError;
 
 /// The interfaces a function belongs to (bits).
 constexpr unsigned kForME = 1u, kForCS = 2u, kForBoth = kForME | kForCS;

@@ -135,14 +135,6 @@ constexpr Variable real_parameter(std::uint32_t vr, const char* name, double sta
   return {vr,    name,  VarType::Real, Causality::Parameter, Variability::Fixed, Initial::Exact, start, unit,
           description, value, index, nullptr, min, max, kDependsNothing, -1, -1};
 }
-/// A fixed Real parameter that is the initial value of continuous state number `state`.
-constexpr Variable initial_state_parameter(std::uint32_t vr, const char* name, double start, const char* unit,
-                                           const char* description, Ref value, int index, double min, double max,
-                                           int state) {
-  Variable v = real_parameter(vr, name, start, unit, description, value, index, min, max);
-  v.initial_of = state;
-  return v;
-}
 /// A fixed Integer parameter (initial exact) with its range.
 constexpr Variable integer_parameter(std::uint32_t vr, const char* name, int start, const char* description,
                                      Ref value, int min, int max) {

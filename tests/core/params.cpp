@@ -1,12 +1,17 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// Parameters: the spec's defaults in SI, and validation messages that name
-// the offending parameter.
+// Parameters: the spec's defaults in SI, validation messages that name
+// the offending parameter, and the parameter table's descriptions against
+// the constants they quote.
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "pkm4puu/model/model.hpp"
+#include "pkm4puu/sim/fixed_step_stability.hpp"
+#include "pkm4puu/sim/parameters.hpp"
+#include "pkm4puu/sim/solver_settings.hpp"
 
 using namespace pkm;
 
@@ -77,4 +82,44 @@ TEST(Params, ZeroGravityIsAllowed) {
   Params p;
   p.g = 0.0;
   EXPECT_TRUE(validate(p).empty());
+}
+
+namespace {
+
+/// How the descriptions write a number: "1eN" for a power of ten, else %g.
+std::string as_written(double x) {
+  const long n = std::lround(std::log10(std::fabs(x)));
+  if (x > 0.0 && std::pow(10.0, static_cast<double>(n)) == x) return "1e" + std::to_string(n);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
+
+std::string description_of(const char* name) {
+  const Parameter* row = find_parameter(name);
+  return row ? row->description : "";
+}
+
+}  // namespace
+
+// The descriptions that quote a limit of the code say the constant's value:
+// Adams gives way to BDF above kAdamsMaxDampingRate (cvode_method_for), and
+// a fixed-step advance takes at most kMaxInnerStepsPerCall inner steps.
+TEST(ParameterTable, DescriptionsQuoteTheConstantsOfTheCode) {
+  const std::string method = description_of("cvode_method");
+  EXPECT_NE(method.find("exceeds " + as_written(kAdamsMaxDampingRate) + " 1/s"), std::string::npos) << method;
+  const std::string budget = description_of("work_budget");
+  EXPECT_NE(budget.find("at most " + as_written(kMaxInnerStepsPerCall) + " per step"), std::string::npos) << budget;
+}
+
+// A row's range is its lo and hi (the model descriptions' min and max): the
+// tolerances' descriptions do not spell it a second time.
+TEST(ParameterTable, TheTolerancesDescriptionsLeaveTheirRangeToMinAndMax) {
+  for (const char* name : {"rtol", "atol"}) {
+    const Parameter* row = find_parameter(name);
+    ASSERT_NE(row, nullptr) << name;
+    const std::string text = row->description;
+    for (double bound : {row->lo, row->hi})
+      EXPECT_EQ(text.find(as_written(bound)), std::string::npos) << name << " quotes " << as_written(bound) << ": " << text;
+  }
 }

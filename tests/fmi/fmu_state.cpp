@@ -21,6 +21,7 @@
 #include "fmi/instance.hpp"
 #include "fmi2FunctionTypes.h"
 #include "fmu_fixture.hpp"
+#include "models/PKM4PUU/plant_state.hpp"
 #include "models/models.hpp"
 #include "pkm4puu/model/params.hpp"
 #include "pkm4puu/sim/solver_memory.hpp"
@@ -196,15 +197,20 @@ TEST_F(FmuState, ForeignOrBrokenFmuStates) {
 // 39; the count (4) and the stored variables (8 each) from byte 83; then the input
 // derivatives and the plant's part (PlantPart).
 /// Where the fields of the plant's part lie in a serialised state of `size`
-/// bytes (plant_data.cpp): it ends, before the 8-byte checksum, with the
-/// plant's time (8), [pose; velocity] (64), the theta1 references (32),
-/// the energy integrals (16), the contact mode (4), the size of the
-/// integrators' memory (4) and that memory.
+/// bytes (plant_state.hpp's layout): it ends before the 8-byte checksum.
 struct PlantPart {
   std::size_t t, y, theta1, energy, stops, memory_size, memory;
-  explicit PlantPart(std::size_t size)
-      : t(size - 8 - sizeof(pkm::SolverMemory) - 128), y(t + 8), theta1(y + 64), energy(theta1 + 32),
-        stops(energy + 16), memory_size(stops + 4), memory(memory_size + 4) {}
+  explicit PlantPart(std::size_t size) {
+    const auto& at = pkm_fmi::pkm4puu_model::kPlantStateLayout;
+    const std::size_t start = size - 8 - at.size;
+    t = start + at.t;
+    y = start + at.y;
+    theta1 = start + at.theta1;
+    energy = start + at.energy;
+    stops = start + at.stops;
+    memory_size = start + at.memory_size;
+    memory = start + at.memory;
+  }
 };
 
 TEST_F(FmuState, ForgedFmuStatesWithAValidChecksumAreRefused) {

@@ -1,16 +1,26 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // The plant FMU's part of an FMU state: what it saves, and what it checks
 // before it restores (fmu_state.cpp holds the layer's part).
+#include <cstdint>
 #include <cstring>
 
 #include "models/PKM4PUU/plant_data.hpp"
+#include "models/PKM4PUU/plant_state.hpp"
 
 namespace pkm_fmi {
 namespace pkm4puu_model {
 
 // The plant's part of an FMU state: its snapshot (plant.hpp), the
 // integrators' memory whole, as its bytes after their count (a state of a
-// build whose memory differs in size is refused).
+// build whose memory differs in size is refused); kPlantStateLayout says
+// where each field lies.
+constexpr PlantStateLayout kAt = kPlantStateLayout;
+static_assert(kAt.y - kAt.t == sizeof(pkm::PlantSnapshot::t) && kAt.theta1 - kAt.y == sizeof(pkm::PlantSnapshot::y) &&
+                  kAt.energy - kAt.theta1 == sizeof(pkm::PlantSnapshot::theta1_ref) &&
+                  kAt.memory - kAt.stops == 2 * sizeof(std::uint32_t) &&
+                  kAt.size - kAt.memory == sizeof(pkm::PlantSnapshot::memory),
+              "kPlantStateLayout is the snapshot's fields as save() writes them");
+
 void PlantData::save(StateWriter& w) const {
   const bool has = plant && plant->initialized();
   w.u8(has ? 1 : 0);

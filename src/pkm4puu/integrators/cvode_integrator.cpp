@@ -8,7 +8,6 @@
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -16,18 +15,6 @@
 namespace pkm {
 
 bool cvode_available() { return true; }
-
-// The floor must lie below every step that a converging run needs. The
-// mechanism's own motions take milliseconds, and 1 ps (kMinStep) is far
-// below them; but a stiff contact or stuck friction has transients of time
-// constant 1 / rate, down to 1e-16 s at the declared extremes (friction
-// velocity 1e-9 m/s on a 1 mg slider), and BDF resolves their start with
-// steps of sqrt(atol) / rate and below. A fixed 1 ps made every run with
-// atol <= 1e-12 fail at the stiffest stops' impact (the error test at
-// hmin); 1e-9 / rate lies a billion times below the fastest time constant.
-double cvode_min_step(double fastest_rate) {
-  return fastest_rate > 0.0 ? std::min(kMinStep, 1e-9 / fastest_rate) : kMinStep;
-}
 
 namespace {
 
@@ -285,11 +272,11 @@ Status CvodeIntegrator::create(CvodeMethod method, double rtol, const Vec10& ato
   // Enough for a long communication interval at the natural step (~1 ms),
   // few enough that a run into a singularity fails in a fraction of a second.
   flag |= CVodeSetMaxNumSteps(mem_, 100000);
-  // A floor on the step (cvode_min_step): without one CVODE creeps towards
-  // the edge of the workspace (a leg singularity) in ever smaller steps
-  // until it has spent its 100000 (about 0.2 s per failing call, 5 s under
-  // the sanitizers); with it, such a call fails after a few hundred
-  // evaluations, at the same point.
+  // A floor on the step (min_step: cvode_min_step, fixed_step_stability.hpp):
+  // without one CVODE creeps towards the edge of the workspace (a leg
+  // singularity) in ever smaller steps until it has spent its 100000 (about
+  // 0.2 s per failing call, 5 s under the sanitizers); with it, such a call
+  // fails after a few hundred evaluations, at the same point.
   flag |= CVodeSetMinStep(mem_, min_step);
   if (roots && n_roots > 0) flag |= CVodeRootInit(mem_, n_roots, &CvodeIntegrator::root_trampoline);
   if (method == CvodeMethod::BDF) {

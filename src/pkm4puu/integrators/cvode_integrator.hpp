@@ -30,14 +30,6 @@ using Mat10 = Eigen::Matrix<double, 10, 10>;
 /// built with nothing but a C++17 compiler; solver = 1, RK4, only).
 bool cvode_available();
 
-/// CVODE's smallest step (s) on a machine whose fastest rate is at most
-/// 1e3 1/s; a stiffer one gets a floor a billion times below its fastest
-/// time constant (cvode_min_step, cvode_integrator.cpp says why).
-constexpr double kMinStep = 1e-12;
-/// min(kMinStep, 1e-9 / fastest_rate): fastest_rate (1/s) bounds the
-/// magnitude of the Jacobian's eigenvalues (fixed_step_stability.hpp).
-double cvode_min_step(double fastest_rate);
-
 class CvodeIntegrator {
  public:
   /// ydot = rhs(t, y); returns 0 on success, > 0 for a recoverable failure
@@ -57,9 +49,10 @@ class CvodeIntegrator {
   /// `atol` per component (each positive). `roots` (may be null) with
   /// `n_roots` indicators: CVODE stops where one changes sign
   /// (CVodeRootInit). `jac` (may be null: difference quotients) is BDF's
-  /// Jacobian; `min_step` CVODE's smallest step.
-  Status init(CvodeMethod method, double rtol, const Vec10& atol, Rhs rhs, void* user, int n_roots = 0,
-              RootFn roots = nullptr, JacFn jac = nullptr, double min_step = kMinStep);
+  /// Jacobian; `min_step` CVODE's smallest step (cvode_min_step,
+  /// fixed_step_stability.hpp).
+  Status init(CvodeMethod method, double rtol, const Vec10& atol, Rhs rhs, void* user, int n_roots, RootFn roots,
+              JacFn jac, double min_step);
   /// Restart the history at (t0, y0): needed after any jump in the inputs.
   Status reset(double t0, const Vec10& y0);
   /// Integrates towards t_out (stop time set, no overshoot). Returns at

@@ -16,8 +16,6 @@ bool cvode_available() { return false; }
 
 CvodeIntegrator::~CvodeIntegrator() = default;
 
-double cvode_min_step(double) { return kMinStep; }
-
 Status CvodeIntegrator::init(CvodeMethod, double, const Vec10&, Rhs, void*, int, RootFn, JacFn, double) {
   error_ = kNoCvode;
   return Status::SolverFailure;

@@ -59,20 +59,19 @@ struct InnerSteps {
 /// bound, fixed_step_stability.hpp) and at the start of the advance.
 struct StepControl {
   bool on = false;  // off: the method has no estimate (RK4)
-  double exponent = 0.5;  // 1 / (p + 1)
   double next = std::numeric_limits<double>::infinity();  // the next step to try (s)
   double first_free = std::numeric_limits<double>::infinity();     // after a switch out of contact
   double first_contact = std::numeric_limits<double>::infinity();  // after a switch into contact
-  long rejected = 0;
 };
 /// The controller's factors: the usual safety 0.9 on the predicted step,
 /// growth at most 5x and shrinking at least 0.1x per step (Hairer, Norsett
-/// and Wanner, Solving ODEs I, II.4).
-constexpr double kStepSafety = 0.9, kStepGrowth = 5.0, kStepShrink = 0.1;
+/// and Wanner, Solving ODEs I, II.4), and the exponent 1 / (p + 1) of the
+/// one method with an estimate, ROS2 (its embedded solution of order p = 1).
+constexpr double kStepSafety = 0.9, kStepGrowth = 5.0, kStepShrink = 0.1, kStepExponent = 0.5;
 
-inline double step_factor(double estimate, double exponent) {
+inline double step_factor(double estimate) {
   if (!(estimate > 0.0)) return kStepGrowth;  // also NaN: the caller rejects a NaN estimate first
-  return std::clamp(kStepSafety * std::pow(estimate, -exponent), kStepShrink, kStepGrowth);
+  return std::clamp(kStepSafety * std::pow(estimate, -kStepExponent), kStepShrink, kStepGrowth);
 }
 
 /// The step from (t0, x) to t1 with `step(t, h, x, estimate)` (one step of
@@ -122,13 +121,12 @@ Status located_fixed_step(System& sys, Stepper&& step_fn, double t0, double t1, 
       budget.estimate = estimate;
       budget.step = step;
       if (!(estimate <= 1.0)) {  // rejected (also NaN): again, shorter
-        ++control.rejected;
-        control.next = step * (std::isfinite(estimate) ? step_factor(estimate, control.exponent) : kStepShrink);
+        control.next = step * (std::isfinite(estimate) ? step_factor(estimate) : kStepShrink);
         continue;
       }
       // Accepted: the next step from this one's estimate; a step cut short
       // (by t1 or a bound) does not shrink a longer proposal that stands.
-      const double proposed = step * step_factor(estimate, control.exponent);
+      const double proposed = step * step_factor(estimate);
       control.next = step < control.next ? std::max(proposed, control.next) : proposed;
     }
     Vec4 rho_trial;

@@ -134,12 +134,12 @@ std::string check_parameter(const char* name, double value, double lo, double hi
   X(141, "rk4_step", Solver, rk4_step, Real, "s", kMinRk4Step, kMaxRk4Step, kPositive, Fixed, Plant, \
     "Fixed step of RK4 and Rosenbrock: a communication step is split into whole steps no longer than this") \
   X(142, "rtol", Solver, rtol, Real, "", kMinRtol, kMaxRtol, kInRange, Fixed, Plant, \
-    "CVODE relative tolerance (at most 1e-2: looser, impacts on undamped stiff stops run away)") \
+    "CVODE relative tolerance (looser than its maximum, impacts on undamped stiff stops run away)") \
   X(143, "atol", Solver, atol, Real, "", kMinAtol, kMaxAtol, kInRange, Fixed, Plant, \
     "CVODE absolute tolerance (on the pose, m and rad, the velocity, and the energy integrals, J; on the " \
-    "velocities at most friction_velocity / 10 where Coulomb friction acts): at least 1e-14, below which the " \
-    "stiffest stops' impact needs more work than one step may take, at most 1e-2, above which impacts on " \
-    "undamped stiff stops run away") \
+    "velocities at most friction_velocity / 10 where Coulomb friction acts): below its minimum the stiffest " \
+    "stops' impact needs more work than one step may take, above its maximum impacts on undamped stiff stops " \
+    "run away") \
   X(144, "cvode_method", Solver, cvode_method, Integer, "", 0, 1, says("must be 0 (Adams) or 1 (BDF)"), Fixed, Plant, \
     "CVODE method: 0 = Adams-Moulton (non-stiff; BDF on a machine whose friction or stop damping against the " \
     "slider's mass exceeds 1e5 1/s), 1 = BDF") \

@@ -31,6 +31,19 @@ Vec10 cvode_atol(const Model& m, const SolverSettings& s) {
   return atol;
 }
 
+// The floor must lie below every step that a converging run needs. The
+// mechanism's own motions take milliseconds, and 1 ps (kMinStep) is far
+// below them; but a stiff contact or stuck friction has transients of time
+// constant 1 / rate, down to 1e-16 s at the declared extremes (friction
+// velocity 1e-9 m/s on a 1 mg slider), and BDF resolves their start with
+// steps of sqrt(atol) / rate and below. A fixed 1 ps made every run with
+// atol <= 1e-12 fail at the stiffest stops' impact (the error test at
+// hmin); 1e-9 / rate lies a billion times below the fastest time constant.
+double cvode_min_step(const Model& m) {
+  const double fastest_rate = stiff_rates(m).contact;
+  return fastest_rate > 0.0 ? std::min(kMinStep, 1e-9 / fastest_rate) : kMinStep;
+}
+
 CvodeMethod cvode_method_for(const Model& m, const SolverSettings& s) {
   if (s.cvode_method == CvodeMethod::Adams && stiff_rates(m).damping > kAdamsMaxDampingRate) return CvodeMethod::BDF;
   return s.cvode_method;

@@ -42,6 +42,13 @@ CvodeMethod cvode_method_for(const Model& m, const SolverSettings& s);
 /// friction_velocity) then makes no progress (docs/solvers.md "CVODE").
 Vec10 cvode_atol(const Model& m, const SolverSettings& s);
 
+/// CVODE's smallest step (s): kMinStep on a machine whose fastest rate
+/// (StiffRates::contact, a bound on the Jacobian's eigenvalues) is at most
+/// 1e3 1/s; on a stiffer one 1e-9 / rate, a billion times below its fastest
+/// time constant (fixed_step_stability.cpp says why).
+constexpr double kMinStep = 1e-12;
+double cvode_min_step(const Model& m);
+
 /// RK4's sub-steps keep h |lambda| <= 0.1: its error per step
 /// (h lambda)^5 / 120 <= 1e-7 of the fast motion, inside its stability
 /// interval [-2.78, 0]. ROS2 starts there after a switch of the contact mode

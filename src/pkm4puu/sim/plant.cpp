@@ -131,18 +131,6 @@ PlantSnapshot Plant::snapshot() const {
   return s;
 }
 
-Status Plant::restore(double t, const Vec8& y, const Vec4& theta1_ref) {
-  settle_energy();  // the integrals keep their values: at the state they belong to
-  PlantSnapshot s;
-  s.t = t;
-  s.y = y;
-  s.theta1_ref = theta1_ref;
-  s.energy = energy_;
-  s.stops = kStopsFromState;
-  s.memory = restarted_solver_memory();  // a restored run goes on as it would have (no new transient)
-  return restore(s);
-}
-
 Status Plant::restore(const PlantSnapshot& snap, bool settled) {
   const unsigned stops = snap.stops;
   const unsigned legs_held = (stops | (stops >> kLegs)) & ((1u << kLegs) - 1u);

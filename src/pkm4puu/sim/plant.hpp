@@ -122,10 +122,6 @@ class Plant {
   /// snapshot.stops = kStopsFromState: the mode the event rule gives at y
   /// from none.
   Status restore(const PlantSnapshot& snapshot, bool settled = true);
-  /// restore() of a time and state from outside (time, y, theta1
-  /// continuity): the energy integrals keep their values, the contact mode
-  /// is the event rule's at y, and no transient is pending.
-  Status restore(double t, const Vec8& y, const Vec4& theta1_ref);
 
   /// The contact mode (end_stops.hpp): which end stops act. Set at
   /// initialize() and restore() by the event rule, switched at every event

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 
 #include "pkm4puu/integrators/located_cvode.hpp"
 #include "pkm4puu/integrators/located_rk4.hpp"
@@ -30,32 +29,46 @@ struct PlantOde {
   double speed = 0;
   double grid_step = 0;
   Status rates(double t, const Vec10& x, Vec10& xdot) { return plant.derivative(t, x, xdot); }
-  /// The rates at (t, x) with the analytic Jacobian of the pose and velocity
-  /// rates (the leg-partitioned terms, the machine included; one evaluation
-  /// gives both) and their time derivative through the inputs,
-  /// B (u(t + h) - u(t)) / h (exact for the FMUs' linear inputs). The
-  /// dissipation rate is left 0: ROS2's dissipated energy is the audit's
-  /// balance (Plant::rosenbrock_dissipation).
-  Status jacobian(double t, const Vec10& x, double h, Vec10& xdot, Mat8& A, Vec8& f_t) {
+  /// The inputs at one instant.
+  struct Inputs {
+    Vec4 F, tau;
+    Wrench we;
+  };
+  /// The pose and velocity rates ydot and their Jacobians A = dydot/dy and
+  /// B = dydot/du (the leg-partitioned terms, the machine included; one
+  /// evaluation gives all) at (t, x) under the held stops and the inputs at
+  /// t, which `u` receives: the analytic Jacobian of ROS2 and of CVODE's
+  /// BDF, counted as one evaluation. NonFinite: an input is not finite;
+  /// SolverFailure: t or the state is not; Unreachable, Singular: a state
+  /// off the workspace.
+  static Status derivative_jacobians(Plant& plant, double t, const Vec10& x, Inputs& u, Vec8& ydot, Mat8& A,
+                                     Mat8x12& B, JointJacobians* joints = nullptr) {
     ++plant.rhs_count_;
     if (!std::isfinite(t)) return Status::SolverFailure;
-    Vec4 F0, tau0, F1, tau1;
-    Wrench we0, we1;
-    read_inputs(plant.inputs_, t, F0, we0, tau0);
-    read_inputs(plant.inputs_, t + h, F1, we1, tau1);
-    if (!F0.allFinite() || !we0.allFinite() || !tau0.allFinite()) return Status::NonFinite;
+    read_inputs(plant.inputs_, t, u.F, u.we, u.tau);
+    if (!u.F.allFinite() || !u.we.allFinite() || !u.tau.allFinite()) return Status::NonFinite;
+    const Status s =
+        state_derivative_jacobians(plant.model_, x.head<8>(), u.F, u.tau, u.we, plant.stops_, ydot, A, B, joints);
+    return s == Status::NonFinite ? Status::SolverFailure : s;
+  }
+  /// The rates at (t, x) with derivative_jacobians' A and their time
+  /// derivative through the inputs, B (u(t + h) - u(t)) / h (exact for the
+  /// FMUs' linear inputs). The dissipation rate is left 0: ROS2's dissipated
+  /// energy is the audit's balance (Plant::rosenbrock_dissipation).
+  Status jacobian(double t, const Vec10& x, double h, Vec10& xdot, Mat8& A, Vec8& f_t) {
+    Inputs u0, u1;
     Vec8 ydot;
     Mat8x12 B;
     JointJacobians joints;
-    const Status s =
-        state_derivative_jacobians(plant.model_, x.head<8>(), F0, tau0, we0, plant.stops_, ydot, A, B, &joints);
-    if (s != Status::Ok) return s == Status::NonFinite ? Status::SolverFailure : s;
+    const Status s = derivative_jacobians(plant, t, x, u0, ydot, A, B, &joints);
+    if (s != Status::Ok) return s;
+    read_inputs(plant.inputs_, t + h, u1.F, u1.we, u1.tau);
     const Pose pd = x.segment<4>(4);
     xdot.head<8>() = ydot;
-    xdot[8] = (F0 + plant.model_.drive_ratio * tau0).dot(joints.J_rho * pd) + we0.dot(pd);  // as energy_rates
+    xdot[8] = (u0.F + plant.model_.drive_ratio * u0.tau).dot(joints.J_rho * pd) + u0.we.dot(pd);  // as energy_rates
     xdot[9] = 0.0;
     Eigen::Matrix<double, kPlantInputs, 1> du;
-    du << F1 - F0, we1 - we0, tau1 - tau0;
+    du << u1.F - u0.F, u1.we - u0.we, u1.tau - u0.tau;
     f_t = B * (du / h);
     return (xdot.allFinite() && A.allFinite() && f_t.allFinite()) ? Status::Ok : Status::SolverFailure;
   }
@@ -86,7 +99,7 @@ Status Plant::prepare_cvode() {
   // (fixed_step_stability.hpp), BDF with the analytic Jacobian.
   const Status s = cvode_.init(cvode_method_for(model_, settings_), settings_.rtol, cvode_atol(model_, settings_),
                                &Plant::cvode_rhs, this, kContactIndicators, &Plant::cvode_roots,
-                               &Plant::cvode_jacobian, cvode_min_step(stiff_rates(model_).contact));
+                               &Plant::cvode_jacobian, cvode_min_step(model_));
   if (s != Status::Ok) {
     error_ = "CVODE could not be set up: " + cvode_.last_error();
     return s == Status::InvalidArgument ? s : Status::SolverFailure;
@@ -142,16 +155,11 @@ int Plant::cvode_rhs(double t, const Vec10& y, Vec10& ydot, void* self) {
 int Plant::cvode_jacobian(double t, const Vec10& x, Mat10& J, void* self) {
   auto* me = static_cast<Plant*>(self);
   if (me->cvode_capped()) return -1;
-  ++me->rhs_count_;
-  Vec4 F, tau;
-  Wrench we;
-  read_inputs(me->inputs_, t, F, we, tau);
+  PlantOde::Inputs u;
   Vec8 ydot;
   Mat8 A;
   Mat8x12 B;
-  if (!std::isfinite(t) ||
-      state_derivative_jacobians(me->model_, x.head<8>(), F, tau, we, me->stops_, ydot, A, B) != Status::Ok ||
-      !A.allFinite())
+  if (PlantOde::derivative_jacobians(*me, t, x, u, ydot, A, B) != Status::Ok)
     return 1;  // a trial state off the workspace: CVODE retries with a smaller step
   // The energy integrals do not act back on the motion: their rows left 0,
   // the Newton iteration converges on them with the motion.

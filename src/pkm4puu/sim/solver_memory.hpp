@@ -17,7 +17,8 @@ namespace pkm {
 /// the struct whole, as its bytes, so that a member added here travels with
 /// them without further code. Members of 8 bytes only (double,
 /// std::int64_t for flags and counts): no padding, and the same bytes on
-/// every platform the FMUs are built for (all little-endian).
+/// every platform the FMUs are built for (all little-endian). The default,
+/// SolverMemory{}, is a restarted run's: its energy balance exact.
 struct SolverMemory {
   // ROS2's dissipated energy is the energy audit's balance, brought up to
   // date when read (Plant::settle_energy): pending (1) or not (0), and the
@@ -27,10 +28,6 @@ struct SolverMemory {
 };
 static_assert(std::is_trivially_copyable<SolverMemory>::value, "SolverMemory travels as its bytes");
 static_assert(sizeof(SolverMemory) % 8 == 0 && alignof(SolverMemory) == 8, "SolverMemory: 8-byte members only");
-
-/// The memory of a run restored from outside (Plant::restore from a time
-/// and a state alone): its energy balance exact.
-constexpr SolverMemory restarted_solver_memory() { return SolverMemory{}; }
 
 /// "" if `m` is a memory some run can have, else why not (a restored
 /// snapshot is checked with it: a forged one is refused).
