@@ -33,7 +33,7 @@ static int run(const Plant* plant, int solver, int batches, double* ticks, const
   }
   for (int b = 0; c && b < batches; ++b) {
     const Ticks t = {H, TICKS, F, solver == 0 ? dF : NULL, plant->control, 12, NULL, ticks + (size_t)b * TICKS};
-    if (plant->fmu.fmi2SetFMUstate(c, home) != fmi2OK || run_ticks(plant, c, &t, 0.0) < 0.0) return 0;
+    if (run_ticks(plant, c, home, &t) < 0.0) return 0;
   }
   if (!c || !free_instance(plant, FMI2_CS, c, &home)) return 0;
   for (int k = 0; k < TICKS; ++k) {
