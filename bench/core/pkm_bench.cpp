@@ -147,31 +147,25 @@ void print_header() {
 }
 
 /// Per-call time of body(acc) (returns a Status, adds a result to acc): N
-/// calls per batch, N grown until a batch lasts effort.batch_s; a failed call
-/// is reported under `what`.
+/// calls per batch, N grown until a batch lasts effort.batch_s, the batches
+/// timed as runs; a failed call is reported under `what`.
 template <class Body>
 Figure time_checked(Core& b, const char* what, Body&& body) {
   double acc = 0;
   Status bad = Status::Ok;
-  auto call = [&] {
-    const Status s = body(acc);
-    if (s != Status::Ok) bad = s;
-  };
   long n = 1;
-  for (double dt = 0; n < (1L << 26); n = std::lround(n * std::clamp(1.2 * effort.batch_s / dt, 2.0, 10.0))) {
+  auto batch = [&] {  // the time per call of a batch of n calls
     const double t0 = bench_now();
-    for (long k = 0; k < n; ++k) call();
-    if ((dt = bench_now() - t0) >= effort.batch_s) break;
-  }
-  std::vector<double> per_call;
-  for (int i = 0; i < effort.batches; ++i) {
-    const double t0 = bench_now();
-    for (long k = 0; k < n; ++k) call();
-    per_call.push_back((bench_now() - t0) / static_cast<double>(n));
-  }
+    for (long k = 0; k < n; ++k)
+      if (const Status s = body(acc); s != Status::Ok) bad = s;
+    return (bench_now() - t0) / static_cast<double>(n);
+  };
+  for (double dt; n < (1L << 26) && (dt = batch() * static_cast<double>(n)) < effort.batch_s;)
+    n = std::lround(static_cast<double>(n) * std::clamp(1.2 * effort.batch_s / dt, 2.0, 10.0));
+  const Figure f = time_runs(batch, effort.batches, effort.batches);
   g_sink = acc;
   b.check(bad, what);
-  return summarise(per_call);
+  return f;
 }
 
 /// time_checked of one expression: `call` gives a Status, `result` a number kept from it.
