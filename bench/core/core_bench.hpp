@@ -28,12 +28,6 @@ struct Figure {
   int batches = 0;
 };
 
-inline Figure summarise(std::vector<double> v) {
-  Figure f;
-  if (!v.empty()) f.median = bench_median(v.data(), v.size(), &f.min), f.batches = static_cast<int>(v.size());
-  return f;
-}
-
 /// Whole runs: run() returns the seconds it measured itself (set-up kept
 /// outside), < 0 on failure; one warm-up, then min..max runs within the budget.
 template <class Run>
@@ -47,7 +41,9 @@ Figure time_runs(Run&& run, int min_runs = effort.min_runs, int max_runs = effor
     v.push_back(s);
     if (r + 1 >= min_runs && bench_now() - start > effort.runs_budget_s) break;
   }
-  return summarise(v);
+  Figure f;
+  if (!v.empty()) f.median = bench_median(v.data(), v.size(), &f.min), f.batches = static_cast<int>(v.size());
+  return f;
 }
 
 constexpr double kTick = 1e-3;  // s, the communication step of the auto-test runs and the ticks
