@@ -105,11 +105,10 @@ static int set_up(int i, const fmi2ValueReference* vr, const fmi2ValueReference*
 }
 
 /* One timed simulated second of case i from the initial state (set untimed): its wall time, 0 on failure. */
-static double batch(void* ctx, int i) {
+static double batch(int i) {
   pkm_state state = {.size = sizeof(pkm_state)};
   double t0;
   int ok;
-  (void)ctx;
   if (cases[i].fmu) return run_ticks(plant, insts[i], homes[i], &ticks[i]);
   ok = pkm_init_pose(models[i], 0.0, P0, NULL) == PKM_OK;
   t0 = bench_now();
@@ -173,7 +172,7 @@ static int compare_run(const Plant* p, const Options* o) {
   printf("the comparison test (docs/model.md; g = 0, F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s)) at a 1 ms step; "
          "median of %d batches after 1 warm-up, the cases interleaved\n\n", o->batches);
   for (i = 0; ok && i < N_CASES; ++i) ok = set_up((int)i, vr, all, n_all);
-  ok = ok && time_cases(N_CASES, o->batches, batch, NULL, median, min);
+  ok = ok && time_cases(N_CASES, o->batches, batch, median, min);
   for (i = 0; ok && i < N_CASES; ++i) ok = record((int)i, vr, o->out);
   for (i = 0; i < N_CASES; ++i) {
     if (insts[i] && !free_instance(p, FMI2_CS, insts[i], &homes[i])) ok = 0;

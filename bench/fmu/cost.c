@@ -48,7 +48,7 @@ static double second(fmi2Component c, fmi2FMUstate home, int j) {
 static fmi2Component cells[N_SOLVERS * N_STEPS]; /* [solver][step] */
 static fmi2FMUstate homes[N_SOLVERS * N_STEPS];
 
-static double cell_second(void* ctx, int i) { return (void)ctx, second(cells[i], homes[i], i % N_STEPS); }
+static double cell_second(int i) { return second(cells[i], homes[i], i % N_STEPS); }
 
 typedef struct {
   int solver, ok;
@@ -116,7 +116,7 @@ static int cost_run(const Plant* p, const Options* o) {
          o->seconds);
   for (i = 0; i < N_SOLVERS * N_STEPS; ++i)
     ok = ok && (cells[i] = instantiate_cell("cell", i / N_STEPS, i % N_STEPS, &homes[i])) != NULL;
-  ok = ok && time_cases(N_SOLVERS * N_STEPS, o->batches, cell_second, NULL, med, mn);
+  ok = ok && time_cases(N_SOLVERS * N_STEPS, o->batches, cell_second, med, mn);
   for (i = 0; i < N_SOLVERS * N_STEPS; ++i)
     if (cells[i] && !free_instance(p, FMI2_CS, cells[i], &homes[i])) ok = 0;
   if (!ok) return 0;

@@ -75,9 +75,9 @@ typedef struct {
 double run_ticks(const Plant* plant, fmi2Component c, fmi2FMUstate home, const Ticks* ticks);
 
 /* The one loop of the timed batches: n cases interleaved batch by batch, one warm-up batch of each first;
- * batch(ctx, i) runs a batch of case i and returns its time (<= 0 after a message on failure). The median and
+ * batch(i) runs a batch of case i and returns its time (<= 0 after a message on failure). The median and
  * minimum over the batches per case in median[i], min[i]; 0 on failure. */
-int time_cases(int n, int batches, double (*batch)(void* ctx, int i), void* ctx, double* median, double* min);
+int time_cases(int n, int batches, double (*batch)(int i), double* median, double* min);
 
 /* Returns 0 from the calling function, after a message, when an FMI call (or an || of them) does not return OK. */
 #define FMI_CHECK(call) \

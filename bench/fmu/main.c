@@ -145,12 +145,12 @@ int lookup_value_references(const Plant* plant, const char* const* names, size_t
   return 1;
 }
 
-int time_cases(int n, int batches, double (*batch)(void* ctx, int i), void* ctx, double* median, double* min) {
+int time_cases(int n, int batches, double (*batch)(int i), double* median, double* min) {
   double* per = malloc(sizeof(double) * (size_t)n * (size_t)batches); /* [case][batch] */
   int ok = per != NULL;
   for (int b = -1; ok && b < batches; ++b)
     for (int i = 0; ok && i < n; ++i) {
-      const double s = batch(ctx, i);
+      const double s = batch(i);
       ok = s > 0.0;
       if (b >= 0) per[i * batches + b] = s;
     }
