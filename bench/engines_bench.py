@@ -7,13 +7,12 @@ mj_inverse (`pkm_fmu_bench inverse`). Targets printed, never asserted.
 """
 import argparse
 import csv
-import math
 import os
 import platform
 import subprocess
 import sys
 import tempfile
-import time
+import timeit
 from pathlib import Path
 
 import numpy as np
@@ -26,7 +25,6 @@ from pkm4puu import motions, spec
 from pkm4puu.cli import engine_comparison as ec
 from pkm4puu.references import mujoco_model
 from pkm4puu.references.pinocchio_model import PinocchioPKM
-from timer import timed
 
 H = 1e-3
 STEPS_TIMED = 1000  # one simulated second
@@ -104,14 +102,12 @@ class PinocchioBench:
     def derivatives(self, calls=2000):
         """Per call: constraintDynamics, and it followed by computeConstraintDynamicsDerivatives."""
         pm, (q, v, f) = self.pm, (self.q0, self.v0, self.tau[1])
-        t0 = time.perf_counter()
-        for _ in range(calls):
-            self.cd(q, v, f)
-        t1 = time.perf_counter()
-        for _ in range(calls):
+
+        def with_derivatives():
             self.cd(q, v, f)
             pin.computeConstraintDynamicsDerivatives(pm.model, pm.data, pm._cm, pm._cd, pm._prox)
-        return (t1 - t0) / calls, (time.perf_counter() - t1) / calls
+        return (timeit.timeit(lambda: self.cd(q, v, f), number=calls) / calls,
+                timeit.timeit(with_derivatives, number=calls) / calls)
 
 
 def inverse_tick(program, batches):
@@ -148,9 +144,9 @@ def main(argv=None):
         if r == 0:
             first, c_out = cases, out
         times = {key: (float(c["median_s_per_sim_s"]), float(c["min_s_per_sim_s"])) for key, c in cases.items()}
-        for key, t in (("mujoco_rollout", timed(mj.rollout, args.batches)[0]),
-                       ("mujoco_loop", timed(mj.python_loop, args.batches, setup=mj.reset)[0]),
-                       ("pinocchio_rk4", timed(lambda: pb.run(STEPS_TIMED), 1)[0])):
+        for key, t in (("mujoco_rollout", timeit.repeat(mj.rollout, repeat=args.batches, number=1)),
+                       ("mujoco_loop", timeit.repeat(mj.python_loop, mj.reset, repeat=args.batches, number=1)),
+                       ("pinocchio_rk4", timeit.repeat(lambda: pb.run(STEPS_TIMED), repeat=1, number=1))):
             times[key] = (float(np.median(t)), float(np.min(t)))
         cd, dd = pb.derivatives()
         times.update(pinocchio_dynamics_call=(cd, cd), pinocchio_derivatives_call=(dd, dd),
