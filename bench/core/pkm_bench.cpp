@@ -73,7 +73,7 @@ struct Core {
   RestToRest path;
   long n_out = 0, n_grid = 0;  // 2000 one-ms steps; 4001 grid points
   int failures = 0;
-  Pose p, pd, pdd, p0, pd0, pdd0;  // the path at t = 1 s and at 0
+  Pose p, pd, pdd;  // the path at t = 1 s (it starts at rest at path.p0)
   InverseDynamicsResult id_mid;
   Vec8 y_mid;
   Vec16 f_mid;
@@ -109,10 +109,9 @@ bool set_up(Core& b) {
   b.n_out = std::lround(b.path.duration / kTick);
   b.n_grid = 2 * b.n_out + 1;
   b.path.eval(1.0, b.p, b.pd, b.pdd);
-  b.path.eval(0.0, b.p0, b.pd0, b.pdd0);
   InverseDynamicsResult r;
   if (inverse_dynamics(b.model, b.p, b.pd, b.pdd, Wrench::Zero(), b.id_mid, false) != Status::Ok ||
-      inverse_dynamics(b.model, b.p0, Pose::Zero(), Pose::Zero(), Wrench::Zero(), r, false) != Status::Ok) {
+      inverse_dynamics(b.model, b.path.p0, Pose::Zero(), Pose::Zero(), Wrench::Zero(), r, false) != Status::Ok) {
     std::fprintf(stderr, "pkm_bench: inverse dynamics failed on the path\n");
     return false;
   }
@@ -331,7 +330,7 @@ RunInfo plant_run(Core& b, const SolverSettings& st, InputSignal input, bool con
   RunInfo info;
   StepRun last;
   info.fig = time_runs([&] {
-    last = plant_steps(b.model, st, b.p0, b.pd0, b.n_out, [&](Plant& plant, long k) {
+    last = plant_steps(b.model, st, b.path.p0, Pose::Zero(), b.n_out, [&](Plant& plant, long k) {
       const Status s = plant.advance(static_cast<double>(k + 1) * kTick, input, continuous && k > 0);
       return s == Status::Ok && input_status ? *input_status : s;
     });
@@ -345,7 +344,7 @@ RunInfo plant_run(Core& b, const SolverSettings& st, InputSignal input, bool con
   }
   info.err = 0;
   for (long k = 0; k <= b.n_out; ++k) {
-    Pose q = b.p0, qd, qdd;
+    Pose q = b.path.p0, qd, qdd;
     if (!at_rest) b.path.eval(static_cast<double>(k) * kTick, q, qd, qdd);
     const Vec8& x = last.states[static_cast<size_t>(k)];
     info.err = std::max(info.err, (x.head<3>() - q.head<3>()).lpNorm<Eigen::Infinity>());

@@ -1,13 +1,11 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
 /* pkm_fmu_bench cost: the plant FMU's cost in one Markdown table: the time
  * per simulated second per communication step h and solver, the heap per
- * instance, instantiate + initialise, and the throughput of one thread per
- * core against one. latency: the 1 ms control tick, each timed on its own,
- * every batch the same simulated second, so the minimum over the batches of
- * tick k is the model's own time for it (the spread above it is the
- * machine's). From the home pose, the holding forces plus 0.2 t N on F[1] as
- * value and slope each tick (CVODE continues), with latency's RK4 0.2 cos(2
- * pi 3 t) N held at each tick's midpoint instead. */
+ * instance, instantiate + initialise, the throughput of one thread per core
+ * against one. latency: each 1 ms tick timed, the batches repeating the same
+ * second, so the minimum over them of tick k is the model's own time for it.
+ * From the home pose, the holding forces plus 0.2 t N on F[1] as value and
+ * slope each tick (CVODE continues); latency's RK4: 0.2 cos(2 pi 3 t) N held. */
 #include "fmu_bench.h"
 
 #include <malloc.h>
