@@ -2,8 +2,8 @@
 /* pkm_fmu_bench compare: one simulated second of the comparison test at a
  * 1 ms step through the C API (the forces at the stage times from a table, as
  * MuJoCo's from an array) and the plant FMU (F held at each tick's midpoint or
- * as a ramp); --out DIR: each case's untimed run of the whole test and the
- * summary as CSV, for bench/engines_bench.py. */
+ * as a ramp); --out DIR: each case's untimed run of the whole test (pose,
+ * delta rho1, ||C||) and the summary as CSV, for bench/engines_bench.py. */
 #include "fmu_bench.h"
 #include "pkm4puu/pkm.h"
 
@@ -60,10 +60,10 @@ static FILE* open_csv(const char* dir, const char* name) {
 static int write_rows(const char* dir, const char* name, int n) {
   FILE* fp = dir ? open_csv(dir, name) : NULL;
   if (!dir || !fp) return !dir;
-  fprintf(fp, "t,x,y,z,phi,rho1,constraint_residual\n");
+  fprintf(fp, "t,x,y,z,phi,delta_rho1,constraint\n");
   for (int k = 0; k < n; ++k)
     fprintf(fp, "%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.6e\n", times[k], rows[k][0], rows[k][1], rows[k][2],
-            rows[k][3], rows[k][4], rows[k][5]);
+            rows[k][3], rows[k][4] - rows[0][4], rows[k][5]);
   fclose(fp);
   return 1;
 }
