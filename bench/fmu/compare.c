@@ -104,7 +104,7 @@ static int set_up(int i, const fmi2ValueReference* vr, const fmi2ValueReference*
   return fprintf(stderr, "pkm_fmu_bench compare: %s: %s\n", c->name, pkm_last_error(models[i])), 0;
 }
 
-/* One timed simulated second of case i from the initial state (set untimed): its wall time, 0 on failure. */
+/* One timed simulated second of case i from the initial state (set untimed): its wall time, <= 0 on failure. */
 static double batch(int i) {
   pkm_state state = {.size = sizeof(pkm_state)};
   double t0;
