@@ -111,10 +111,7 @@ class PinocchioBench:
 def inverse_tick(program, batches):
     """`pkm_fmu_bench inverse` with MuJoCo's model of the same mechanism (spec gravity, no machine) at the
     auto-test path at t = 1 s: the legs' coordinates, rates and accelerations completed from the platform's."""
-    pm, (pose, pd, pdd) = PinocchioPKM(), (np.asarray(v, dtype=float) for v in motions.autotest_motion(1.0))
-    q = pm.q_from_pose(pose)
-    qd = pm.complete_velocity(q, pd)
-    qdd = pm.complete_acceleration(q, qd, pdd)
+    _, _, (q, qd, qdd) = PinocchioPKM().inverse_dynamics(*motions.autotest_motion(1.0))
     with tempfile.TemporaryDirectory() as tmp:
         mjcf, state = Path(tmp) / "pkm4puu.xml", Path(tmp) / "state.txt"
         mjcf.write_text(mujoco_model.mjcf())
