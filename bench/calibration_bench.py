@@ -9,6 +9,7 @@ peak falls below it from a few blocks on: --seconds 100).
 import argparse
 import sys
 import time
+import timeit
 import tracemalloc
 
 import numpy as np
@@ -16,7 +17,6 @@ import numpy as np
 from pkm4puu import capi
 from pkm4puu.calibration.parameters import make_plant
 from pkm4puu.locate import library_path
-from timer import timed
 
 TARGET = 1.0  # s for 10 s of 1 kHz data
 MODEL = {"friction_velocity": 0.005, "rotor_inertia": 1.5e-7, "friction_viscous": 5.0, "friction_coulomb": 0.6}
@@ -47,10 +47,10 @@ def main(argv=None):
     from pkm4puu.calibration import filtered_derivatives, identify
     r = identify(t, rho, F, model=MODEL, lib=lib)
     first = time.perf_counter() - t0
-    warm = timed(lambda: identify(t, rho, F, model=MODEL, lib=lib), args.repeat)[0]
+    warm = timeit.repeat(lambda: identify(t, rho, F, model=MODEL, lib=lib), repeat=args.repeat, number=1)
     r_, rd, rdd = filtered_derivatives(t, rho, 20.0)
     with make_plant(lib, MODEL) as p:
-        reg = timed(lambda: p.regressor_joints(r_, rd, rdd), max(args.repeat, 1))[0]
+        reg = timeit.repeat(lambda: p.regressor_joints(r_, rd, rdd), repeat=max(args.repeat, 1), number=1)
     tracemalloc.start()
     identify(t, rho, F, model=MODEL, lib=lib)
     peak = tracemalloc.get_traced_memory()[1]

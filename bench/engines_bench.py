@@ -7,13 +7,12 @@ mj_inverse (`pkm_fmu_bench inverse`). Targets printed, never asserted.
 """
 import argparse
 import csv
-import math
 import os
 import platform
 import subprocess
 import sys
 import tempfile
-import time
+import timeit
 from pathlib import Path
 
 import numpy as np
@@ -23,10 +22,9 @@ import mujoco.rollout
 import pinocchio as pin
 
 from pkm4puu import motions, spec
-from pkm4puu.cli.engine_comparison import deviation, mujoco_run, pinocchio_reference, pinocchio_rk4, rk4_on_manifold
+from pkm4puu.cli import engine_comparison as ec
 from pkm4puu.references import mujoco_model
 from pkm4puu.references.pinocchio_model import PinocchioPKM
-from timer import timed
 
 H = 1e-3
 STEPS_TIMED = 1000  # one simulated second
@@ -57,8 +55,7 @@ def c_cases(program, batches):
             cases = {row["case"]: row for row in csv.DictReader(f)}
         for key, c in cases.items():
             d = np.genfromtxt(Path(tmp) / f"{key}.csv", delimiter=",", names=True)
-            c["run"] = {n: d[n] for n in ("t", "x", "y", "z", "phi")}
-            c["run"]["delta_rho1"] = d["rho1"] - d["rho1"][0]
+            c["run"] = {n: d[n] for n in d.dtype.names}  # t, x, y, z, phi, delta_rho1, constraint
     return cases, out
 
 
@@ -97,30 +94,24 @@ class PinocchioBench:
         self.run(10)  # warm-up
 
     def run(self, n):
-        pm, tau = self.pm, self.tau
-        rk4_on_manifold(pm.model, self.q0, self.v0, H, n, lambda q, v, k, stage: pin.constraintDynamics(
-            pm.model, pm.data, q, v, tau[2 * k + stage], pm._cm, pm._cd, pm._prox))
+        cd, tau = self.cd, self.tau
+        ec.rk4_on_manifold(self.pm.model, self.q0, self.v0, H, n, lambda q, v, k, stage: cd(q, v, tau[2 * k + stage]))
 
     def derivatives(self, calls=2000):
         """Per call: constraintDynamics, and it followed by computeConstraintDynamicsDerivatives."""
         pm, (q, v, f) = self.pm, (self.q0, self.v0, self.tau[1])
-        t0 = time.perf_counter()
-        for _ in range(calls):
-            self.cd(q, v, f)
-        t1 = time.perf_counter()
-        for _ in range(calls):
+
+        def with_derivatives():
             self.cd(q, v, f)
             pin.computeConstraintDynamicsDerivatives(pm.model, pm.data, pm._cm, pm._cd, pm._prox)
-        return (t1 - t0) / calls, (time.perf_counter() - t1) / calls
+        return (timeit.timeit(lambda: self.cd(q, v, f), number=calls) / calls,
+                timeit.timeit(with_derivatives, number=calls) / calls)
 
 
 def inverse_tick(program, batches):
     """`pkm_fmu_bench inverse` with MuJoCo's model of the same mechanism (spec gravity, no machine) at the
     auto-test path at t = 1 s: the legs' coordinates, rates and accelerations completed from the platform's."""
-    pm, (pose, pd, pdd) = PinocchioPKM(), (np.asarray(v, dtype=float) for v in motions.autotest_motion(1.0))
-    q = pm.q_from_pose(pose)
-    qd = pm.complete_velocity(q, pd)
-    qdd = pm.complete_acceleration(q, qd, pdd)
+    _, _, (q, qd, qdd) = PinocchioPKM().inverse_dynamics(*motions.autotest_motion(1.0))
     with tempfile.TemporaryDirectory() as tmp:
         mjcf, state = Path(tmp) / "pkm4puu.xml", Path(tmp) / "state.txt"
         mjcf.write_text(mujoco_model.mjcf())
@@ -141,49 +132,42 @@ def main(argv=None):
         ap.exit(2, f"engines_bench: no {program}: build it (cmake --build {args.build} --target pkm_fmu_bench)\n")
 
     mj, pb = MuJoCoBench(), PinocchioBench()
-    times, best = {}, {}  # case -> the rounds' medians; the best batch of all
-
-    def add(case, median, best_batch):
-        times.setdefault(case, []).append(float(median))
-        best[case] = min(best.get(case, math.inf), float(best_batch))
-
-    first, c_out = None, ""
+    rounds = []  # each round's {case: (median, best batch)}
     for r in range(args.rounds):
         log(f"round {r + 1} of {args.rounds}")
         cases, out = c_cases(program, args.batches)
-        first, c_out = first or cases, c_out or out
-        for key, c in cases.items():
-            add(key, c["median_s_per_sim_s"], c["min_s_per_sim_s"])
-        per = {"mujoco_rollout": timed(mj.rollout, args.batches)[0],
-               "mujoco_loop": timed(mj.python_loop, args.batches, setup=mj.reset)[0],
-               "pinocchio_rk4": timed(lambda: pb.run(STEPS_TIMED), 1)[0]}
-        per["pinocchio_dynamics_call"], per["pinocchio_derivatives_call"] = pb.derivatives()
-        per["pinocchio_bare"] = 4 * STEPS_TIMED * per["pinocchio_dynamics_call"]  # RK4's calls, at that cost
-        for key, v in per.items():
-            add(key, np.median(v), np.min(v))
-    median = {k: float(np.median(v)) for k, v in times.items()}
+        if r == 0:
+            first, c_out = cases, out
+        times = {key: (float(c["median_s_per_sim_s"]), float(c["min_s_per_sim_s"])) for key, c in cases.items()}
+        for key, t in (("mujoco_rollout", timeit.repeat(mj.rollout, repeat=args.batches, number=1)),
+                       ("mujoco_loop", timeit.repeat(mj.python_loop, mj.reset, repeat=args.batches, number=1)),
+                       ("pinocchio_rk4", timeit.repeat(lambda: pb.run(STEPS_TIMED), repeat=1, number=1))):
+            times[key] = (float(np.median(t)), float(np.min(t)))
+        cd, dd = pb.derivatives()
+        times.update(pinocchio_dynamics_call=(cd, cd), pinocchio_derivatives_call=(dd, dd),
+                     pinocchio_bare=(4 * STEPS_TIMED * cd,) * 2)  # RK4's calls, at that cost
+        rounds.append(times)
+    median = {key: float(np.median([t[key][0] for t in rounds])) for key in rounds[0]}
+    best = {key: min(t[key][1] for t in rounds) for key in rounds[0]}
     log("inverse dynamics: the inverse FMU's tick against mj_inverse")
     inverse_out = inverse_tick(program, 5 if args.quick else 51)
 
     log("accuracy: Pinocchio's reference (DOP853, rtol 1e-13) and each engine's whole 1.5 s run")
-    ref = pinocchio_reference("exact")
-
-    def dev(run):  # deviation() at the run's own output times (one-call cases have only a few)
-        idx = np.rint(np.asarray(run["t"]) / H).astype(int)
-        return deviation(run, {n: ref[n][idx] for n in ("x", "y", "z", "phi", "delta_rho1")})
-
-    runs = {"mujoco_rollout": mujoco_run(), "pinocchio_rk4": pinocchio_rk4(h=H)}  # the whole test, untimed
-    rows = [(f"this project, {c['what']}", key, float(c["max_constraint_residual"]), dev(c["run"]), c["forces"])
-            for key, c in first.items()]
-    rows += [(label, key, runs[key]["constraint"].max(), dev(runs[key]), forces) if key in runs
-             else (label, key, None, None, forces) for key, (label, forces) in OTHERS.items()]
+    ref = ec.pinocchio_reference("exact")
+    runs = {key: c["run"] for key, c in first.items()}
+    runs.update(mujoco_rollout=ec.mujoco_run(), pinocchio_rk4=ec.pinocchio_rk4(h=H))  # the whole test, untimed
     t_mj = median["mujoco_rollout"]
+
+    def accuracy(run):  # ‖C(q)‖, and deviation() at the run's own output times (one-call cases have only a few)
+        d = ec.deviation(run, {n: ref[n][np.rint(run["t"] / H).astype(int)] for n in ec.OUT})
+        return f"{run['constraint'].max():.1e} | {d[0]:.1e} / {d[1]:.1e}"
+
     lines = ["| | time per simulated second, median (best) | MuJoCo's time / this | max ‖C(q)‖ (m) "
              "| max difference from the reference, position (m) / φ (rad) | forces |", "|---|---|---|---|---|---|"]
-    for label, key, c, d, forces in rows:
-        cs, ds = "" if c is None else f"{c:.1e}", "" if d is None else f"{d[0]:.1e} / {d[1]:.1e}"
+    ours = {key: (f"this project, {c['what']}", c["forces"]) for key, c in first.items()}
+    for key, (label, forces) in {**ours, **OTHERS}.items():
         lines.append(f"| {label} | {1e3 * median[key]:.2f} ms ({1e3 * best[key]:.2f}) | {t_mj / median[key]:.1f}× | "
-                     f"{cs} | {ds} | {forces} |")
+                     f"{accuracy(runs[key]) if key in runs else ' | '} | {forces} |")
 
     print(c_out.rstrip() + "\n")
     print(f"engines_bench: python {platform.python_version()}, mujoco {mujoco.__version__}, "

@@ -6,20 +6,19 @@ convergence with the grid (first order: Richardson's extrapolate of the two
 finest).
 """
 import argparse
+import statistics
 import sys
 import time
+import timeit
 
 import numpy as np
-
-from timer import timed
 
 TARGET = 1.0  # s to plan the standard cycle
 
 
-def median_timed(fn, repeat):
-    """(fn's result, the median wall time of `repeat` calls)."""
-    times, out = timed(fn, repeat)
-    return out, float(np.median(times))
+def median_time(fn, repeat):
+    """The median wall time of `repeat` calls of fn()."""
+    return statistics.median(timeit.repeat(fn, repeat=repeat, number=1))
 
 
 def main(argv=None):
@@ -40,7 +39,7 @@ def main(argv=None):
     cycle = pkm4puu.plan_cycle(build=args.build)
     first = time.perf_counter() - t0
 
-    cycle, plan = median_timed(lambda: pkm4puu.plan_cycle(build=args.build), args.repeat)
+    plan = median_time(lambda: pkm4puu.plan_cycle(build=args.build), args.repeat)
     path, s = arch(), np.linspace(0.0, 1.0, GRID + 1)
     legs = ((path, spec.CYCLE_PAYLOAD), (path.reversed(), 0.0))
 
@@ -51,15 +50,15 @@ def main(argv=None):
                 out.append(topp.path_coefficients(dyn, p, s))
         return out
 
-    coeffs, t_coeff = median_timed(coefficients, args.repeat)
+    t_coeff = median_time(coefficients, args.repeat)
+    coeffs = coefficients()
 
     def solve():
         for a, b, c, drho_ds in coeffs:
             topp.solve(s, a, b, c, spec.CYCLE_F_MAX, spec.CYCLE_V_MAX ** 2 / (drho_ds ** 2).max(axis=1))
 
-    _, t_solve = median_timed(solve, args.repeat)
-    _, t_sample = median_timed(lambda: [segment.sample(seg, DT, build=args.build) for seg in cycle.segments],
-                               args.repeat)
+    t_solve = median_time(solve, args.repeat)
+    t_sample = median_time(lambda: [segment.sample(seg, DT, build=args.build) for seg in cycle.segments], args.repeat)
 
     print(f"pick-and-place planning: the standard cycle ({cycle.arch.describe()}, payload {spec.CYCLE_PAYLOAD:g} kg), "
           f"grid {GRID} intervals per leg, samples every {DT:g} s; median of {args.repeat} calls")

@@ -28,12 +28,6 @@ struct Figure {
   int batches = 0;
 };
 
-inline Figure summarise(std::vector<double> v) {
-  Figure f;
-  if (!v.empty()) f.median = bench_median(v.data(), v.size(), &f.min), f.batches = static_cast<int>(v.size());
-  return f;
-}
-
 /// Whole runs: run() returns the seconds it measured itself (set-up kept
 /// outside), < 0 on failure; one warm-up, then min..max runs within the budget.
 template <class Run>
@@ -47,7 +41,9 @@ Figure time_runs(Run&& run, int min_runs = effort.min_runs, int max_runs = effor
     v.push_back(s);
     if (r + 1 >= min_runs && bench_now() - start > effort.runs_budget_s) break;
   }
-  return summarise(v);
+  Figure f;
+  if (!v.empty()) f.median = bench_median(v.data(), v.size(), &f.min), f.batches = static_cast<int>(v.size());
+  return f;
 }
 
 constexpr double kTick = 1e-3;  // s, the communication step of the auto-test runs and the ticks
@@ -63,6 +59,7 @@ inline SolverSettings settings(Solver solver, double rtol = 1e-8, double atol = 
 
 struct StepRun {
   double seconds = 0;  // the steps' wall time, up to the first failing step included
+  double us = NAN;     // timed_steps: the runs' median microseconds per step (the failing step included)
   Status status = Status::Ok;
   long ok_steps = 0, rhs = 0, rhs_max = 0, cvode_steps = 0;  // rhs_max: the most in one step
   std::vector<Vec8> states;                                  // pose and rates after each step, the initial first
@@ -89,6 +86,18 @@ StepRun plant_steps(const Model& m, const SolverSettings& st, const Pose& p0, co
   r.seconds = bench_now() - t0;
   r.rhs = plant.rhs_evaluations();
   r.cvode_steps = plant.cvode_steps();
+  return r;
+}
+
+/// effort.tick_runs timed runs of n steps from the home pose at rest (plant_steps): the last run, with its `us`.
+template <class Step>
+StepRun timed_steps(const Model& m, const SolverSettings& st, long n, Step&& step) {
+  StepRun r;
+  const Figure f = time_runs([&] {
+    r = plant_steps(m, st, kHome, Pose::Zero(), n, step);
+    return r.seconds / static_cast<double>(std::min(r.ok_steps + 1, n));
+  }, effort.tick_runs, effort.tick_runs);
+  r.us = 1e6 * f.median;
   return r;
 }
 

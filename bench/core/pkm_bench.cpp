@@ -73,7 +73,7 @@ struct Core {
   RestToRest path;
   long n_out = 0, n_grid = 0;  // 2000 one-ms steps; 4001 grid points
   int failures = 0;
-  Pose p, pd, pdd, p0, pd0, pdd0;  // the path at t = 1 s and at 0
+  Pose p, pd, pdd;  // the path at t = 1 s (it starts at rest at path.p0)
   InverseDynamicsResult id_mid;
   Vec8 y_mid;
   Vec16 f_mid;
@@ -109,10 +109,9 @@ bool set_up(Core& b) {
   b.n_out = std::lround(b.path.duration / kTick);
   b.n_grid = 2 * b.n_out + 1;
   b.path.eval(1.0, b.p, b.pd, b.pdd);
-  b.path.eval(0.0, b.p0, b.pd0, b.pdd0);
   InverseDynamicsResult r;
   if (inverse_dynamics(b.model, b.p, b.pd, b.pdd, Wrench::Zero(), b.id_mid, false) != Status::Ok ||
-      inverse_dynamics(b.model, b.p0, Pose::Zero(), Pose::Zero(), Wrench::Zero(), r, false) != Status::Ok) {
+      inverse_dynamics(b.model, b.path.p0, Pose::Zero(), Pose::Zero(), Wrench::Zero(), r, false) != Status::Ok) {
     std::fprintf(stderr, "pkm_bench: inverse dynamics failed on the path\n");
     return false;
   }
@@ -147,31 +146,25 @@ void print_header() {
 }
 
 /// Per-call time of body(acc) (returns a Status, adds a result to acc): N
-/// calls per batch, N grown until a batch lasts effort.batch_s; a failed call
-/// is reported under `what`.
+/// calls per batch, N grown until a batch lasts effort.batch_s, the batches
+/// timed as runs; a failed call is reported under `what`.
 template <class Body>
 Figure time_checked(Core& b, const char* what, Body&& body) {
   double acc = 0;
   Status bad = Status::Ok;
-  auto call = [&] {
-    const Status s = body(acc);
-    if (s != Status::Ok) bad = s;
-  };
   long n = 1;
-  for (double dt = 0; n < (1L << 26); n = std::lround(n * std::clamp(1.2 * effort.batch_s / dt, 2.0, 10.0))) {
+  auto batch = [&] {  // the time per call of a batch of n calls
     const double t0 = bench_now();
-    for (long k = 0; k < n; ++k) call();
-    if ((dt = bench_now() - t0) >= effort.batch_s) break;
-  }
-  std::vector<double> per_call;
-  for (int i = 0; i < effort.batches; ++i) {
-    const double t0 = bench_now();
-    for (long k = 0; k < n; ++k) call();
-    per_call.push_back((bench_now() - t0) / static_cast<double>(n));
-  }
+    for (long k = 0; k < n; ++k)
+      if (const Status s = body(acc); s != Status::Ok) bad = s;
+    return (bench_now() - t0) / static_cast<double>(n);
+  };
+  for (double dt; n < (1L << 26) && (dt = batch() * static_cast<double>(n)) < effort.batch_s;)
+    n = std::lround(static_cast<double>(n) * std::clamp(1.2 * effort.batch_s / dt, 2.0, 10.0));
+  const Figure f = time_runs(batch, effort.batches, effort.batches);
   g_sink = acc;
   b.check(bad, what);
-  return summarise(per_call);
+  return f;
 }
 
 /// time_checked of one expression: `call` gives a Status, `result` a number kept from it.
@@ -337,7 +330,7 @@ RunInfo plant_run(Core& b, const SolverSettings& st, InputSignal input, bool con
   RunInfo info;
   StepRun last;
   info.fig = time_runs([&] {
-    last = plant_steps(b.model, st, b.p0, b.pd0, b.n_out, [&](Plant& plant, long k) {
+    last = plant_steps(b.model, st, b.path.p0, Pose::Zero(), b.n_out, [&](Plant& plant, long k) {
       const Status s = plant.advance(static_cast<double>(k + 1) * kTick, input, continuous && k > 0);
       return s == Status::Ok && input_status ? *input_status : s;
     });
@@ -351,7 +344,7 @@ RunInfo plant_run(Core& b, const SolverSettings& st, InputSignal input, bool con
   }
   info.err = 0;
   for (long k = 0; k <= b.n_out; ++k) {
-    Pose q = b.p0, qd, qdd;
+    Pose q = b.path.p0, qd, qdd;
     if (!at_rest) b.path.eval(static_cast<double>(k) * kTick, q, qd, qdd);
     const Vec8& x = last.states[static_cast<size_t>(k)];
     info.err = std::max(info.err, (x.head<3>() - q.head<3>()).lpNorm<Eigen::Infinity>());

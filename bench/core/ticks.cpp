@@ -33,11 +33,12 @@ LinearInputs step_inputs(Inputs kind, long k, const Vec4& F_static) {
   return in;
 }
 
-StepRun tick_run(const Model& m, const SolverSettings& st, Inputs kind, bool cont, const Vec4& F_static) {
-  return plant_steps(m, st, kHome, Pose::Zero(), kTicks, [&](Plant& plant, long k) {
+/// A tick's step for plant_steps: the inputs of `kind`, CVODE continued across the steps if `cont`.
+auto tick_step(Inputs kind, bool cont, const Vec4& F_static) {
+  return [=](Plant& plant, long k) {
     LinearInputs in = step_inputs(kind, k, F_static);
     return plant.advance(static_cast<double>(k + 1) * kTick, in.signal(), cont && k > 0);
-  });
+  };
 }
 
 /// The stiff cases: F = 0 from the home pose, 200 steps of 1 ms; per solver
@@ -53,20 +54,10 @@ void stiff_cases(double rk4_tick_us) {
                {"stops 1e9/1e6", {{"stop_stiffness", 1e9}, {"stop_damping", 1e6}}},
                {"stops, m_slider 1e-2", {{"stop_stiffness", 1e9}, {"stop_damping", 1e6}, {"m_slider", 1e-2}}},
                {"stops, m_slider 1e-6", {{"stop_stiffness", 1e9}, {"stop_damping", 1e6}, {"m_slider", 1e-6}}}};
-  struct Outcome {
-    StepRun last;
-    double us;  // the median microseconds per step, the failing step included
-  };
   auto run = [](const Model& m, Solver solver) {
-    const SolverSettings st = settings(solver, 1e-10, 1e-12, CvodeMethod::BDF);
-    Outcome o;
-    o.us = 1e6 * time_runs([&] {
-      o.last = plant_steps(m, st, kHome, Pose::Zero(), 200, [](Plant& plant, long k) {
-        return plant.advance(static_cast<double>(k + 1) * kTick, InputSignal{});
-      });
-      return o.last.seconds / static_cast<double>(std::min(o.last.ok_steps + 1, 200L));
-    }, effort.tick_runs, effort.tick_runs).median;
-    return o;
+    return timed_steps(m, settings(solver, 1e-10, 1e-12, CvodeMethod::BDF), 200, [](Plant& plant, long k) {
+      return plant.advance(static_cast<double>(k + 1) * kTick, InputSignal{});
+    });
   };
   std::printf("\nthe stiff cases: F = 0 from the home pose, 1 ms steps, 200 steps; CVODE BDF rtol 1e-10 is the "
               "reference\n(targets: ROS2 within 1 %% of CVODE, at most 3x an RK4 tick)\n");
@@ -77,19 +68,19 @@ void stiff_cases(double rk4_tick_us) {
     for (const auto& [parameter, value] : c.set) find_parameter(parameter)->set(config, value);
     Model m;
     if (make_model(config.params, m) != Status::Ok) continue;
-    const Outcome cv = run(m, Solver::Cvode), r4 = run(m, Solver::Rk4), rb = run(m, Solver::Rosenbrock);
+    const StepRun cv = run(m, Solver::Cvode), r4 = run(m, Solver::Rk4), rb = run(m, Solver::Rosenbrock);
     double dev = 0, scale = 0;
-    for (long k = 1; k <= std::min(cv.last.ok_steps, rb.last.ok_steps); ++k) {
-      dev = std::max(dev, std::fabs(rb.last.states[k][6] - cv.last.states[k][6]));
-      scale = std::max(scale, std::fabs(cv.last.states[k][6]));
+    for (long k = 1; k <= std::min(cv.ok_steps, rb.ok_steps); ++k) {
+      dev = std::max(dev, std::fabs(rb.states[k][6] - cv.states[k][6]));
+      scale = std::max(scale, std::fabs(cv.states[k][6]));
     }
     std::printf("%-30s", c.name);
-    for (const Outcome* o : {&cv, &r4, &rb}) {
+    for (const StepRun* o : {&cv, &r4, &rb}) {
       char cell[32];
-      std::snprintf(cell, sizeof cell, "%.2f/%ld", o->us, o->last.ok_steps);
+      std::snprintf(cell, sizeof cell, "%.2f/%ld", o->us, o->ok_steps);
       std::printf(" %14s", cell);
     }
-    std::printf(" %10.2f %10.2f %10.2f %11.2g%%\n", r4.last.ok_steps ? rb.us / r4.us : 0.0, rb.us / rk4_tick_us,
+    std::printf(" %10.2f %10.2f %10.2f %11.2g%%\n", r4.ok_steps ? rb.us / r4.us : 0.0, rb.us / rk4_tick_us,
                 rb.us / cv.us, scale > 0 ? 100 * dev / scale : 0.0);
   }
   std::printf("us/ok: median microseconds per step (the failing step included) / steps answered OK; /RK4 tick: ROS2\n"
@@ -130,16 +121,10 @@ int ticks_part(bool parseable) {
   int failures = 0;
   double rk4_us = 0, restart_us = 0;
   for (const Inputs kind : {Inputs::Ramp, Inputs::Sampled, Inputs::Held}) {
-    const StepRun ref = parseable ? StepRun{} : tick_run(model, tight, kind, false, id.F);
+    const StepRun ref =
+        parseable ? StepRun{} : plant_steps(model, tight, kHome, Pose::Zero(), kTicks, tick_step(kind, false, id.F));
     for (const auto& c : cases) {
-      StepRun r;
-      const Figure f = time_runs(
-          [&] {
-            r = tick_run(model, c.st, kind, c.cont, id.F);
-            return r.status == Status::Ok ? r.seconds : -1.0;
-          },
-          effort.tick_runs, effort.tick_runs);
-      const double us = 1e6 * f.median / kTicks;
+      const StepRun r = timed_steps(model, c.st, kTicks, tick_step(kind, c.cont, id.F));
       char name[64];
       std::snprintf(name, sizeof name, "%s: %s", kInputNames[static_cast<int>(kind)], c.name);
       if (r.status != Status::Ok) {
@@ -149,18 +134,18 @@ int ticks_part(bool parseable) {
       }
       const Vec8& last = r.states.back();
       if (parseable) {
-        std::printf("tick;%s;%.6f;%.17g;%.17g;%.17g;%.17g\n", name, us, last[0], last[1], last[2], last[3]);
+        std::printf("tick;%s;%.6f;%.17g;%.17g;%.17g;%.17g\n", name, r.us, last[0], last[1], last[2], last[3]);
         continue;
       }
       double dev = 0;
       for (size_t k = 0; k < r.states.size() && k < ref.states.size(); ++k)
         dev = std::max(dev, (r.states[k].head<3>() - ref.states[k].head<3>()).lpNorm<Eigen::Infinity>());
-      std::printf("%-44s %9.3f %9.2f %9ld %9.2f %12.2e", name, us, static_cast<double>(r.rhs) / kTicks, r.rhs_max,
+      std::printf("%-44s %9.3f %9.2f %9ld %9.2f %12.2e", name, r.us, static_cast<double>(r.rhs) / kTicks, r.rhs_max,
                   static_cast<double>(r.cvode_steps) / kTicks, dev);
-      if (&c.st == &cvode && !c.cont) restart_us = us;
-      if (&c.st == &cvode && c.cont) std::printf("   %.1fx faster than restarting", restart_us / us);
-      if (&c.st == &rk4) rk4_us = us;
-      if (&c.st == &ros2) std::printf("   %.2fx RK4 (target <= 3x)", us / rk4_us);
+      if (&c.st == &cvode && !c.cont) restart_us = r.us;
+      if (&c.st == &cvode && c.cont) std::printf("   %.1fx faster than restarting", restart_us / r.us);
+      if (&c.st == &rk4) rk4_us = r.us;
+      if (&c.st == &ros2) std::printf("   %.2fx RK4 (target <= 3x)", r.us / rk4_us);
       std::printf("\n");
     }
   }

@@ -16,7 +16,7 @@
 #include "timer.h"
 
 typedef struct {
-  const char *so, *xml, *out, *mjcf, *state; /* --fmu, --xml, --out (compare), --mjcf, --state (inverse) */
+  const char *out, *mjcf, *state; /* --out (compare), --mjcf, --state (inverse) */
   int batches;
   double seconds; /* --seconds (cost) */
 } Options;
@@ -27,8 +27,8 @@ typedef struct {
 #undef PKM_BENCH_DECLARE3
 } Fmu3;
 
-/* The FMU binary, loaded (FMI 3.0 too for the inverse FMU), its model description's text and guid; the plant's
- * F[1..4], controller outputs and solver. */
+/* The build's FMU binary, loaded (FMI 3.0 too for the inverse FMU), its model description's text and guid; the
+ * plant's F[1..4], controller outputs and solver. */
 typedef struct {
   Fmu fmu;
   Fmu3 fmu3;
@@ -41,7 +41,7 @@ typedef struct {
   const char *name, *summary;
   int (*run)(const Plant* plant, const Options* options);
   int default_batches;
-  const char* options; /* its own options beyond --fmu, --xml, --batches */
+  const char* options; /* its own options beyond --batches */
   int inverse;         /* drives the inverse FMU (PKM4PUU_Inverse) */
 } Subcommand;
 
@@ -59,8 +59,9 @@ int free_instance(const Plant* plant, int kind, void* c, fmi2FMUstate* home);
 /* The value references of names[0..n-1]; 0 after a message if one is missing. */
 int lookup_value_references(const Plant* plant, const char* const* names, size_t n, fmi2ValueReference* vr);
 
-/* A master's ticks: each sets F[k] (with dF, their slopes too), DoSteps h and gets the n_out outputs `out`,
- * kept in record (n x n_out) if given; tick_s (if given) receives each tick's time. */
+/* A master's ticks: each sets F[k] (with dF, their slopes too), DoSteps h and gets the n_out outputs `out`, kept in
+ * record ((n + 1) x n_out, the outputs before the first tick first) if given; tick_s (if given) receives each tick's
+ * time. */
 typedef struct {
   double h;
   int n;
@@ -69,13 +70,14 @@ typedef struct {
   size_t n_out;
   double *record, *tick_s;
 } Ticks;
-/* The ticks from time t0: their wall time, or < 0 after a message when a call fails. */
-double run_ticks(const Plant* plant, fmi2Component c, const Ticks* ticks, double t0);
+/* The ticks from t = 0, from the state home if given (restored untimed): their wall time, < 0 after a message when
+ * a call fails. */
+double run_ticks(const Plant* plant, fmi2Component c, fmi2FMUstate home, const Ticks* ticks);
 
 /* The one loop of the timed batches: n cases interleaved batch by batch, one warm-up batch of each first;
- * batch(ctx, i) runs a batch of case i and returns its time (<= 0 after a message on failure). The median and
+ * batch(i) runs a batch of case i and returns its time (<= 0 after a message on failure). The median and
  * minimum over the batches per case in median[i], min[i]; 0 on failure. */
-int time_cases(int n, int batches, double (*batch)(void* ctx, int i), void* ctx, double* median, double* min);
+int time_cases(int n, int batches, double (*batch)(int i), double* median, double* min);
 
 /* Returns 0 from the calling function, after a message, when an FMI call (or an || of them) does not return OK. */
 #define FMI_CHECK(call) \

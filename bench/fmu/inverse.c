@@ -28,7 +28,7 @@ static mjData* md;
 
 /* A batch of ticks of instance `kind` (a batch of mj_inverse: kind 4): the time per tick, 0 after a message on
  * failure. */
-static double time_ticks(void* ctx, int kind) {
+static double time_ticks(int kind) {
   const Fmu* f2 = &plant->fmu;
   const Fmu3* f3 = &plant->fmu3;
   fmi3Boolean event, terminate, early;
@@ -36,7 +36,6 @@ static double time_ticks(void* ctx, int kind) {
   double F[4] = {0, 0, 0, 0}, *tk = &t[kind];
   void* ci = kind < 4 ? c[kind] : NULL;
   const double t0 = bench_now();
-  (void)ctx;
   for (int k = 0; k < REPEAT * TICKS; ++k, *tk += H, sum += F[0]) {
     const double* u = motion[k % TICKS];
     if (kind == FMI2_CS)
@@ -95,7 +94,7 @@ static int inverse_run(const Plant* p, const Options* o) {
          "median and min per call over %d batches of %d calls, the cases interleaved batch by batch\n\n",
          o->batches, REPEAT * TICKS);
   for (k = 0; ok && k < 4; ++k) ok = (c[k] = instantiate(p, k, kind_names[k], -1, 0, NULL, NULL, NULL)) != NULL;
-  ok = ok && time_cases(4 + have_mj, o->batches, time_ticks, NULL, med, mn);
+  ok = ok && time_cases(4 + have_mj, o->batches, time_ticks, med, mn);
   for (k = 0; k < 4; ++k)
     if (c[k]) free_instance(p, k, c[k], NULL);
 #if PKM_HAVE_MUJOCO

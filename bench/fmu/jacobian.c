@@ -21,12 +21,11 @@ static pkm_model* m;
 static double J[N_CASES][N_UNKNOWNS * N_KNOWNS]; /* each case's last full Jacobian (8 x 20, row-major) */
 
 /* One batch of EVALS full Jacobians: the time per Jacobian, 0 on failure. */
-static double batch(void* ctx, int kind) {
+static double batch(int kind) {
   double x[10], seed[N_KNOWNS] = {0}, col[N_UNKNOWNS], A[64], B[96], ydot[8], seconds;
   const double inputs[12] = {STATIC_FORCE, STATIC_FORCE, STATIC_FORCE, STATIC_FORCE}, one = 1.0;
   const int single = kind == CASE_SINGLE || kind == CASE_SINGLE_OVERHEAD;
   const int moving = kind == CASE_FMI || kind == CASE_SINGLE || kind == CASE_CAPI;
-  (void)ctx;
   memcpy(x, kState, sizeof x);
   if (!moving) FMI_CHECK(f->fmi2SetContinuousStates(c, x, 10));
   seconds = bench_now();
@@ -67,7 +66,7 @@ static int jacobian_run(const Plant* plant, const Options* o) {
            lookup_value_references(plant, known_names, N_KNOWNS, knowns);
   f = &plant->fmu;
   ok = ok && pkm_create(&m) == PKM_OK && (c = instantiate(plant, FMI2_ME, "jacobian", -1, 0, NULL, NULL, NULL));
-  ok = ok && time_cases(N_CASES, o->batches, batch, NULL, med, mn);
+  ok = ok && time_cases(N_CASES, o->batches, batch, med, mn);
   if (c && !free_instance(plant, FMI2_ME, c, NULL)) ok = 0;
   pkm_destroy(m);
   if (!ok) return 0;

@@ -14,19 +14,17 @@ static int usage_error(const char* what, const char* arg) {
   return 2;
 }
 
-/* The options after the subcommand (the common ones, or a word of sub->options); 0, or 2 after a message. */
+/* The options after the subcommand (--batches, or a word of sub->options); 0, or 2 after a message. */
 static int parse_options(const Subcommand* sub, int argc, char** argv, Options* o) {
   for (int i = 2; i < argc; i += 2) {
     const char *opt = argv[i], *value = i + 1 < argc ? argv[i + 1] : NULL, *own = strstr(sub->options, opt);
-    const char** const targets[] = {&o->so, &o->xml, &o->out, &o->mjcf, &o->state};
-    const char* const names[] = {"--fmu", "--xml", "--out", "--mjcf", "--state"};
     char* end = NULL;
-    if (strncmp(opt, "--", 2) != 0 || (strcmp(opt, "--fmu") != 0 && strcmp(opt, "--xml") != 0 &&
-                                       strcmp(opt, "--batches") != 0 && !(own && own[strlen(opt)] == ' ')))
+    if (strncmp(opt, "--", 2) != 0 || (strcmp(opt, "--batches") != 0 && !(own && own[strlen(opt)] == ' ')))
       return usage_error(opt[0] == '-' ? "unknown option" : "unexpected argument", opt);
     if (!value) return usage_error("missing value after", opt);
-    for (size_t k = 0; k < 5; ++k)
-      if (strcmp(opt, names[k]) == 0) *targets[k] = value;
+    if (strcmp(opt, "--out") == 0) o->out = value;
+    if (strcmp(opt, "--mjcf") == 0) o->mjcf = value;
+    if (strcmp(opt, "--state") == 0) o->state = value;
     if (strcmp(opt, "--batches") == 0 && ((o->batches = (int)strtol(value, &end, 10)), *end || o->batches < 1 ||
                                           o->batches > 100000))
       return usage_error("--batches out of range", value);
@@ -36,10 +34,12 @@ static int parse_options(const Subcommand* sub, int argc, char** argv, Options* 
   return 0;
 }
 
-/* The binary's functions and what the subcommand needs of its model description; 0 after a message. */
-static int load(const Subcommand* sub, const char* xml, Plant* p) {
-  const char* root = p->text ? strstr(p->text, "<fmiModelDescription") : NULL;
+/* The build's binary, its functions and what the subcommand needs of its model description; 0 after a message. */
+static int load(const Subcommand* sub, Plant* p) {
+  const char* xml = sub->inverse ? PKM_FMU_INVERSE_XML : PKM_FMU_PLANT_XML;
+  const char* root = (p->text = read_text(xml)) ? strstr(p->text, "<fmiModelDescription") : NULL;
   int ok;
+  p->so = sub->inverse ? PKM_FMU_INVERSE_SO : PKM_FMU_PLANT_SO;
   if (!p->text) return fprintf(stderr, "pkm_fmu_bench: cannot read the model description %s\n", xml), 0;
   if (sub->inverse)
     ok = root && attribute(root, strchr(root, '>'), "guid", p->guid, sizeof p->guid);
@@ -55,32 +55,25 @@ static int load(const Subcommand* sub, const char* xml, Plant* p) {
 
 int main(int argc, char** argv) {
   const Subcommand* sub = NULL;
-  Options o = {NULL, NULL, NULL, NULL, NULL, 0, 3.0};
+  Options o = {NULL, NULL, NULL, 0, 3.0};
   Plant plant;
   int ok;
   if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
     FILE* fp = argc < 2 ? stderr : stdout;
-    fprintf(fp, "usage: pkm_fmu_bench SUBCOMMAND [--fmu SO] [--xml modelDescription.xml] [--batches N] [options]\n\n");
+    fprintf(fp, "usage: pkm_fmu_bench SUBCOMMAND [--batches N] [options] (the build's FMU binaries)\n\n");
     for (size_t i = 0; i < N_SUBCOMMANDS; ++i)
       fprintf(fp, "  %-9s %s\n            --batches N (default %d)%s%s\n", subcommands[i]->name,
               subcommands[i]->summary, subcommands[i]->default_batches, *subcommands[i]->options ? "; " : "",
               subcommands[i]->options);
-    fprintf(fp, "\n--fmu: default the build's binary; --xml: its model description (needed with another binary)\n");
     return argc < 2 ? 2 : 0;
   }
   for (size_t i = 0; i < N_SUBCOMMANDS; ++i)
     if (strcmp(argv[1], subcommands[i]->name) == 0) sub = subcommands[i];
   if (!sub) return usage_error("unknown subcommand", argv[1]);
   o.batches = sub->default_batches;
-  o.so = sub->inverse ? PKM_FMU_INVERSE_SO : PKM_FMU_PLANT_SO;
   if (parse_options(sub, argc, argv, &o) != 0) return 2;
-  if (!o.xml && strcmp(o.so, sub->inverse ? PKM_FMU_INVERSE_SO : PKM_FMU_PLANT_SO) != 0)
-    return usage_error("--fmu other than the build's needs --xml", o.so);
-  if (!o.xml) o.xml = sub->inverse ? PKM_FMU_INVERSE_XML : PKM_FMU_PLANT_XML;
   memset(&plant, 0, sizeof plant);
-  plant.so = o.so;
-  plant.text = read_text(o.xml);
-  ok = load(sub, o.xml, &plant);
+  ok = load(sub, &plant);
   if (ok) {
     printf("pkm_fmu_bench %s: %s\n", sub->name, sub->summary);
     bench_print_machine();
@@ -152,12 +145,12 @@ int lookup_value_references(const Plant* plant, const char* const* names, size_t
   return 1;
 }
 
-int time_cases(int n, int batches, double (*batch)(void* ctx, int i), void* ctx, double* median, double* min) {
+int time_cases(int n, int batches, double (*batch)(int i), double* median, double* min) {
   double* per = malloc(sizeof(double) * (size_t)n * (size_t)batches); /* [case][batch] */
   int ok = per != NULL;
   for (int b = -1; ok && b < batches; ++b)
     for (int i = 0; ok && i < n; ++i) {
-      const double s = batch(ctx, i);
+      const double s = batch(i);
       ok = s > 0.0;
       if (b >= 0) per[i * batches + b] = s;
     }
@@ -166,22 +159,23 @@ int time_cases(int n, int batches, double (*batch)(void* ctx, int i), void* ctx,
   return ok;
 }
 
-double run_ticks(const Plant* plant, fmi2Component c, const Ticks* t, double t0) {
+double run_ticks(const Plant* plant, fmi2Component c, fmi2FMUstate home, const Ticks* t) {
   static const fmi2Integer order[4] = {1, 1, 1, 1};
   const Fmu* f = &plant->fmu;
-  double y[256];
-  const double start = bench_now();
-  for (int k = 0; k < t->n; ++k) {
+  double y[256], *out = t->record ? t->record : y, start;
+  int k = 0;
+  fmi2Status s = home ? f->fmi2SetFMUstate(c, home) : fmi2OK;
+  if (s == fmi2OK && t->record) s = f->fmi2GetReal(c, t->out, t->n_out, t->record);
+  start = bench_now();
+  for (; s == fmi2OK && k < t->n; ++k) {
     const double tick = t->tick_s ? bench_now() : 0.0;
-    fmi2Status s = f->fmi2SetReal(c, plant->F, 4, t->F[k]);
+    s = f->fmi2SetReal(c, plant->F, 4, t->F[k]);
     if (s == fmi2OK && t->dF) s = f->fmi2SetRealInputDerivatives(c, plant->F, 4, order, t->dF[k]);
-    if (s == fmi2OK) s = f->fmi2DoStep(c, t0 + k * t->h, t->h, fmi2True);
-    if (s == fmi2OK && t->n_out) s = f->fmi2GetReal(c, t->out, t->n_out, t->record ? t->record + k * t->n_out : y);
+    if (s == fmi2OK) s = f->fmi2DoStep(c, k * t->h, t->h, fmi2True);
+    if (s == fmi2OK && t->n_out) s = f->fmi2GetReal(c, t->out, t->n_out, out + (t->record ? (k + 1) * t->n_out : 0));
     if (t->tick_s) t->tick_s[k] = bench_now() - tick;
-    if (s != fmi2OK) {
-      fprintf(stderr, "pkm_fmu_bench: a call of tick %d (t = %g s) returned %s\n", k, t0 + k * t->h, status_name(s));
-      return -1.0;
-    }
   }
-  return bench_now() - start;
+  if (s == fmi2OK) return bench_now() - start;
+  fprintf(stderr, "pkm_fmu_bench: a call of tick %d of %d (0: the start) returned %s\n", k, t->n, status_name(s));
+  return -1.0;
 }
