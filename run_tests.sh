@@ -24,6 +24,15 @@ setup_log=build/setup.log
 ./scripts/setup.sh >"$setup_log" 2>&1 &
 setup_pid=$!
 sanitized_log=build/sanitized_tests.log
+# Every suite's results (JUnit XML: ctest's, pytest's, and those of the
+# sanitized checks' own pytest and googletest runs, which write here when
+# PKM_TEST_RESULTS is set) for the summary of skipped tests at the end
+# (scripts/skipped_tests.py). An earlier run's are removed first: a part
+# that did not run shows as such.
+export PKM_TEST_RESULTS="$PWD/build/test_results"
+results=$PKM_TEST_RESULTS
+rm -rf "$results"
+mkdir -p "$results"
 # In a process group of its own (setsid), so that a failure before the end
 # stops the whole run (ctest, the script, the compilers) and leaves nothing
 # behind. A new session is also a new scheduling group where the kernel
@@ -36,9 +45,11 @@ ready=build/.main_build_done
 rm -f "$ready"
 setsid bash -c 'echo 10 >/proc/self/autogroup 2>/dev/null || true
   late="hardening_sanitized_fmpy|hardening_sanitized_fmi_tests"
-  nice -n 10 ctest --test-dir build --output-on-failure --no-tests=error -j2 -L sanitized -E "$late" || exit 1
+  nice -n 10 ctest --test-dir build --output-on-failure --no-tests=error -j2 -L sanitized -E "$late" \
+    --output-junit "$PKM_TEST_RESULTS/ctest_sanitized.xml" || exit 1
   while [ ! -f "$0" ]; do sleep 2; done
-  exec nice -n 10 ctest --test-dir build --output-on-failure --no-tests=error -j2 -R "$late"' \
+  exec nice -n 10 ctest --test-dir build --output-on-failure --no-tests=error -j2 -R "$late" \
+    --output-junit "$PKM_TEST_RESULTS/ctest_sanitized_late.xml"' \
   "$ready" >"$sanitized_log" 2>&1 &
 sanitized_pid=$!
 trap 'kill -- -"$sanitized_pid" 2>/dev/null || true; kill "$setup_pid" 2>/dev/null || true' EXIT
@@ -51,11 +62,11 @@ fi
 cat "$setup_log" >&2
 touch "$ready"
 # --no-tests=error: a build that registered no test must fail, not pass silently.
-ctest --test-dir build --output-on-failure -j2 --no-tests=error -LE sanitized
+ctest --test-dir build --output-on-failure -j2 --no-tests=error -LE sanitized --output-junit "$results/ctest.xml"
 status=0
 # Only call pytest when there are tests, so its exit code 5 (no tests) cannot occur.
 if compgen -G "python_checks/test_*.py" >/dev/null; then
-  .venv/bin/python -m pytest -q python_checks || status=$?
+  .venv/bin/python -m pytest -q python_checks --junitxml="$results/pytest.xml" || status=$?
 else
   echo "run_tests: no python_checks/test_*.py, pytest skipped" >&2
 fi
@@ -69,4 +80,8 @@ else
   status=1
 fi
 trap - EXIT
+# What did not run, and why (a check whose tool is missing skips, and says so here).
+.venv/bin/python scripts/skipped_tests.py ctest="$results/ctest.xml" pytest="$results/pytest.xml" \
+  "ctest sanitized=$results/ctest_sanitized.xml" "ctest sanitized checks=$results/ctest_sanitized_late.xml" \
+  "pytest sanitized=$results/pytest_sanitized.xml" "gtest sanitized=$results/gtest_sanitized" >&2
 exit "$status"

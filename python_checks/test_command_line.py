@@ -23,12 +23,18 @@ from pkm4puu.program import writable_dir
 REPORTS = ["autotest", "comparison", "engines", "cycle"]
 
 
-def run_cli(*args, cwd):
+# Runs a command as a user who obeys file permissions, root included.
+WITHOUT_PRIVILEGES = Path(__file__).resolve().parents[1] / "tests" / "without_privileges.sh"
+
+
+def run_cli(*args, cwd, unprivileged=False):
     """python -m pkm4puu ARGS in cwd, with a build directory that does not
-    exist: a command that got past its arguments would fail with status 1."""
+    exist: a command that got past its arguments would fail with status 1.
+    `unprivileged`: through WITHOUT_PRIVILEGES (root without its capabilities)."""
     env = {**os.environ, locate.BUILD_ENV: str(cwd / "no-build")}
-    return subprocess.run([sys.executable, "-m", "pkm4puu", *args], capture_output=True, text=True, cwd=cwd,
-                          env=env, timeout=120)
+    runner = [str(WITHOUT_PRIVILEGES)] if unprivileged else []
+    return subprocess.run([*runner, sys.executable, "-m", "pkm4puu", *args], capture_output=True, text=True,
+                          cwd=cwd, env=env, timeout=120)
 
 
 def refused(proc, *names):
@@ -54,13 +60,15 @@ def test_out_under_a_file_is_refused(tmp_path, command):
     assert refused(run_cli(command, "--out", str(afile / "results"), cwd=tmp_path), "--out", afile / "results")
 
 
-@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into a read-only directory")
 @pytest.mark.parametrize("command", REPORTS)
 def test_out_in_a_read_only_directory_is_refused(tmp_path, command):
+    """As an ordinary user and as root (who, without its capabilities, meets
+    the read-only directory as everyone else does)."""
     ro = tmp_path / "read_only"
     ro.mkdir(mode=0o555)
     try:
-        assert refused(run_cli(command, "--out", str(ro / "results"), cwd=tmp_path), "--out", "not writable")
+        proc = run_cli(command, "--out", str(ro / "results"), cwd=tmp_path, unprivileged=True)
+        assert refused(proc, "--out", f"{ro / 'results'}: {ro} is not writable")
     finally:
         ro.chmod(0o755)
 

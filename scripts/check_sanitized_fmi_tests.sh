@@ -42,6 +42,8 @@ logs="$tree/fmi-tests"
 rm -rf "$logs" && mkdir -p "$logs"
 export LD_PRELOAD="$sanitizer_runtime" PKM_FMU_BINARIES="$binaries"
 export GTEST_FILTER='-Stepping.AStepTooLongForCvodeIsDiscarded'
+# Their results for the test command's summary of skipped tests (run_tests.sh).
+[ -z "${PKM_TEST_RESULTS:-}" ] || export GTEST_OUTPUT="xml:$PKM_TEST_RESULTS/gtest_sanitized/"
 echo "check_sanitized_fmi_tests: ${#programs[@]} programs against $binaries (logs: $logs)" >&2
 # Two at a time; each program's log is printed if it fails.
 printf '%s\n' "${programs[@]}" | xargs -P 2 -I{} bash -c '

@@ -30,7 +30,10 @@ ctypes.CDLL(os.path.join(d, 'binaries', 'linux64', 'PKM4PUU.so'))" 2>/dev/null; 
 fi
 export LD_PRELOAD="$sanitizer_runtime"
 export PKM_BUILD_DIR="$tree"
-exec .venv/bin/python -m pytest -q -p no:cacheprovider \
+# Its results for the test command's summary of skipped tests (run_tests.sh).
+junit=()
+[ -z "${PKM_TEST_RESULTS:-}" ] || junit=(--junitxml="$PKM_TEST_RESULTS/pytest_sanitized.xml")
+exec .venv/bin/python -m pytest -q -p no:cacheprovider "${junit[@]}" \
   python_checks/test_fmu_autotest.py python_checks/test_fmu_comparison.py python_checks/test_fmu_derivatives.py \
   python_checks/test_fmu_flavours.py python_checks/test_fmu_instances.py python_checks/test_fmu_interface.py \
   python_checks/test_fmu_machine.py python_checks/test_fmu_model_exchange.py python_checks/test_fmu_state.py \

@@ -3,24 +3,22 @@
 #   -DPROGRAM=<path> -DARGS=<arguments, separated by |> -DEXIT=<expected status>
 #   [-DSTDERR=<regex stderr must match>] [-DSTDOUT=<regex stdout must match>]
 #   [-DNOT_STDOUT=<regex stdout must not match>] [-DREMOVE=<path> removed first]
-#   [-DREAD_ONLY_DIR=<path>: created read-only first; skipped ("SKIPPED:") as
-#    root, who can write into it anyway]
+#   [-DREAD_ONLY_DIR=<path>: created read-only first; the program then runs
+#    through without_privileges.sh, so that it is read-only to root too]
 #   [-DFILE=<path> -DFILE_MATCHES=<regex its content must match>]
 string(REPLACE "|" ";" args "${ARGS}")
 if(DEFINED REMOVE)
   file(REMOVE_RECURSE "${REMOVE}")
 endif()
+set(runner)
 if(DEFINED READ_ONLY_DIR)
-  execute_process(COMMAND id -u OUTPUT_VARIABLE uid OUTPUT_STRIP_TRAILING_WHITESPACE)
-  if(uid STREQUAL "0")
-    message("SKIPPED: as root, a read-only directory is writable")
-    return()
-  endif()
   file(REMOVE_RECURSE "${READ_ONLY_DIR}")
   file(MAKE_DIRECTORY "${READ_ONLY_DIR}")
   file(CHMOD "${READ_ONLY_DIR}" PERMISSIONS OWNER_READ OWNER_EXECUTE)
+  set(runner "${CMAKE_CURRENT_LIST_DIR}/without_privileges.sh")
 endif()
-execute_process(COMMAND "${PROGRAM}" ${args} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 300)
+execute_process(COMMAND ${runner} "${PROGRAM}" ${args} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err
+                TIMEOUT 300)
 message("exit status ${rc}\nstdout:\n${out}\nstderr:\n${err}")
 if(DEFINED READ_ONLY_DIR)
   file(CHMOD "${READ_ONLY_DIR}" PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE)

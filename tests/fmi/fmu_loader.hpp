@@ -23,6 +23,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <sstream>
@@ -164,6 +165,9 @@ struct LogMessage {
 /// Collects the FMU's log messages (thread-safe: one Log per instance).
 struct Log {
   std::vector<LogMessage> messages;
+  /// Called with each message once collected, in the thread that logged it
+  /// (a test can wait there: the FMU is inside the call that logs).
+  std::function<void(const LogMessage&)> on_message;
   bool contains(const std::string& s) const {
     for (const auto& m : messages)
       if (m.text.find(s) != std::string::npos) return true;
@@ -186,7 +190,9 @@ inline void collect_log(fmi2ComponentEnvironment env, fmi2String, fmi2Status sta
   va_start(args, message);
   std::vsnprintf(text, sizeof text, message ? message : "", args);
   va_end(args);
-  static_cast<Log*>(env)->messages.push_back({status, category ? category : "", text});
+  Log& log = *static_cast<Log*>(env);
+  log.messages.push_back({status, category ? category : "", text});
+  if (log.on_message) log.on_message(log.messages.back());
 }
 
 inline fmi2ValueReference vr_of(const pkm_fmi::ModelDefinition& d, const std::string& name) {

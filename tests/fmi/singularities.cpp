@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <set>
 #include <string>
@@ -277,14 +278,26 @@ SpecGuards spec_guards(double x, double y, double phi) {
   return g;
 }
 
-// Leg 2's rod turns horizontal at x = 0.0231306807897694 m
-// (y = 0, z = 0.05 m, phi = 0); with dx = 0.01 m/s the inverse FMU used to
+/// Where leg `i`'s rod turns horizontal (theta2 = 0) as the platform moves
+/// along +x from home (y = 0, phi = 0; z does not enter): in spec_guards'
+/// terms A = l, so (x + d_x(0))^2 + d_y^2 - h'^2 = l^2, d_y being constant
+/// along x: x = sqrt(l^2 + h'^2 - d_y^2) - d_x(0).
+double x_rod_horizontal(int i) {
+  const ref::RefParams p;
+  const int k = i - 1;
+  const double dx0 = p.r_Q * std::cos(p.beta[k] + p.gamma[k]) - p.r_b * std::cos(p.beta[k]);
+  const double dy = p.r_Q * std::sin(p.beta[k] + p.gamma[k]) - p.r_b * std::sin(p.beta[k]);
+  return std::sqrt(p.l * p.l + p.h_prime * p.h_prime - dy * dy) - dx0;
+}
+
+// Leg 2's rod turns horizontal at x = x_rod_horizontal(2) (0.0231 m;
+// y = 0, z = 0.05 m, phi = 0); with dx = 0.01 m/s the inverse FMU used to
 // answer fmi2OK with forces of -1.1e19 N. Approaching that pose along x,
 // every answer must follow the guards as computed from the spec: OK with
 // leg_measure_min and jacobian_condition equal to the spec's within the
 // limits, fmi2Discard with the reason and the last good outputs beyond.
 TEST(HardeningSingularities, InverseFmuDiscardsPosesBeyondTheGuardsWithTheLastGoodOutputs) {
-  const double x_singular = 0.0231306807897694;
+  const double x_singular = x_rod_horizontal(2);
   struct Case {
     double max_condition, min_measure;
   };
@@ -347,8 +360,10 @@ TEST(HardeningSingularities, InverseFmuDiscardsPosesBeyondTheGuardsWithTheLastGo
     ASSERT_EQ(inv.step(0.0, 1e-3), fmi2OK) << inv.log.dump();
     std::string said;
     for (const std::string& r : reasons) said += (said.empty() ? "\"" : "\" / \"") + r + " ...";
-    table_row(std::string("inverse FMU, dx = 0.01 m/s, x -> 0.0231306807897694 m (leg 2's rod horizontal); "
-                          "max_jacobian_condition = ") + std::to_string(c.max_condition),
+    char toward[120];
+    std::snprintf(toward, sizeof toward, "inverse FMU, dx = 0.01 m/s, x -> %.16g m (leg 2's rod horizontal); ",
+                  x_singular);
+    table_row(std::string(toward) + "max_jacobian_condition = " + std::to_string(c.max_condition),
               std::to_string(ok) + " poses within the guards fmi2OK (|F| <= " + std::to_string(worst_force) +
                   " N), " + std::to_string(discarded) + " beyond fmi2Discard " + said + "\"",
               "yes: the last good outputs handed out again; back home the static forces");
@@ -356,33 +371,54 @@ TEST(HardeningSingularities, InverseFmuDiscardsPosesBeyondTheGuardsWithTheLastGo
 }
 
 TEST(HardeningSingularities, FmpyStopsAtTheLastSuccessfulTime) {
+  // kDrives[0] through fmpy.simulate_fmu (stop_time 1 s) and through this
+  // file's own drive, which reads fmi2LastSuccessfulTime from the FMU at
+  // the default rk4_step. fmpy must end its result there: one row at
+  // t = 0, one per successful step, the last successful time once more.
   if (!have_fmpy()) GTEST_SKIP() << "no Python with fmpy (PKM_FMU_PYTHON)";
+  const Drive& d = kDrives[0];
+  const double rk4_step = pkm_fmi::pkm4puu_definition().find("rk4_step")->start;
+  char drive[300];
+  std::snprintf(drive, sizeof drive,
+                "step_size=%.17g, start_values={'F[1]': %.17g, 'F[2]': %.17g, 'F[3]': %.17g, 'F[4]': %.17g, ",
+                d.step, d.F[0], d.F[1], d.F[2], d.F[3]);
   const std::string script =
       "import math, fmpy\n"
-      "F = 2.655616050\n"
       "for solver in (0, 1):\n"
-      "    r = fmpy.simulate_fmu('" PKM_FMU_PLANT_FMU "', stop_time=1.0, step_size=1e-3,\n"
-      "        start_values={'F[1]': F + 1.0, 'F[2]': F, 'F[3]': F - 1.0, 'F[4]': F, 'solver': solver},\n"
+      "    r = fmpy.simulate_fmu('" PKM_FMU_PLANT_FMU "', stop_time=1.0, " + std::string(drive) + "'solver': solver},\n"
       "        output=['x', 'y', 'z', 'phi', 'rho[4]', 'theta2[4]', 'jacobian_condition'])\n"
       "    finite = all(math.isfinite(v) for row in r for v in row)\n"
-      "    print('RESULT', solver, len(r), r['time'][-1], int(finite))\n";
+      "    print('RESULT', solver, len(r), repr(float(r['time'][-1])), int(finite))\n";
   int status = 0;
   const std::string out = pkm_test::run_python(script, &status);
   ASSERT_EQ(status, 0) << out;
+  std::string ends;
   for (int solver : {0, 1}) {
+    SCOPED_TRACE(solver == 0 ? "CVODE" : "RK4");
+    Outcome o;
+    run_into_singularity(d, solver, rk4_step, o);
+    if (HasFatalFailure()) return;
     const std::string key = "RESULT " + std::to_string(solver) + " ";
     const std::size_t at = out.find(key);
     ASSERT_NE(at, std::string::npos) << out;
     int rows = 0, finite = 0;
     double t_end = 0;
     ASSERT_EQ(std::sscanf(out.c_str() + at + key.size(), "%d %lf %d", &rows, &t_end, &finite), 3) << out;
-    EXPECT_NEAR(t_end, 0.193, 1e-9) << "fmpy stopped at fmi2LastSuccessfulTime, not at stop_time\n" << out;
+    // fmpy's communication points are k * step_size, the drive's sums of
+    // steps: equal within the FMU's own time tolerance (1e-9 s near t = 0).
+    EXPECT_NEAR(t_end, o.last, 1e-9) << "fmpy did not stop at fmi2LastSuccessfulTime\n" << out;
+    EXPECT_LT(t_end, 1.0) << "fmpy ran to stop_time";
     EXPECT_EQ(finite, 1) << "no NaN in fmpy's result";
-    EXPECT_EQ(rows, 195) << "t = 0, 0.001, ..., 0.193, and the last successful time once more";
+    EXPECT_EQ(rows, std::lround(o.last / d.step) + 2) << "t = 0, one row per successful step, the last successful "
+                                                         "time once more";
+    char said[80];
+    std::snprintf(said, sizeof said, "%s%s %.3f s (%d rows)", ends.empty() ? "" : ", ", solver == 0 ? "CVODE" : "RK4",
+                  t_end, rows);
+    ends += said;
   }
-  table_row("fmpy.simulate_fmu, stop_time 1 s, F[1] = Fs + 1 N, F[3] = Fs - 1 N (CVODE and RK4)",
+  table_row(std::string("fmpy.simulate_fmu, stop_time 1 s: ") + d.name + " (CVODE and RK4)",
             "fmpy reads fmi2Terminated = true after the fmi2Discard and ends the run (no exception, no retry loop)",
-            "yes: result ends at t = 0.193 s = fmi2LastSuccessfulTime, every value finite");
+            "yes: result ends at fmi2LastSuccessfulTime (" + ends + "), every value finite");
 }
 
 }  // namespace

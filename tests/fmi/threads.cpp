@@ -8,7 +8,9 @@
 // the second call with fmi2Error instead of racing the first.
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstring>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -157,77 +159,108 @@ TEST(HardeningThreads, TheBinariesHaveNoMutableStaticDataOfTheirOwn) {
             "instances share nothing mutable");
 }
 
-/// The 50 ms step from t = 0 of `p` (slow_rk4: about 0.1 s) in a thread of
-/// its own, under way (5 ms in) when the constructor returns.
+/// The 50 ms step from t = 0 of `p` in a thread of its own, held inside
+/// fmi2DoStep from the constructor's return until finish(): the step's
+/// first log message (category logCalls, "fmi2DoStep(t, h)", logged inside
+/// the call) arrives in the stepping thread, which waits there. So the
+/// other thread's calls meet a step under way, however loaded the machine.
 class StepInAnotherThread {
  public:
-  explicit StepInAnotherThread(PlantFmu& p)
-      : thread_([this, &p] {
-          started_ = true;
-          status_ = p.step(0.0, 0.05);
-          done = true;
-        }) {
-    while (!started_) std::this_thread::yield();
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  explicit StepInAnotherThread(PlantFmu& p) : p_(p) {
+    EXPECT_EQ(p.lib.fmi2SetDebugLogging(p.c, fmi2True, 1, kCalls), fmi2OK) << p.log.dump();
+    p.log.on_message = [this](const LogMessage& m) {
+      if (m.text.rfind("fmi2DoStep(", 0) != 0) return;  // not the step's: another thread's, go on
+      std::unique_lock<std::mutex> lock(mutex_);
+      inside_ = true;
+      changed_.notify_all();
+      changed_.wait(lock, [this] { return released_; });
+    };
+    thread_ = std::thread([this] { status_ = p_.step(0.0, 0.05); });
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait_for(lock, std::chrono::seconds(60), [this] { return inside_; });
+  }
+  /// The step logged its call and waits inside fmi2DoStep (false if it did
+  /// not within a minute).
+  bool inside() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return inside_;
   }
   ~StepInAnotherThread() {
-    if (thread_.joinable()) thread_.join();
+    if (thread_.joinable()) finish();
   }
   StepInAnotherThread(const StepInAnotherThread&) = delete;
   StepInAnotherThread& operator=(const StepInAnotherThread&) = delete;
-  /// Waits for the step; its status.
-  fmi2Status join() {
+  /// Lets the step go on and waits for it; its status. Call logging off again.
+  fmi2Status finish() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      released_ = true;
+    }
+    changed_.notify_all();
     thread_.join();
+    p_.log.on_message = nullptr;
+    EXPECT_EQ(p_.lib.fmi2SetDebugLogging(p_.c, fmi2False, 1, kCalls), fmi2OK) << p_.log.dump();
     return status_;
   }
-  std::atomic<bool> done{false};
 
  private:
-  std::atomic<bool> started_{false};
+  static constexpr fmi2String kCalls[1] = {"logCalls"};
+  PlantFmu& p_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  bool inside_ = false, released_ = false;
   fmi2Status status_ = fmi2Fatal;
-  std::thread thread_;  // last: starts when the members above are set
+  std::thread thread_;
 };
 
 TEST(HardeningThreads, ASecondThreadOnTheSameInstanceIsRefused) {
-  // RK4 at 1 us: a 50 ms step takes 5e4 RK4 steps (about 0.1 s), during
-  // which another thread reads the instance.
+  // While another thread is inside a 50 ms fmi2DoStep (RK4 at 1 us, 5e4 RK4
+  // steps once it goes on), this thread reads the instance: every read is
+  // refused.
   PlantFmu p("shared"), twin("twin");
   for (PlantFmu* q : {&p, &twin}) slow_rk4(*q);
-  StepInAnotherThread stepper(p);
   const fmi2ValueReference x = p.vr("x");
-  int refused = 0, answered = 0;
-  while (!stepper.done && refused < 1000) {
-    double v = 0.0;
-    (p.lib.fmi2GetReal(p.c, &x, 1, &v) == fmi2Error ? refused : answered) += 1;
+  constexpr int kReads = 100;
+  int refused = 0;
+  {
+    StepInAnotherThread stepper(p);
+    ASSERT_TRUE(stepper.inside()) << p.log.dump();
+    for (int k = 0; k < kReads; ++k) {
+      double v = 0.0;
+      refused += p.lib.fmi2GetReal(p.c, &x, 1, &v) == fmi2Error;
+    }
+    ASSERT_EQ(stepper.finish(), fmi2OK) << p.log.dump();
   }
-  ASSERT_EQ(stepper.join(), fmi2OK) << p.log.dump();
-  EXPECT_GT(refused, 0) << answered << " reads answered during the step";
-  EXPECT_TRUE(p.log.contains("called while another call on this instance is running")) << p.log.dump();
+  EXPECT_EQ(refused, kReads) << p.log.dump();
+  EXPECT_TRUE(p.log.contains("fmi2GetReal: called while another call on this instance is running")) << p.log.dump();
   // The step itself was not disturbed.
   ASSERT_EQ(twin.step(0.0, 0.05), fmi2OK);
   EXPECT_TRUE(bit_identical(p.outputs(), twin.outputs()));
-  table_row("one instance from two threads: fmi2GetReal in a loop while another thread runs a 50 ms fmi2DoStep",
-            "the reads during the step: fmi2Error \"called while another call on this instance is running (from "
-            "another thread?)\" (" + std::to_string(refused) + " refused, " + std::to_string(answered) +
-                " answered before or after)",
+  table_row("one instance from two threads: fmi2GetReal in a loop while another thread is inside a 50 ms "
+            "fmi2DoStep",
+            "every read during the step: fmi2Error \"called while another call on this instance is running (from "
+            "another thread?)\" (" + std::to_string(refused) + " of " + std::to_string(kReads) + " refused)",
             "yes: the step completes bit-identical to an undisturbed twin's");
 }
 
 TEST(HardeningThreads, FreeingAnInstanceWhileAnotherThreadStepsItIsRefused) {
-  // As above: a 50 ms step of about 0.1 s, during which another thread frees
-  // the instance. Deleting it would pull the memory from under the step.
+  // As above: another thread frees the instance while the step is under
+  // way. Deleting it would pull the memory from under the step.
   PlantFmu p("shared"), twin("twin");
   for (PlantFmu* q : {&p, &twin}) slow_rk4(*q);
-  StepInAnotherThread stepper(p);
-  p.lib.fmi2FreeInstance(p.c);
-  ASSERT_EQ(stepper.join(), fmi2OK) << p.log.dump();
+  {
+    StepInAnotherThread stepper(p);
+    ASSERT_TRUE(stepper.inside()) << p.log.dump();
+    p.lib.fmi2FreeInstance(p.c);
+    ASSERT_EQ(stepper.finish(), fmi2OK) << p.log.dump();
+  }
   EXPECT_TRUE(p.log.contains("fmi2FreeInstance: called while another call on this instance is running"))
       << p.log.dump();
   // Still alive and undisturbed: it answers, equal to the twin, and is freed
   // at the end of the test (PlantFmu's destructor; valgrind's run checks leaks).
   ASSERT_EQ(twin.step(0.0, 0.05), fmi2OK);
   EXPECT_TRUE(bit_identical(p.outputs(), twin.outputs()));
-  table_row("fmi2FreeInstance from a second thread while a 50 ms fmi2DoStep runs",
+  table_row("fmi2FreeInstance from a second thread while it is inside a 50 ms fmi2DoStep",
             "refused with an error \"called while another call on this instance is running\"; the instance "
             "stays alive",
             "yes: the step completes bit-identical to an undisturbed twin's; a later FreeInstance frees it");

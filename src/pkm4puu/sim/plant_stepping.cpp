@@ -13,6 +13,7 @@
 #include "pkm4puu/dynamics/lagrangian.hpp"
 #include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
 #include "pkm4puu/kinematics/actuator_positions.hpp"
+#include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/sim/fixed_step_stability.hpp"
 #include "pkm4puu/sim/plant.hpp"
 
