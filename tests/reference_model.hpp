@@ -161,6 +161,18 @@ inline double potential_energy(const RefParams& p, const Q& q) {
   return V + p.m_platform * p.g * q(14) + p.payload_mass * p.g * payload_com_world(p, q)(2);
 }
 
+/// Where leg `i`'s rod turns horizontal (theta2 = 0) as the platform moves
+/// along +x from home (y = 0, phi = 0; z does not enter): in spec_guards'
+/// terms A = l, so (x + d_x(0))^2 + d_y^2 - h'^2 = l^2, d_y being constant
+/// along x: x = sqrt(l^2 + h'^2 - d_y^2) - d_x(0).
+inline double x_rod_horizontal(int i) {
+  const RefParams p;
+  const int k = i - 1;
+  const double dx0 = p.r_Q * std::cos(p.beta[k] + p.gamma[k]) - p.r_b * std::cos(p.beta[k]);
+  const double dy = p.r_Q * std::sin(p.beta[k] + p.gamma[k]) - p.r_b * std::sin(p.beta[k]);
+  return std::sqrt(p.l * p.l + p.h_prime * p.h_prime - dy * dy) - dx0;
+}
+
 }  // namespace ref
 
 #endif  // PKM4PUU_TESTS_REFERENCE_MODEL_HPP

@@ -278,26 +278,14 @@ SpecGuards spec_guards(double x, double y, double phi) {
   return g;
 }
 
-/// Where leg `i`'s rod turns horizontal (theta2 = 0) as the platform moves
-/// along +x from home (y = 0, phi = 0; z does not enter): in spec_guards'
-/// terms A = l, so (x + d_x(0))^2 + d_y^2 - h'^2 = l^2, d_y being constant
-/// along x: x = sqrt(l^2 + h'^2 - d_y^2) - d_x(0).
-double x_rod_horizontal(int i) {
-  const ref::RefParams p;
-  const int k = i - 1;
-  const double dx0 = p.r_Q * std::cos(p.beta[k] + p.gamma[k]) - p.r_b * std::cos(p.beta[k]);
-  const double dy = p.r_Q * std::sin(p.beta[k] + p.gamma[k]) - p.r_b * std::sin(p.beta[k]);
-  return std::sqrt(p.l * p.l + p.h_prime * p.h_prime - dy * dy) - dx0;
-}
-
-// Leg 2's rod turns horizontal at x = x_rod_horizontal(2) (0.0231 m;
+// Leg 2's rod turns horizontal at x = ref::x_rod_horizontal(2) (0.0231 m;
 // y = 0, z = 0.05 m, phi = 0); with dx = 0.01 m/s the inverse FMU used to
 // answer fmi2OK with forces of -1.1e19 N. Approaching that pose along x,
 // every answer must follow the guards as computed from the spec: OK with
 // leg_measure_min and jacobian_condition equal to the spec's within the
 // limits, fmi2Discard with the reason and the last good outputs beyond.
 TEST(HardeningSingularities, InverseFmuDiscardsPosesBeyondTheGuardsWithTheLastGoodOutputs) {
-  const double x_singular = x_rod_horizontal(2);
+  const double x_singular = ref::x_rod_horizontal(2);
   struct Case {
     double max_condition, min_measure;
   };
