@@ -73,6 +73,14 @@ def test_out_in_a_read_only_directory_is_refused(tmp_path, command):
         ro.chmod(0o755)
 
 
+@pytest.mark.parametrize("command", REPORTS)
+def test_out_where_the_file_system_refuses_even_root_is_refused(tmp_path, command):
+    """/proc takes no new files from anyone, root included, though root passes
+    every permission check: the refusal comes before any run all the same."""
+    assert refused(run_cli(command, "--out", "/proc/pkm4puu_results", cwd=tmp_path), "--out",
+                   "/proc/pkm4puu_results: /proc is not writable")
+
+
 def test_out_that_can_be_created_is_accepted(tmp_path):
     """The check refuses what cannot be written, not what is missing yet
     (and creates nothing itself)."""

@@ -11,6 +11,7 @@ import argparse
 import math
 import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -125,8 +126,11 @@ def _unwritable_dir(path, must_exist=False):
         return "no such directory"
     if not probe.is_dir():
         return f"{probe} is not a directory"
-    if not os.access(probe, os.W_OK | os.X_OK):
-        return f"{probe} is not writable"
+    try:  # the file system's answer, not the permission bits' (root passes those, yet /proc refuses it)
+        with tempfile.TemporaryFile(dir=probe):
+            pass
+    except OSError as e:
+        return f"{probe} is not writable ({e.strerror})"
     return None
 
 
