@@ -2,9 +2,9 @@
 // The plant FMU's Model Exchange hooks (the continuous states, their
 // derivatives, the event indicators and the event update) and its partial
 // derivatives (fmiGetDirectionalDerivative).
-#include <cstring>
 
 #include "models/PKM4PUU/plant_data.hpp"
+#include "models/common/slider_partials.hpp"
 #include "pkm4puu/dynamics/reduced_dynamics_derivatives.hpp"
 #include "pkm4puu/kinematics/actuator_positions.hpp"
 #include "pkm4puu/kinematics/workspace_guard.hpp"
@@ -126,12 +126,7 @@ Status PlantData::partial_derivatives(Context& ctx, const Variable* const unknow
       }
     } else if (v.state >= 0) {
       row[v.state] = 1.0;
-    } else if (std::strncmp(v.name, "rho[", 4) == 0) {
-      row.head<4>() = joints.J_rho.row(v.index);
-    } else if (std::strncmp(v.name, "drho[", 5) == 0) {
-      row.head<4>() = joints.drhod_dp.row(v.index);
-      row.segment<4>(4) = joints.J_rho.row(v.index);
-    } else {
+    } else if (!slider_partials(v.name, v.index, joints.J_rho, joints.drhod_dp, row)) {
       ctx.log.error("%s: the partial derivatives of %s are not provided (analytic so far: the states' "
                     "derivatives, the states, rho[1..4] and drho[1..4])",
                     fn, v.name);

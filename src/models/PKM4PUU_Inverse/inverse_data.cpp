@@ -6,6 +6,7 @@
 #include <cstring>
 #include <optional>
 
+#include "models/common/slider_partials.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
 #include "pkm4puu/kinematics/constraints.hpp"
 #include "pkm4puu/kinematics/workspace_guard.hpp"
@@ -168,12 +169,7 @@ Status InverseData::partial_derivatives(Context& ctx, const Variable* const unkn
       const double scale = v.name[0] == 'F' ? 1.0 : 1.0 / m->drive_ratio;  // tau = F p / (2 pi)
       row << d.dp.row(v.index), d.dpd.row(v.index), d.dpdd.row(v.index), d.dwe.row(v.index);
       row *= scale;
-    } else if (std::strncmp(v.name, "rho[", 4) == 0) {
-      row.head<4>() = d.J_rho.row(v.index);
-    } else if (std::strncmp(v.name, "drho[", 5) == 0) {
-      row.head<4>() = d.drhod_dp.row(v.index);
-      row.segment<4>(4) = d.J_rho.row(v.index);
-    } else {
+    } else if (!slider_partials(v.name, v.index, d.J_rho, d.drhod_dp, row)) {
       ctx.log.error("%s: the partial derivatives of %s are not provided (analytic so far: F, tau, rho and drho)", fn,
                     v.name);
       return Status::Error;
