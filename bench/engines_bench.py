@@ -53,70 +53,51 @@ def c_cases(program, batches):
         out = run_program(program, ["compare", "--out", tmp, "--batches", str(batches)])
         with open(Path(tmp) / "summary.csv") as f:
             cases = {row["case"]: row for row in csv.DictReader(f)}
-        for key, c in cases.items():
-            d = np.genfromtxt(Path(tmp) / f"{key}.csv", delimiter=",", names=True)
-            c["run"] = {n: d[n] for n in d.dtype.names}  # t, x, y, z, phi, delta_rho1, constraint
+        runs = np.genfromtxt(Path(tmp) / "runs.csv", delimiter=",", names=True, dtype=None, encoding="utf-8")
+        for key, c in cases.items():  # t, x, y, z, phi, delta_rho1, constraint
+            c["run"] = {n: runs[n][runs["case"] == key] for n in runs.dtype.names[1:]}
     return cases, out
 
 
-class MuJoCoBench:
-    """mj_step over the test: in mujoco.rollout (MuJoCo's own C loop) and in a Python loop."""
+def mujoco_timers():
+    """mj_step over the test: (in mujoco.rollout, MuJoCo's own C loop; in a Python loop; the reset before it)."""
+    model, data = mujoco_model.build(g=0.0)
+    sp = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    s0 = np.empty(mujoco.mj_stateSize(model, sp))
+    mujoco.mj_getState(model, data, s0, sp)
+    ctrl = np.array([motions.comparison_forces((k + 0.5) * H) for k in range(STEPS_TIMED)])
 
-    def __init__(self):
-        self.model, self.data = mujoco_model.build(g=0.0)
-        self.sp = mujoco.mjtState.mjSTATE_FULLPHYSICS
-        self.s0 = np.empty(mujoco.mj_stateSize(self.model, self.sp))
-        mujoco.mj_getState(self.model, self.data, self.s0, self.sp)
-        self.ctrl = np.array([motions.comparison_forces((k + 0.5) * H) for k in range(STEPS_TIMED)])
-        self.rollout()  # warm-up
-
-    def rollout(self):
-        mujoco.rollout.rollout(self.model, self.data, self.s0[None], self.ctrl[None])
-
-    def reset(self):
-        mujoco.mj_setState(self.model, self.data, self.s0, self.sp)
-
-    def python_loop(self):
+    def python_loop():
         for k in range(STEPS_TIMED):
-            self.data.ctrl[:] = self.ctrl[k]
-            mujoco.mj_step(self.model, self.data)
+            data.ctrl[:] = ctrl[k]
+            mujoco.mj_step(model, data)
+    return (lambda: mujoco.rollout.rollout(model, data, s0[None], ctrl[None]), python_loop,
+            lambda: mujoco.mj_setState(model, data, s0, sp))
 
 
-class PinocchioBench:
-    """constraintDynamics (C++) inside RK4 at 1 ms in Python, the forces at the stage times."""
+def pinocchio_timers(calls=2000):
+    """constraintDynamics (C++) inside RK4 at 1 ms in Python, the forces at the stage times; and per call (each of
+    `calls` at one state): constraintDynamics, and it followed by computeConstraintDynamicsDerivatives."""
+    pm = PinocchioPKM(g=0.0)
+    pm.setup_constraint_dynamics()
+    q0, v0 = pm.q_from_pose(spec.P0), np.zeros(16)
+    tau = [pm.S @ motions.comparison_forces(j * H / 2) for j in range(2 * STEPS_TIMED + 1)]
 
-    def __init__(self):
-        self.pm = pm = PinocchioPKM(g=0.0)
-        pm.setup_constraint_dynamics()
-        self.q0, self.v0 = pm.q_from_pose(spec.P0), np.zeros(16)
-        self.tau = [pm.S @ motions.comparison_forces(j * H / 2) for j in range(2 * STEPS_TIMED + 1)]
-        self.cd = lambda q, v, f: pin.constraintDynamics(pm.model, pm.data, q, v, f, pm._cm, pm._cd, pm._prox)
-        self.run(10)  # warm-up
+    def cd(q=q0, v=v0, f=tau[1]):
+        return pin.constraintDynamics(pm.model, pm.data, q, v, f, pm._cm, pm._cd, pm._prox)
 
-    def run(self, n):
-        cd, tau = self.cd, self.tau
-        ec.rk4_on_manifold(self.pm.model, self.q0, self.v0, H, n, lambda q, v, k, stage: cd(q, v, tau[2 * k + stage]))
-
-    def derivatives(self, calls=2000):
-        """Per call: constraintDynamics, and it followed by computeConstraintDynamicsDerivatives."""
-        pm, (q, v, f) = self.pm, (self.q0, self.v0, self.tau[1])
-
-        def with_derivatives():
-            self.cd(q, v, f)
-            pin.computeConstraintDynamicsDerivatives(pm.model, pm.data, pm._cm, pm._cd, pm._prox)
-        return (timeit.timeit(lambda: self.cd(q, v, f), number=calls) / calls,
-                timeit.timeit(with_derivatives, number=calls) / calls)
+    def with_derivatives():
+        cd()
+        pin.computeConstraintDynamicsDerivatives(pm.model, pm.data, pm._cm, pm._cd, pm._prox)
+    return (lambda: ec.rk4_on_manifold(pm.model, q0, v0, H, STEPS_TIMED, lambda q, v, k, i: cd(q, v, tau[2 * k + i])),
+            lambda: (timeit.timeit(cd, number=calls) / calls, timeit.timeit(with_derivatives, number=calls) / calls))
 
 
 def inverse_tick(program, batches):
-    """`pkm_fmu_bench inverse` with MuJoCo's model of the same mechanism (spec gravity, no machine) at the
-    auto-test path at t = 1 s: the legs' coordinates, rates and accelerations completed from the platform's."""
-    _, _, (q, qd, qdd) = PinocchioPKM().inverse_dynamics(*motions.autotest_motion(1.0))
+    """`pkm_fmu_bench inverse` with MuJoCo's model of the same mechanism (the spec's gravity, no machine)."""
     with tempfile.TemporaryDirectory() as tmp:
-        mjcf, state = Path(tmp) / "pkm4puu.xml", Path(tmp) / "state.txt"
-        mjcf.write_text(mujoco_model.mjcf())
-        state.write_text("\n".join(" ".join(f"{x:.17g}" for x in v) for v in (q, qd, qdd)) + "\n")
-        return run_program(program, ["inverse", "--batches", str(batches), "--mjcf", str(mjcf), "--state", str(state)])
+        (Path(tmp) / "pkm4puu.xml").write_text(mujoco_model.mjcf())
+        return run_program(program, ["inverse", "--batches", str(batches), "--mjcf", str(Path(tmp) / "pkm4puu.xml")])
 
 
 def main(argv=None):
@@ -131,7 +112,9 @@ def main(argv=None):
     if not program.is_file():
         ap.exit(2, f"engines_bench: no {program}: build it (cmake --build {args.build} --target pkm_fmu_bench)\n")
 
-    mj, pb = MuJoCoBench(), PinocchioBench()
+    rollout, python_loop, reset = mujoco_timers()
+    rk4, per_call = pinocchio_timers()
+    rollout(), rk4()  # warm-up
     rounds = []  # each round's {case: (median, best batch)}
     for r in range(args.rounds):
         log(f"round {r + 1} of {args.rounds}")
@@ -139,11 +122,11 @@ def main(argv=None):
         if r == 0:
             first, c_out = cases, out
         times = {key: (float(c["median_s_per_sim_s"]), float(c["min_s_per_sim_s"])) for key, c in cases.items()}
-        for key, t in (("mujoco_rollout", timeit.repeat(mj.rollout, repeat=args.batches, number=1)),
-                       ("mujoco_loop", timeit.repeat(mj.python_loop, mj.reset, repeat=args.batches, number=1)),
-                       ("pinocchio_rk4", timeit.repeat(lambda: pb.run(STEPS_TIMED), repeat=1, number=1))):
+        for key, t in (("mujoco_rollout", timeit.repeat(rollout, repeat=args.batches, number=1)),
+                       ("mujoco_loop", timeit.repeat(python_loop, reset, repeat=args.batches, number=1)),
+                       ("pinocchio_rk4", timeit.repeat(rk4, repeat=1, number=1))):
             times[key] = (float(np.median(t)), float(np.min(t)))
-        cd, dd = pb.derivatives()
+        cd, dd = per_call()
         times.update(pinocchio_dynamics_call=(cd, cd), pinocchio_derivatives_call=(dd, dd),
                      pinocchio_bare=(4 * STEPS_TIMED * cd,) * 2)  # RK4's calls, at that cost
         rounds.append(times)

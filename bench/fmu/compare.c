@@ -1,9 +1,6 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench compare: one simulated second of the comparison test at a
- * 1 ms step through the C API (the forces at the stage times from a table, as
- * MuJoCo's from an array) and the plant FMU (F held at each tick's midpoint or
- * as a ramp); --out DIR: each case's untimed run of the whole test (pose,
- * delta rho1, ||C||) and the summary as CSV, for bench/engines_bench.py. */
+/* pkm_fmu_bench compare: one simulated second of the comparison test at 1 ms through the C API and the plant FMU;
+ * --out DIR: the untimed runs of the whole test (runs.csv) and the summary as CSV, for bench/engines_bench.py. */
 #include "fmu_bench.h"
 #include "pkm4puu/pkm.h"
 
@@ -49,23 +46,13 @@ static double median[N_CASES], min[N_CASES], max_c[N_CASES]; /* s per simulated 
 
 static double times[STEPS_TEST + 1], rows[STEPS_TEST + 1][6]; /* t; x, y, z, phi, rho1, ||C|| */
 
-static FILE* open_csv(const char* dir, const char* name) {
+static FILE* open_csv(const char* dir, const char* name, const char* header) {
   char path[1024];
   FILE* fp;
   snprintf(path, sizeof path, "%s/%s.csv", dir, name);
   if (!(fp = fopen(path, "w"))) fprintf(stderr, "pkm_fmu_bench: cannot write %s\n", path);
+  if (fp) fprintf(fp, "%s\n", header);
   return fp;
-}
-
-static int write_rows(const char* dir, const char* name, int n) {
-  FILE* fp = dir ? open_csv(dir, name) : NULL;
-  if (!dir || !fp) return !dir;
-  fprintf(fp, "t,x,y,z,phi,delta_rho1,constraint\n");
-  for (int k = 0; k < n; ++k)
-    fprintf(fp, "%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.6e\n", times[k], rows[k][0], rows[k][1], rows[k][2],
-            rows[k][3], rows[k][4] - rows[0][4], rows[k][5]);
-  fclose(fp);
-  return 1;
 }
 
 static double force_table[2 * STEPS_TEST + 1][4]; /* F at t_j = j h/2 */
@@ -74,11 +61,10 @@ static double force_table[2 * STEPS_TEST + 1][4]; /* F at t_j = j h/2 */
 static void input_callback(void* user, double t, double u[PKM_PLANT_INPUTS]) {
   const long j = lround(t / (0.5 * STEP));
   (void)user;
-  if (j >= 0 && j <= 2 * STEPS_TEST && fabs(t / (0.5 * STEP) - (double)j) < 1e-9) {
+  if (j >= 0 && j <= 2 * STEPS_TEST && fabs(t / (0.5 * STEP) - (double)j) < 1e-9)
     memcpy(u, force_table[j], sizeof force_table[j]);
-  } else {
+  else
     forces(t, u); /* CVODE's own stage times */
-  }
 }
 
 static double held[STEPS_TEST][4], ramp[STEPS_TEST][4], slope[STEPS_TEST][4];
@@ -120,8 +106,8 @@ static double batch(int i) {
 }
 
 /* Case i's untimed run of the whole 1.5 s test: the pose, rho1 and the constraint residual after every tick (the
- * one-call cases: every 0.5 s), into dir/<case>.csv. */
-static int record(int i, const fmi2ValueReference* vr, const char* dir) {
+ * one-call cases: every 0.5 s), as rows of `runs` if given. */
+static int record(int i, const fmi2ValueReference* vr, FILE* runs) {
   pkm_model* m = models[i];
   pkm_outputs o = {.size = sizeof(pkm_outputs)};
   double u[PKM_PLANT_INPUTS] = {0.0};
@@ -145,7 +131,10 @@ static int record(int i, const fmi2ValueReference* vr, const char* dir) {
     if (!ok) fprintf(stderr, "pkm_fmu_bench compare: %s: %s\n", cases[i].name, pkm_last_error(m));
   }
   for (int k = 0; ok && k < n; ++k) max_c[i] = fmax(max_c[i], rows[k][5]);
-  return ok && write_rows(dir, cases[i].name, n);
+  for (int k = 0; ok && runs && k < n; ++k)
+    fprintf(runs, "%s,%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.6e\n", cases[i].name, times[k], rows[k][0], rows[k][1],
+            rows[k][2], rows[k][3], rows[k][4] - rows[0][4], rows[k][5]);
+  return ok;
 }
 
 /* How a case's forces reach the integrator (bench/engines_bench.py's column). */
@@ -157,23 +146,23 @@ static const char* forces_of(const Case* c) {
 static int compare_run(const Plant* p, const Options* o) {
   static const char* const names[] = {"x", "y", "z", "phi", "rho[1]", "constraint_residual", "rk4_step", "g", "z0",
                                       "rtol", "atol"};
+  FILE* runs = o->out ? open_csv(o->out, "runs", "case,t,x,y,z,phi,delta_rho1,constraint") : NULL;
   fmi2ValueReference vr[11], all[MAX_OUTPUTS];
   const size_t n_all = real_outputs(p->text, all, MAX_OUTPUTS);
   size_t i;
-  int ok = n_all > 0 && lookup_value_references(p, names, 11, vr);
+  int ok = n_all > 0 && lookup_value_references(p, names, 11, vr) && (runs || !o->out);
   plant = p;
   for (int k = 0; k <= 2 * STEPS_TEST; ++k) forces(0.5 * STEP * k, force_table[k]);
-  for (int k = 0; k < STEPS_TEST; ++k) {
-    forces((k + 0.5) * STEP, held[k]);
-    forces(k * STEP, ramp[k]);
-    forces((k + 1) * STEP, slope[k]);
-    for (i = 0; i < 4; ++i) slope[k][i] = (slope[k][i] - ramp[k][i]) / STEP;
-  }
+  for (int k = 0; k < STEPS_TEST; ++k) /* held at the midpoint; the ramp's value and slope */
+    for (i = 0; i < 4; ++i)
+      held[k][i] = force_table[2 * k + 1][i], ramp[k][i] = force_table[2 * k][i],
+      slope[k][i] = (force_table[2 * k + 2][i] - ramp[k][i]) / STEP;
   printf("the comparison test (docs/model.md; g = 0, F1 = -F4 = 0.02 N sin(2 pi t / 1.5 s)) at a 1 ms step; "
          "median of %d batches after 1 warm-up, the cases interleaved\n\n", o->batches);
   for (i = 0; ok && i < N_CASES; ++i) ok = set_up((int)i, vr, all, n_all);
   ok = ok && time_cases(N_CASES, o->batches, batch, median, min);
-  for (i = 0; ok && i < N_CASES; ++i) ok = record((int)i, vr, o->out);
+  for (i = 0; ok && i < N_CASES; ++i) ok = record((int)i, vr, runs);
+  if (runs) fclose(runs);
   for (i = 0; i < N_CASES; ++i) {
     if (insts[i] && !free_instance(p, FMI2_CS, insts[i], &homes[i])) ok = 0;
     pkm_destroy(models[i]);
@@ -190,9 +179,8 @@ static int compare_run(const Plant* p, const Options* o) {
   printf("target (context): an RK4 tick with the 12 outputs <= 3 us (> 300x real time): %.3f us, %s\n",
          1e3 * median[7], median[7] <= 3e-3 ? "ok" : "OVER");
   if (o->out) {
-    FILE* fp = open_csv(o->out, "summary");
+    FILE* fp = open_csv(o->out, "summary", "case,what,forces,median_s_per_sim_s,min_s_per_sim_s,target_vs_mujoco");
     if (!fp) return 0;
-    fprintf(fp, "case,what,forces,median_s_per_sim_s,min_s_per_sim_s,target_vs_mujoco\n");
     for (i = 0; i < N_CASES; ++i)
       fprintf(fp, "%s,\"%s\",%s,%.6e,%.6e,%g\n", cases[i].name, cases[i].what, forces_of(&cases[i]), median[i],
               min[i], cases[i].target);

@@ -1,11 +1,6 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench cost: the plant FMU's cost in one Markdown table: the time
- * per simulated second per communication step h and solver, the heap per
- * instance, instantiate + initialise, the throughput of one thread per core
- * against one. latency: each 1 ms tick timed, the batches repeating the same
- * second, so the minimum over them of tick k is the model's own time for it.
- * From the home pose, the holding forces plus 0.2 t N on F[1] as value and
- * slope each tick (CVODE continues); latency's RK4: 0.2 cos(2 pi 3 t) N held. */
+/* pkm_fmu_bench cost: the plant FMU's cost table (time per simulated second per step h and solver, heap,
+ * initialisation, throughput); latency: each 1 ms tick timed. Their scenarios: docs/performance.md. */
 #include "fmu_bench.h"
 
 #include <malloc.h>

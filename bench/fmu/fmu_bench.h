@@ -1,7 +1,6 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench: what its subcommands share (main.c defines it): the
- * options, the loaded FMU, its instances, the one loop of a master's ticks.
- * Each source file includes it first (it asks for POSIX and GNU functions). */
+/* pkm_fmu_bench: what its subcommands share (main.c defines it): the options, the loaded FMU, its instances, the
+ * one loop of a master's ticks. Each source file includes it first (it asks for POSIX and GNU functions). */
 #ifndef PKM_BENCH_FMU_BENCH_H
 #define PKM_BENCH_FMU_BENCH_H
 
@@ -16,7 +15,7 @@
 #include "timer.h"
 
 typedef struct {
-  const char *out, *mjcf, *state; /* --out (compare), --mjcf, --state (inverse) */
+  const char *out, *mjcf; /* --out (compare), --mjcf (inverse) */
   int batches;
   double seconds; /* --seconds (cost) */
 } Options;
@@ -60,8 +59,7 @@ int free_instance(const Plant* plant, int kind, void* c, fmi2FMUstate* home);
 int lookup_value_references(const Plant* plant, const char* const* names, size_t n, fmi2ValueReference* vr);
 
 /* A master's ticks: each sets F[k] (with dF, their slopes too), DoSteps h and gets the n_out outputs `out`, kept in
- * record ((n + 1) x n_out, the outputs before the first tick first) if given; tick_s (if given) receives each tick's
- * time. */
+ * record ((n + 1) x n_out, the outputs before the first tick first) if given; tick_s (if given): each tick's time. */
 typedef struct {
   double h;
   int n;
@@ -74,9 +72,8 @@ typedef struct {
  * a call fails. */
 double run_ticks(const Plant* plant, fmi2Component c, fmi2FMUstate home, const Ticks* ticks);
 
-/* The one loop of the timed batches: n cases interleaved batch by batch, one warm-up batch of each first;
- * batch(i) runs a batch of case i and returns its time (<= 0 after a message on failure). The median and
- * minimum over the batches per case in median[i], min[i]; 0 on failure. */
+/* The one loop of the timed batches: n cases interleaved batch by batch, one warm-up batch of each first; batch(i)
+ * runs one of case i, returns its time (<= 0 after a message on failure). Per case median[i], min[i]; 0 on failure. */
 int time_cases(int n, int batches, double (*batch)(int i), double* median, double* min);
 
 /* Returns 0 from the calling function, after a message, when an FMI call (or an || of them) does not return OK. */

@@ -1,9 +1,8 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench inverse: the inverse FMU's tick (FMI 2.0 and 3.0, as a
- * computed-force controller drives it every 1 ms) along a smooth loop about
- * the home pose against MuJoCo's mj_inverse on the same mechanism (built with
- * MuJoCo, given the MJCF and state bench/engines_bench.py writes). */
+/* pkm_fmu_bench inverse: the inverse FMU's tick (FMI 2.0 and 3.0, every 1 ms along a smooth loop about the home
+ * pose) against MuJoCo's mj_inverse on the same mechanism (built with MuJoCo, given its MJCF). */
 #include "fmu_bench.h"
+#include "pkm4puu/pkm.h"
 
 #if PKM_HAVE_MUJOCO
 #include <mujoco/mujoco.h>
@@ -26,8 +25,7 @@ static mjModel* mm;
 static mjData* md;
 #endif
 
-/* A batch of ticks of instance `kind` (a batch of mj_inverse: kind 4): the time per tick, 0 after a message on
- * failure. */
+/* A batch of ticks of instance `kind` (kind 4: of mj_inverse): the time per tick, 0 after a message on failure. */
 static double time_ticks(int kind) {
   const Fmu* f2 = &plant->fmu;
   const Fmu3* f3 = &plant->fmu3;
@@ -58,18 +56,21 @@ static double time_ticks(int kind) {
 }
 
 #if PKM_HAVE_MUJOCO
-/* The model of `mjcf` at the state in `state` (48 numbers: qpos, qvel, qacc); 0 after a message on failure. */
-static int load_mujoco(const char* mjcf, const char* state, mjModel** m, mjData** d) {
+/* The model of `mjcf` at the table's first motion, the legs' from the C API's inverse dynamics (MuJoCo's joints in
+ * the coordinate order of docs/model.md); 0 after a message on failure. */
+static int load_mujoco(const char* mjcf) {
   char error[1000] = "";
-  FILE* fp = fopen(state, "r");
-  int i, ok;
-  *m = mj_loadXML(mjcf, NULL, error, sizeof error);
-  *d = *m ? mj_makeData(*m) : NULL;
-  ok = *m && *d && fp && (*m)->nq == 16 && (*m)->nv == 16;
-  for (i = 0; ok && i < 48; ++i)
-    ok = fscanf(fp, "%lf", &(i < 16 ? (*d)->qpos : i < 32 ? (*d)->qvel : (*d)->qacc)[i % 16]) == 1;
-  if (fp) fclose(fp);
-  if (!ok) fprintf(stderr, "pkm_fmu_bench inverse: cannot load %s / %s %s\n", mjcf, state, error);
+  pkm_inverse_result r = {.size = sizeof r};
+  pkm_model* m = NULL;
+  int ok = pkm_create(&m) == PKM_OK &&
+           pkm_inverse_dynamics(m, motion[0], motion[0] + 4, motion[0] + 8, NULL, &r) == PKM_OK;
+  pkm_destroy(m);
+  md = (mm = ok ? mj_loadXML(mjcf, NULL, error, sizeof error) : NULL) ? mj_makeData(mm) : NULL;
+  if ((ok = md && mm->nq == 16 && mm->nv == 16)) {
+    memcpy(md->qpos, r.q, sizeof r.q), memcpy(md->qvel, r.qd, sizeof r.qd), memcpy(md->qacc, r.qdd, sizeof r.qdd);
+  } else {
+    fprintf(stderr, "pkm_fmu_bench inverse: cannot load %s %s\n", mjcf, error);
+  }
   return ok;
 }
 #endif
@@ -80,9 +81,6 @@ static int inverse_run(const Plant* p, const Options* o) {
   double med[5] = {0}, mn[5] = {0}; /* the four instances, then mj_inverse */
   int b, k, have_mj = 0, ok = lookup_value_references(p, inputs, 12, in) && lookup_value_references(p, outputs, 4, out);
   plant = p;
-#if PKM_HAVE_MUJOCO
-  if (ok && o->mjcf && o->state) ok = have_mj = load_mujoco(o->mjcf, o->state, &mm, &md);
-#endif
   for (k = 0; k < TICKS; ++k) { /* one period per table, with the exact rates and accelerations */
     const double w = 2.0 * PI, s = sin(w * k * H), co = cos(w * k * H), a[4] = {0.002, 0.002, 0.005, 0.05};
     const double q[4] = {a[0] * s, a[1] * co, a[2] * s, a[3] * s}, v[4] = {a[0] * w * co, -a[1] * w * s, a[2] * w * co,
@@ -90,6 +88,9 @@ static int inverse_run(const Plant* p, const Options* o) {
     for (b = 0; b < 4; ++b)
       motion[k][b] = q[b] + (b == 2 ? 0.05 : 0.0), motion[k][4 + b] = v[b], motion[k][8 + b] = -w * w * q[b];
   }
+#if PKM_HAVE_MUJOCO
+  if (ok && o->mjcf) ok = have_mj = load_mujoco(o->mjcf);
+#endif
   printf("tick = set the 12 motion inputs, advance (CS: DoStep 1 ms; ME: SetTime), get F[1..4];\n"
          "median and min per call over %d batches of %d calls, the cases interleaved batch by batch\n\n",
          o->batches, REPEAT * TICKS);
@@ -114,11 +115,11 @@ static int inverse_run(const Plant* p, const Options* o) {
     printf("\n");
   }
   if (!have_mj)
-    printf("   (no mj_inverse: %s)\n", PKM_HAVE_MUJOCO ? "give --mjcf and --state (bench/engines_bench.py does)"
+    printf("   (no mj_inverse: %s)\n", PKM_HAVE_MUJOCO ? "give --mjcf (bench/engines_bench.py does)"
                                                     : "built without MuJoCo's library and headers");
   if (!(sum == sum)) printf("(non-finite forces)\n"); /* keeps the loops' results alive */
   return 1;
 }
 
 const Subcommand inverse_subcommand = {"inverse", "the inverse FMU's tick against MuJoCo's mj_inverse", inverse_run,
-                                       101, "--mjcf FILE --state FILE (MuJoCo's model and state)", 1};
+                                       101, "--mjcf FILE (MuJoCo's model of the mechanism)", 1};

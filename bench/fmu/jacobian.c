@@ -1,9 +1,6 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench jacobian: the state derivative's full Jacobian [A B] (8 x 20)
- * through fmi2GetDirectionalDerivative (Model Exchange) against the C API's
- * pkm_forward_derivatives; each evaluation moves x by 1e-12 m * (k % 1024), so
- * nothing is reused, and the same calls at an unchanged state leave the FMI
- * overhead. */
+/* pkm_fmu_bench jacobian: the full Jacobian [A B] (8 x 20) through fmi2GetDirectionalDerivative against the C API's
+ * pkm_forward_derivatives, x moved by 1e-12 m * (k % 1024) per evaluation; at an unchanged state: the FMI overhead. */
 #include "fmu_bench.h"
 #include "pkm4puu/pkm.h"
 

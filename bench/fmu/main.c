@@ -1,8 +1,6 @@
 /* SPDX-License-Identifier: BSD-2-Clause */
-/* pkm_fmu_bench: the FMUs' benchmarks, a subcommand each (plain C11, the built
- * binary through dlopen and the raw FMI functions, as a master drives it),
- * each table with its ratios measured in the same run. Exit status: 1 if a
- * call fails or a file cannot be read, 2 for a usage error, never how fast. */
+/* pkm_fmu_bench: the FMUs' benchmarks, a subcommand each (plain C11, the built binary through dlopen and the raw FMI
+ * functions, as a master drives it). Exit status: 1 if a call fails, 2 for a usage error, never how fast. */
 #include "fmu_bench.h"
 
 static const Subcommand* const subcommands[] = {&compare_subcommand, &cost_subcommand, &latency_subcommand,
@@ -24,7 +22,6 @@ static int parse_options(const Subcommand* sub, int argc, char** argv, Options* 
     if (!value) return usage_error("missing value after", opt);
     if (strcmp(opt, "--out") == 0) o->out = value;
     if (strcmp(opt, "--mjcf") == 0) o->mjcf = value;
-    if (strcmp(opt, "--state") == 0) o->state = value;
     if (strcmp(opt, "--batches") == 0 && ((o->batches = (int)strtol(value, &end, 10)), *end || o->batches < 1 ||
                                           o->batches > 100000))
       return usage_error("--batches out of range", value);
@@ -55,7 +52,7 @@ static int load(const Subcommand* sub, Plant* p) {
 
 int main(int argc, char** argv) {
   const Subcommand* sub = NULL;
-  Options o = {NULL, NULL, NULL, 0, 3.0};
+  Options o = {NULL, NULL, 0, 3.0};
   Plant plant;
   int ok;
   if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
@@ -129,13 +126,8 @@ void* instantiate(const Plant* plant, int kind, const char* name, int solver, si
 
 int free_instance(const Plant* plant, int kind, void* c, fmi2FMUstate* home) {
   int ok = !(home && *home && plant->fmu.fmi2FreeFMUstate(c, home) != fmi2OK);
-  if (kind <= FMI2_ME) {
-    ok = plant->fmu.fmi2Terminate(c) == fmi2OK && ok;
-    plant->fmu.fmi2FreeInstance(c);
-  } else {
-    ok = plant->fmu3.fmi3Terminate(c) == fmi3OK && ok;
-    plant->fmu3.fmi3FreeInstance(c);
-  }
+  ok = (kind <= FMI2_ME ? plant->fmu.fmi2Terminate(c) == fmi2OK : plant->fmu3.fmi3Terminate(c) == fmi3OK) && ok;
+  kind <= FMI2_ME ? plant->fmu.fmi2FreeInstance(c) : plant->fmu3.fmi3FreeInstance(c);
   return ok;
 }
 

@@ -144,7 +144,7 @@ def pinocchio_reference(force_law="exact", machine=None, g=0.0, forces=motions.c
 def rk4_on_manifold(model, q, v, h, n, acc, after_step=None):
     """n fixed RK4 steps of h on the model's configuration manifold from (q,
     v): acc(q, v, k, stage) the accelerations at t_k + (0, h/2, h)[stage];
-    after_step(k, q) after step k (also bench/engines_bench.py's timed run)."""
+    after_step(k, q) after step k (bench/engines_bench.py times it too)."""
     for k in range(n):
         a1 = acc(q, v, k, 0)
         v2 = v + a1 * h / 2
