@@ -15,11 +15,9 @@ namespace pkm::bench {
 
 /// How long each figure is measured: the defaults, or --quick.
 struct Effort {
-  int batches = 31;                 // batches per per-call figure
-  double batch_s = 4e-3;            // a per-call batch lasts at least this
-  int max_runs = 31, min_runs = 5;  // whole runs: at most, at least, and the wall-time budget
-  double runs_budget_s = 6.0;
-  int tick_runs = 15;  // runs of a simulated second per tick row
+  int batches = 31;       // batches per per-call figure, runs per whole-run figure
+  double batch_s = 4e-3;  // a per-call batch lasts at least this
+  int tick_runs = 15;     // runs of a simulated second per tick row
 };
 extern Effort effort;
 
@@ -28,19 +26,13 @@ struct Figure {
   int batches = 0;
 };
 
-/// Whole runs: run() returns the seconds it measured itself (set-up kept
-/// outside), < 0 on failure; one warm-up, then min..max runs within the budget.
+/// One warm-up run, then `runs` (fewer if one fails); run() returns the
+/// seconds it measured itself (set-up kept outside), < 0 on failure.
 template <class Run>
-Figure time_runs(Run&& run, int min_runs = effort.min_runs, int max_runs = effort.max_runs) {
+Figure time_runs(Run&& run, int runs = effort.batches) {
   std::vector<double> v;
-  const double start = bench_now();
   run();
-  for (int r = 0; r < max_runs; ++r) {
-    const double s = run();
-    if (!(s >= 0)) break;
-    v.push_back(s);
-    if (r + 1 >= min_runs && bench_now() - start > effort.runs_budget_s) break;
-  }
+  for (double s; static_cast<int>(v.size()) < runs && (s = run()) >= 0;) v.push_back(s);
   Figure f;
   if (!v.empty()) f.median = bench_median(v.data(), v.size(), &f.min), f.batches = static_cast<int>(v.size());
   return f;
@@ -65,8 +57,7 @@ struct StepRun {
   std::vector<Vec8> states;                                  // pose and rates after each step, the initial first
 };
 
-/// n steps of the Plant from (p0, pd0), set up outside the timing: step(plant, k)
-/// advances it to step k's end (the auto-test runs and the ticks).
+/// n steps of the Plant from (p0, pd0), set up outside the timing: step(plant, k) advances it to step k's end.
 template <class Step>
 StepRun plant_steps(const Model& m, const SolverSettings& st, const Pose& p0, const Pose& pd0, long n, Step&& step) {
   StepRun r;
@@ -96,7 +87,7 @@ StepRun timed_steps(const Model& m, const SolverSettings& st, long n, Step&& ste
   const Figure f = time_runs([&] {
     r = plant_steps(m, st, kHome, Pose::Zero(), n, step);
     return r.seconds / static_cast<double>(std::min(r.ok_steps + 1, n));
-  }, effort.tick_runs, effort.tick_runs);
+  }, effort.tick_runs);
   r.us = 1e6 * f.median;
   return r;
 }

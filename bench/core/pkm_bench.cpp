@@ -1,12 +1,9 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// pkm_bench [core|ticks] [--quick] [--parseable]: the core's timing figures as
-// tables, each with its ratios to a baseline measured in the same run (never a
-// pass/fail exit code). core (here): the state derivative, its analytic
-// derivatives, the regressor, the inverse dynamics, the 2-s auto-test; ticks
-// (ticks.cpp): 1-ms steps of the Plant per solver and input, then the stiff
-// cases. --quick: short batches (the documentation build's run); --parseable
-// (ticks): one line a run, tick;<run>;<us/step>;<x>;<y>;<z>;<phi>, the pose
-// after 1 s (tests/platform_ticks.py).
+// pkm_bench [core|ticks] [--quick] [--parseable]: the core's timings, each with
+// its ratios to a baseline of the same run (never a pass/fail exit code).
+// core (here): items 1 to 3; ticks (ticks.cpp). --quick: the docs build's short
+// batches; --parseable (ticks): "tick;<run>;<us/step>;<x>;<y>;<z>;<phi>" lines.
+#include <cassert>
 #include <cstdio>
 #include <string>
 
@@ -15,6 +12,7 @@
 #include "apps/autotest.hpp"
 #include "apps/trajectory.hpp"
 #include "core/core_bench.hpp"
+#include "pkm4puu/dynamics/forward_dynamics.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics.hpp"
 #include "pkm4puu/dynamics/inverse_dynamics_derivatives.hpp"
 #include "pkm4puu/dynamics/lagrangian.hpp"
@@ -44,9 +42,6 @@ std::string fmt_time(double s) {  // "123 ns", "1.234 us", "1.234 ms", "1.234 s"
 const char* ok_mark(double value, double target) { return value <= target ? "ok" : "OVER"; }
 void rule() { std::printf("%s\n", std::string(96, '-').c_str()); }
 
-const std::pair<Formulation, const char*> kFormulations[] = {  // the rows: the enumerators' names
-    {Formulation::LegPartitioned, "LegPartitioned"}, {Formulation::NullSpaceQR, "NullSpaceQR"},
-    {Formulation::Augmented, "Augmented"}};
 constexpr double kDerivativeTarget = 0.25e-6;                  // s, one LegPartitioned state derivative
 constexpr double kInverseTarget = 1.0, kInverseStretch = 0.5;  // x one state derivative
 
@@ -65,9 +60,8 @@ struct ForceTable {
   }
 };
 
-/// What the core sections measure on: the model, the auto-test path, the
-/// state at t = 1 s, the stage-time grid t_j = j h/2 with its forces, the
-/// solvers; and the failure count.
+/// What the core sections measure on: the model, the auto-test path, its state at t = 1 s, the stage-time grid
+/// t_j = j h/2 with its forces, the solvers; and the failure count.
 struct Core {
   Model model;
   RestToRest path;
@@ -129,25 +123,21 @@ bool set_up(Core& b) {
 }
 
 void print_header() {
-#ifdef NDEBUG
-  const char* asserts = "NDEBUG";
-#else
-  const char* asserts = "asserts ON";
-#endif
+  bool asserts = false;
+  assert((asserts = true));  // true where asserts are compiled in
   rule();
   std::printf("pkm_bench  ");
   bench_print_machine();
   std::printf("           build: %s (%s), %s, Eigen %d.%d.%d, SUNDIALS %s\n",
-              *PKM_BENCH_BUILD_TYPE ? PKM_BENCH_BUILD_TYPE : "none", asserts, PKM_BENCH_COMPILER, EIGEN_WORLD_VERSION,
-              EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION, SUNDIALS_VERSION);
+              *PKM_BENCH_BUILD_TYPE ? PKM_BENCH_BUILD_TYPE : "none", asserts ? "asserts ON" : "NDEBUG",
+              PKM_BENCH_COMPILER, EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION, SUNDIALS_VERSION);
   std::printf("           timing: median and min over %d batches of N calls (N: a batch >= %g ms)%s\n", effort.batches,
               1e3 * effort.batch_s, effort.batches < 31 ? " (--quick)" : "");
   rule();
 }
 
-/// Per-call time of body(acc) (returns a Status, adds a result to acc): N
-/// calls per batch, N grown until a batch lasts effort.batch_s, the batches
-/// timed as runs; a failed call is reported under `what`.
+/// Per-call time of body(acc) (returns a Status, adds a result to acc): N calls per batch, N grown until a batch
+/// lasts effort.batch_s, the batches timed as runs; a failed call is reported under `what`.
 template <class Body>
 Figure time_checked(Core& b, const char* what, Body&& body) {
   double acc = 0;
@@ -161,7 +151,7 @@ Figure time_checked(Core& b, const char* what, Body&& body) {
   };
   for (double dt; n < (1L << 26) && (dt = batch() * static_cast<double>(n)) < effort.batch_s;)
     n = std::lround(static_cast<double>(n) * std::clamp(1.2 * effort.batch_s / dt, 2.0, 10.0));
-  const Figure f = time_runs(batch, effort.batches, effort.batches);
+  const Figure f = time_runs(batch);
   g_sink = acc;
   b.check(bad, what);
   return f;
@@ -198,7 +188,9 @@ Figure state_derivative_section(Core& b) {
   heading("1. Forward dynamics: one pkm::state_derivative at t = 1.000 s of the auto-test path\n"
           "   (y = path pose and velocity, f = inverse-dynamics forces there; y[0] += 1e-12*(k%1024) per call)",
           "vs LegP");
-  for (const auto& [formulation, name] : kFormulations) {
+  for (const Formulation formulation :
+       {Formulation::LegPartitioned, Formulation::NullSpaceQR, Formulation::Augmented}) {
+    const char* name = formulation_name(formulation);
     Vec8 yk = b.y_mid, ydot;
     long k = 0;
     const Figure f = PKM_TIMED(b, name, state_derivative(b.model, formulation, nudge(yk, b.y_mid, k++), b.f_mid, ydot),
@@ -215,8 +207,8 @@ Figure state_derivative_section(Core& b) {
   return legp;
 }
 
-/// 1b and 1c: the analytic derivatives and the regressor, each beside what
-/// it differentiates or stands for, that baseline measured right beside it.
+/// 1b and 1c: the analytic derivatives and the regressor, each beside what it
+/// differentiates or stands for, measured right before it.
 void derivatives_section(Core& b) {
   Vec8 yk = b.y_mid, ydot;
   Pose pk = b.p;
@@ -226,10 +218,6 @@ void derivatives_section(Core& b) {
   InverseDynamicsResult r;
   RegressorSample rs;
   long k = 0;
-  auto id = [&] {
-    return PKM_TIMED(b, "inverse_dynamics",
-                     inverse_dynamics(b.model, nudge(pk, b.p, k++), b.pd, b.pdd, Wrench::Zero(), r, false), r.F[0]);
-  };
   const Figure jac = PKM_TIMED(b, "state_derivative_jacobians",
                                state_derivative_jacobians(b.model, nudge(yk, b.y_mid, k++), b.id_mid.F, Vec4::Zero(),
                                                           Wrench::Zero(), kStopsFromState, ydot, A, B),
@@ -240,14 +228,14 @@ void derivatives_section(Core& b) {
   const Figure idd = PKM_TIMED(
       b, "inverse_dynamics_derivatives",
       inverse_dynamics_derivatives(b.model, nudge(pk, b.p, k++), b.pd, b.pdd, Wrench::Zero(), d), d.dp(0, 0));
-  const Figure id1 = id();
+  const Figure id = PKM_TIMED(
+      b, "inverse_dynamics", inverse_dynamics(b.model, nudge(pk, b.p, k++), b.pd, b.pdd, Wrench::Zero(), r, false),
+      r.F[0]);
   const Figure reg = PKM_TIMED(b, "regressor", regressor(b.model, nudge(pk, b.p, k++), b.pd, b.pdd, Wrench::Zero(), rs),
                                rs.Y(0, 0));
-  const Figure id2 = id();
-  Vec4 rho, rhod, rhodd;  // the sliders' motion, from the same inverse dynamics
-  b.check(inverse_dynamics(b.model, b.p, b.pd, b.pdd, Wrench::Zero(), r, false), "inverse_dynamics");
+  Vec4 rho, rhod, rhodd;  // the sliders' motion at the same state (set_up's inverse dynamics)
   for (int i = 0; i < kLegs; ++i)
-    rho[i] = r.q[leg_offset(i)], rhod[i] = r.qd[leg_offset(i)], rhodd[i] = r.qdd[leg_offset(i)];
+    rho[i] = b.id_mid.q[leg_offset(i)], rhod[i] = b.id_mid.qd[leg_offset(i)], rhodd[i] = b.id_mid.qdd[leg_offset(i)];
   Vec4 rk = rho;
   const Figure joints = PKM_TIMED(b, "joint_regressor",  // from the previous sample's pose, 1e-12 m away
                                   (rs.pose = b.p, joint_regressor(b.model, nudge(rk, rho, k++), rhod, rhodd,
@@ -257,13 +245,13 @@ void derivatives_section(Core& b) {
   line("state_derivative (LegPartitioned, baseline)", sd1, sd1.median);
   line("state_derivative_jacobians: ydot, A 8x8, B 8x12", jac, sd1.median, target_mark(jac.median / sd1.median, 3.0));
   std::printf("   %-48s %12s %12s %9.2fx\n", "  (central differences: 24 state derivatives)", "", "", 24.0);
-  line("inverse_dynamics (cold, baseline)", id1, id1.median);
-  line("inverse_dynamics_derivatives: F, dF 4x16", idd, id1.median);
+  line("inverse_dynamics (cold, baseline)", id, id.median);
+  line("inverse_dynamics_derivatives: F, dF 4x16", idd, id.median);
   rule();
   heading("1c. Calibration regressor at the same motion (regressor.hpp)", "ratio");
-  line("inverse_dynamics (cold, baseline)", id2, id2.median);
-  line("regressor: Y 4x14, F0 from the platform motion", reg, id2.median, target_mark(reg.median / id2.median, 2.0));
-  line("joint_regressor: from rho, drho, ddrho", joints, id2.median);
+  line("inverse_dynamics (cold, baseline, as in 1b)", id, id.median);
+  line("regressor: Y 4x14, F0 from the platform motion", reg, id.median, target_mark(reg.median / id.median, 2.0));
+  line("joint_regressor: from rho, drho, ddrho", joints, id.median);
   rule();
 }
 
@@ -322,9 +310,8 @@ struct RunInfo {
   std::string note;
 };
 
-/// Plant::advance over the 2 s in 1-ms calls driven by `input` (`at_rest`:
-/// the error against P0 instead of the path); `input_status`: the input's
-/// own failure (PathForces).
+/// Plant::advance over the 2 s in 1-ms calls driven by `input` (`at_rest`: the error against P0 instead of the
+/// path); `input_status`: the input's own failure (PathForces).
 RunInfo plant_run(Core& b, const SolverSettings& st, InputSignal input, bool continuous, bool at_rest,
                   const Status* input_status = nullptr) {
   RunInfo info;
@@ -374,9 +361,7 @@ RunInfo autotest_run(Core& b, const SolverSettings& st) {
   return info;
 }
 
-/// 3: the 2-s auto-test with each solver: forward only (RK4: the forces
-/// tabulated; CVODE: the static forces held), the round trip bare
-/// (PathForces) and run_autotest as a whole; and the ratios among them.
+/// 3: the 2-s auto-test per solver, forward only and round trip (the rows' legend says how), and their ratios.
 void autotest_section(Core& b, const Figure& sd, const Figure& stages) {
   auto round_trip = [&](const SolverSettings& st) {
     PathForces forces;
@@ -452,7 +437,7 @@ int main(int argc, char** argv) {
     if (a == "core") core = true;
     else if (a == "ticks") ticks = true;
     else if (a == "--parseable") parseable = true;
-    else if (a == "--quick") effort = Effort{7, 2e-3, 7, 3, 1.0, 3};
+    else if (a == "--quick") effort = Effort{7, 2e-3, 3};
     else {
       std::fprintf(stderr, "pkm_bench: unknown argument %s (usage: pkm_bench [core|ticks] [--quick] [--parseable])\n",
                    argv[i]);

@@ -1,7 +1,5 @@
 // SPDX-License-Identifier: BSD-2-Clause
-// pkm_bench ticks: 1 s of 1-ms steps of the core's Plant from the home pose
-// per solver and kind of input, each against the same inputs integrated
-// tightly; then the stiff cases (F = 0 onto the end stops) per solver.
+// pkm_bench ticks: the core Plant's 1-ms steps per solver and kind of input, then the stiff cases per solver.
 #include <cstdio>
 
 #include "core/core_bench.hpp"
@@ -41,9 +39,7 @@ auto tick_step(Inputs kind, bool cont, const Vec4& F_static) {
   };
 }
 
-/// The stiff cases: F = 0 from the home pose, 200 steps of 1 ms; per solver
-/// the median time per step and the steps answered OK; ROS2's deviation in dz
-/// from CVODE (BDF, rtol 1e-10) over the steps CVODE answered; the ratios.
+/// The stiff cases (their table's heading and legend say what is measured).
 void stiff_cases(double rk4_tick_us) {
   const struct {
     const char* name;
@@ -84,18 +80,14 @@ void stiff_cases(double rk4_tick_us) {
                 rb.us / cv.us, scale > 0 ? 100 * dev / scale : 0.0);
   }
   std::printf("us/ok: median microseconds per step (the failing step included) / steps answered OK; /RK4 tick: ROS2\n"
-              "against the held-input RK4 tick above (%.3f us, the default machine). RK4 refuses the stuck-friction\n"
-              "case at initialisation (0 steps) and runs out of its work budget at the stiff stops' impact; ROS2's\n"
-              "deviation covers the steps CVODE answered.\n",
-              rk4_tick_us);
+              "against the held-input RK4 tick above (%.3f us, the default machine); ROS2's deviation: over the steps\n"
+              "CVODE answered.\n", rk4_tick_us);
 }
 
 }  // namespace
 
-/// 1 s of 1-ms steps of the Plant from the home pose, per input kind: CVODE
-/// restarted at every step and continued across them, RK4, ROS2; each row's
-/// deviation from the same inputs integrated at rtol 1e-12 (restarted at
-/// every step: exact for inputs smooth within each step).
+/// The ticks per input kind and solver, each against the same inputs integrated tightly (restarted at every
+/// step: exact for inputs smooth within each step); then the stiff cases.
 int ticks_part(bool parseable) {
   Model model;
   InverseDynamicsResult id;
@@ -150,8 +142,7 @@ int ticks_part(bool parseable) {
     }
   }
   if (parseable) return failures ? 1 : 0;
-  std::printf("\nreference: CVODE rtol 1e-12, restarted every step, the same inputs. Continuing across the jumps of\n"
-              "sampled or held inputs costs accuracy: the FMU continues only where the inputs continue (pkm4puu.cpp).\n");
+  std::printf("\nreference: CVODE rtol 1e-12, restarted every step, the same inputs\n");
   stiff_cases(rk4_us);
   return failures ? 1 : 0;
 }
