@@ -28,25 +28,6 @@ struct StopContact {
   int side = 0;       // -1: the lower stop (depth = rho_min - rho), +1: the upper, 0: none
 };
 
-inline StopContact stop_contact(const Params& p, double rho, double rhod) {
-  StopContact c;
-  if (rho < p.rho_min) {
-    c.depth = p.rho_min - rho;
-    c.rate = -rhod;
-    c.force = std::fmax(0.0, p.stop_stiffness * c.depth + p.stop_damping * c.rate);
-    c.side = -1;
-  } else if (rho > p.rho_max) {
-    c.depth = rho - p.rho_max;
-    c.rate = rhod;
-    c.force = -std::fmax(0.0, p.stop_stiffness * c.depth + p.stop_damping * c.rate);
-    c.side = 1;
-  }
-  return c;
-}
-
-/// F_stop on rho (N, signed along +z).
-inline double stop_force(const Params& p, double rho, double rhod) { return stop_contact(p, rho, rhod).force; }
-
 /// The contact mode: which stops act, held fixed between located events by
 /// the integrators (bit i: leg i's lower stop, bit 4 + i: its upper stop,
 /// bit 8 + i: leg i's held stop clamped, its spring and damper pulling),
@@ -74,6 +55,7 @@ constexpr unsigned clamp_bit(int leg) { return 1u << (8 + leg); }
 /// crossing) by k delta + d delta_dot, or not at all while clamped (then
 /// with whatever sign that has near the located switch); a stop not held
 /// does not act.
+inline StopContact stop_contact(const Params& p, double rho, double rhod);
 inline StopContact stop_contact(const Params& p, int leg, unsigned stops, double rho, double rhod) {
   if (stops == kStopsFromState) return stop_contact(p, rho, rhod);
   StopContact c;
@@ -91,6 +73,19 @@ inline StopContact stop_contact(const Params& p, int leg, unsigned stops, double
   if (!(stops & clamp_bit(leg))) c.force = -c.side * (p.stop_stiffness * c.depth + p.stop_damping * c.rate);
   return c;
 }
+
+/// The plain state function (each stop acts where its joint is past it, the
+/// force clamped at 0 where it would pull): the held law above, with the
+/// contact mode the state itself implies, so the law is written once.
+inline StopContact stop_contact(const Params& p, double rho, double rhod) {
+  const unsigned passed = rho < p.rho_min ? 1u : (rho > p.rho_max ? 1u << kLegs : 0u);  // as leg 0
+  StopContact c = stop_contact(p, 0, passed, rho, rhod);
+  if (c.side * c.force > 0.0) c.force = 0.0;  // k delta + d delta_dot < 0: clamped
+  return c;
+}
+
+/// F_stop on rho (N, signed along +z).
+inline double stop_force(const Params& p, double rho, double rhod) { return stop_contact(p, rho, rhod).force; }
 
 /// The stops the joints are past at these actuator positions, as a contact
 /// mode (bit i: rho_i < rho_min, bit 4 + i: rho_i > rho_max).
