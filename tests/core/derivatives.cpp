@@ -251,11 +251,11 @@ TEST(MachineDerivatives, PassiveForceAndDissipationSlopesMatchRichardsonDifferen
     SCOPED_TRACE(j.what);
     const PassiveSlopes f = passive_joint_force_slopes(p, 0, j.stops, j.rho, j.rhod);
     const PassiveSlopes d = dissipated_power_slopes(p, 0, j.stops, j.rho, j.rhod);
-    Eigen::MatrixXd an(2, 2), fd(2, 2);
-    Eigen::VectorXd err(2);
+    Eigen::Matrix2d an, fd;  // fixed size: GCC 12 misreads the dynamic blocks' stores (-Wstringop-overflow)
+    Eigen::Vector2d err;
     an << f.drho, f.drhod, d.drho, d.drhod;
     auto both = [&](double rho, double rhod) {
-      Eigen::VectorXd v(2);
+      Eigen::Vector2d v;
       v << passive_joint_force(p, 0, j.stops, rho, rhod), dissipated_power(p, 0, j.stops, rho, rhod);
       return v;
     };
