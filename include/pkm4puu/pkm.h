@@ -152,7 +152,10 @@ PKM_API pkm_status pkm_parameter_info(size_t index, pkm_parameter* info);
 PKM_API pkm_status pkm_init_pose(pkm_model* m, double t0, const double pose[4], const double velocity[4]);
 
 /** Forward dynamics from the current time to t_end with the inputs u
- * (PKM_PLANT_INPUTS values; NULL: all zero) held constant. */
+ * (PKM_PLANT_INPUTS values; NULL: all zero) held constant. An advance the
+ * solver cannot take (CVODE over less than 2^-511 s; RK4 or ROS2 over more
+ * than 1e5 grid steps of rk4_step) is refused before any work,
+ * PKM_ERR_INVALID_ARGUMENT with the reason, the state unchanged. */
 PKM_API pkm_status pkm_advance(pkm_model* m, double t_end, const double u[PKM_PLANT_INPUTS]);
 
 /** Writes the inputs u[PKM_PLANT_INPUTS] at time t (they come in zeroed). */

@@ -208,6 +208,37 @@ TEST(CApi, NonFiniteForceIsRejectedAndTheStateKept) {
   EXPECT_EQ(std::memcmp(&s0, &s1, sizeof s0), 0);
 }
 
+// An advance the integrator cannot take is refused before any work, with
+// its reason, the state kept; the FMU's DoStep asks the same question
+// (Plant::advance_refusal). CVODE over less than sqrt(DBL_MIN) = 2^-511 s:
+// its first-step estimate squares the span; RK4 over more grid steps than one
+// call may take (1e5: rk4_step 1e-6 s over 0.2 s is 2e5).
+TEST(CApi, AnAdvanceTheIntegratorCannotTakeIsRefusedBeforeAnyWork) {
+  const struct {
+    int solver;
+    double rk4_step, span;
+    const char* why;
+  } cases[] = {{PKM_SOLVER_CVODE, 1e-3, 1e-200, "shorter than CVODE can start with"},
+               {PKM_SOLVER_CVODE, 1e-3, std::ldexp(1.0, -512), "shorter than CVODE can start with"},
+               {PKM_SOLVER_RK4, 1e-6, 0.2, "more than the 100000 inner steps one call may take"}};
+  const Inputs in(kZero);
+  for (const auto& c : cases) {
+    Handle h;
+    ASSERT_EQ(pkm_set_parameter(h.m, "solver", c.solver), PKM_OK);
+    ASSERT_EQ(pkm_set_parameter(h.m, "rk4_step", c.rk4_step), PKM_OK);
+    ASSERT_EQ(pkm_init_pose(h.m, 0.0, kHome, nullptr), PKM_OK);
+    pkm_state s0 = sized<pkm_state>(), s1 = sized<pkm_state>();
+    ASSERT_EQ(pkm_get_state(h.m, &s0), PKM_OK);
+    EXPECT_EQ(pkm_advance(h.m, c.span, in.u), PKM_ERR_INVALID_ARGUMENT) << c.why;
+    EXPECT_TRUE(contains(h.error(), c.why)) << h.error();
+    ASSERT_EQ(pkm_get_state(h.m, &s1), PKM_OK);
+    EXPECT_EQ(std::memcmp(&s0, &s1, sizeof s0), 0) << c.why;
+  }
+  Handle h;  // at the bound CVODE starts
+  ASSERT_EQ(pkm_init_pose(h.m, 0.0, kHome, nullptr), PKM_OK);
+  EXPECT_EQ(pkm_advance(h.m, std::ldexp(1.0, -511), in.u), PKM_OK) << h.error();
+}
+
 TEST(CApi, StaticForcesHoldTheHomePose) {
   // Inverse dynamics at rest, fed forward for 0.5 s, keeps the platform put.
   Handle h;

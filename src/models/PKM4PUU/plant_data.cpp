@@ -198,20 +198,9 @@ bool PlantData::inputs_continue() const {
 }
 
 Status PlantData::check_step(Context& ctx, double h) const {
-  if (plant && plant->solver().solver == pkm::Solver::Cvode && h < pkm::kMinCvodeSpan) {
-    ctx.log.error("DoStep: a communication step of %.17g s is shorter than CVODE can start with (%.6g s, "
-                  "sqrt(DBL_MIN)); the call has no effect",
-                  h, pkm::kMinCvodeSpan);
-    return Status::Error;
-  }
-  if (!plant || !pkm::fixed_step(plant->solver().solver)) return Status::OK;
-  const double step = plant->solver().rk4_step;
-  const double steps = pkm::rk4_steps_for(h, step);
-  if (steps <= pkm::kMaxInnerStepsPerCall) return Status::OK;
-  ctx.log.error("DoStep: a communication step of %.6g s needs %.3g fixed steps of rk4_step = %.6g s, more than the "
-                "%.0f inner steps one call may take: use shorter communication steps or a larger rk4_step; the call "
-                "has no effect",
-                h, steps, step, pkm::kMaxInnerStepsPerCall);
+  const std::string why = plant ? plant->advance_refusal(h, "a communication step") : std::string();
+  if (why.empty()) return Status::OK;
+  ctx.log.error("DoStep: %s; the call has no effect", why.c_str());
   return Status::Error;
 }
 

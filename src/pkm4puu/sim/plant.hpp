@@ -100,6 +100,12 @@ class Plant {
   /// ending beyond them is undone and Status::Singular (or ::Unreachable)
   /// returned, with last_error() naming the leg or the condition number.
   Status advance(double t_end, const InputSignal& inputs, bool continuous = false);
+  /// Why an advance over `span` seconds would be refused before any work
+  /// ("" if it would not; advance returns Status::InvalidArgument with it):
+  /// CVODE over less than kMinCvodeSpan, or more fixed grid steps than one
+  /// call may take (kMaxInnerStepsPerCall). `what` names the span in the
+  /// message ("an interval", "a communication step").
+  std::string advance_refusal(double span, const char* what) const;
 
   bool initialized() const { return initialized_; }
   double time() const { return t_; }

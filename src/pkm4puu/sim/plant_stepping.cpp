@@ -177,16 +177,7 @@ bool Plant::cvode_capped() {
 
 Status Plant::advance_fixed(double t_end) {
   const double span = t_end - t_;
-  const double steps = rk4_steps_for(span, settings_.rk4_step);
-  if (!(steps <= kMaxInnerStepsPerCall)) {  // also NaN
-    char buf[240];
-    std::snprintf(buf, sizeof buf,
-                  "an interval of %.6g s needs %.3g fixed steps of rk4_step = %.6g s, more than the %.0f inner steps "
-                  "one call may take: use shorter intervals or a larger rk4_step",
-                  span, steps, settings_.rk4_step, kMaxInnerStepsPerCall);
-    error_ = buf;
-    return Status::InvalidArgument;
-  }
+  const double steps = rk4_steps_for(span, settings_.rk4_step);  // within the cap: advance_refusal
   const long n = std::max(1L, static_cast<long>(steps));
   const double h = span / static_cast<double>(n);
   const double t0 = t_;
@@ -315,11 +306,26 @@ Status Plant::advance_cvode(double t_end, bool continuous) {
   return Status::Ok;
 }
 
+std::string Plant::advance_refusal(double span, const char* what) const {
+  char buf[320] = "";
+  const double steps = fixed_step(settings_.solver) ? rk4_steps_for(span, settings_.rk4_step) : 0.0;
+  if (settings_.solver == Solver::Cvode && span < kMinCvodeSpan)
+    std::snprintf(buf, sizeof buf, "%s of %.17g s is shorter than CVODE can start with (%.6g s, sqrt(DBL_MIN))", what,
+                  span, kMinCvodeSpan);
+  else if (!(steps <= kMaxInnerStepsPerCall))  // also NaN
+    std::snprintf(buf, sizeof buf,
+                  "%s of %.6g s needs %.3g fixed steps of rk4_step = %.6g s, more than the %.0f inner steps one call "
+                  "may take: use a shorter one or a larger rk4_step",
+                  what, span, steps, settings_.rk4_step, kMaxInnerStepsPerCall);
+  return buf;
+}
+
 Status Plant::advance(double t_end, const InputSignal& inputs, bool continuous) {
   if (!initialized_) return Status::NotInitialized;
   if (!std::isfinite(t_end)) return Status::NonFinite;
   if (!(t_end > t_)) return t_end == t_ ? Status::Ok : Status::InvalidArgument;
-  error_.clear();
+  error_ = advance_refusal(t_end - t_, "an interval");
+  if (!error_.empty()) return Status::InvalidArgument;
   inputs_ = inputs;
   const double t_start = t_;
   const Vec8 y_start = y_;
