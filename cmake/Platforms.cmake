@@ -69,8 +69,9 @@ foreach(_t IN ITEMS win64 aarch64)
                -DPKM_CROSS_PREFIX=${_prefix}
                -DPython3_EXECUTABLE=${Python3_EXECUTABLE} -DPKM_TRACE_REFERENCE=${PKM_TRACE_DIR}
     BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR> -j2
-                  --target PKM4PUU PKM4PUU_Inverse fmi_state_machine fmi_variables fmi_fmu_states_restored
-                          fmi_fmu_states_refused fmi_stepping fmi_logging fmi_autotest_chain ${_extra_targets}
+                  --target PKM4PUU PKM4PUU_Inverse fmi_state_machine fmi_bad_arguments fmi_variables
+                          fmi_fmu_states_restored fmi_fmu_states_refused fmi_stepping fmi_logging fmi_autotest_chain
+                          ${_extra_targets}
     BUILD_ALWAYS ON
     BUILD_BYPRODUCTS ${_products}
     INSTALL_COMMAND ""

@@ -14,8 +14,8 @@ build=build-sanitize
 if [[ "${1:-}" == "--build-dir" ]]; then build="$2"; fi
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPKM_SANITIZE=ON -DPKM_LTO=OFF \
       -DPKM_BUILD_BENCHMARKS=OFF >/dev/null
-targets=(fmi_state_machine fmi_variables fmi_fmu_states_restored fmi_fmu_states_refused fmi_stepping fmi_logging
-         fmi_binary fmi_model_exchange fmi_machine fmi_bad_inputs_and_parameters fmi_singularities fmi_threads)
+targets=(fmi_state_machine fmi_bad_arguments fmi_variables fmi_fmu_states_restored fmi_fmu_states_refused fmi_stepping
+         fmi_logging fmi_binary fmi_model_exchange fmi_machine fmi_bad_inputs_and_parameters fmi_singularities fmi_threads)
 cmake --build "$build" -j2 --target "${targets[@]}"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 for t in "${targets[@]}"; do

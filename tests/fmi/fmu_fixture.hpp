@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: BSD-2-Clause
 // What the tests of the FMU binaries share beyond fmu_loader.hpp: the
-// fixture that checks both binaries loaded, two ways of driving the plant's
-// inputs, and the check of a misuse on a stepping instance (the answer the
-// error policy prescribes, a logged reason, every variable and the next step
-// unchanged), and serialised FMU states, read and forged.
+// fixture that checks both binaries loaded (and the state-machine tests' on
+// it), two ways of driving the plant's inputs, and the check of a misuse on
+// a stepping instance (the answer the error policy prescribes, a logged
+// reason, every variable and the next step unchanged), and serialised FMU
+// states, read and forged.
 #pragma once
 
 #include <cmath>
@@ -34,6 +35,9 @@ class FmuTest : public ::testing::Test {
   }
   FmuLibrary& lib = plant_library();
 };
+
+/// The StateMachine tests' fixture (state_machine.cpp, bad_arguments.cpp).
+class StateMachine : public FmuTest {};
 
 /// Inputs that move the platform around: forces near the static ones plus
 /// a slow variation, and their derivatives for interpolation.
