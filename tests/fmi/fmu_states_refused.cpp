@@ -119,7 +119,7 @@ TEST_F(FmuState, ForeignOrBrokenFmuStates) {
 }
 
 // States with a valid checksum and absurd content. The layout
-// (fmu_state.cpp): a 32-byte header; mode (4), three flags (3), startTime,
+// (src/fmi/fmu_state.cpp): a 32-byte header; mode (4), three flags (3), startTime,
 // stopTime, time, last successful time, time since start (8 each) from byte
 // 39; the count (4) and the stored variables (8 each) from byte 83; then the input
 // derivatives and the plant's part (PlantPart).
