@@ -7,8 +7,10 @@ include_guard(GLOBAL)
 if(Python3_Interpreter_FOUND AND NOT CMAKE_CROSSCOMPILING)
   execute_process(COMMAND "${Python3_EXECUTABLE}" -c "import mujoco, os; print(os.path.dirname(mujoco.__file__))"
                   OUTPUT_VARIABLE _pkm_mujoco OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
-  file(GLOB _pkm_mujoco_lib "${_pkm_mujoco}/libmujoco.so*")
-  if(_pkm_mujoco AND _pkm_mujoco_lib AND EXISTS "${_pkm_mujoco}/include/mujoco/mujoco.h")
+  if(_pkm_mujoco)
+    file(GLOB _pkm_mujoco_lib "${_pkm_mujoco}/libmujoco.so*")
+  endif()
+  if(_pkm_mujoco_lib AND EXISTS "${_pkm_mujoco}/include/mujoco/mujoco.h")
     list(GET _pkm_mujoco_lib 0 _pkm_mujoco_lib)
     add_library(pkm::mujoco SHARED IMPORTED)
     set_target_properties(pkm::mujoco PROPERTIES IMPORTED_LOCATION "${_pkm_mujoco_lib}"

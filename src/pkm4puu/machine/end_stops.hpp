@@ -50,12 +50,14 @@ constexpr unsigned kContactModeBits = 0xFFFu;
 /// Bit 8 + leg: the leg's held stop is clamped.
 constexpr unsigned clamp_bit(int leg) { return 1u << (8 + leg); }
 
+/// The plain state function, defined below through the held law.
+inline StopContact stop_contact(const Params& p, double rho, double rhod);
+
 /// The same as stop_contact with the contact mode held: a held stop acts
 /// with the signed depth (slightly negative just before the located
 /// crossing) by k delta + d delta_dot, or not at all while clamped (then
 /// with whatever sign that has near the located switch); a stop not held
 /// does not act.
-inline StopContact stop_contact(const Params& p, double rho, double rhod);
 inline StopContact stop_contact(const Params& p, int leg, unsigned stops, double rho, double rhod) {
   if (stops == kStopsFromState) return stop_contact(p, rho, rhod);
   StopContact c;
